@@ -1,0 +1,63 @@
+"""ambfplus: surgical simulation with ground-truth data, a C++ engine scripted from Python.
+
+Conventions (SI units; world frame right-handed, z up):
+
+- ``Camera.pose`` is world-from-camera in the OpenCV camera frame (x right, y down, z forward).
+- ``Frame.rgb`` is uint8 (H, W, 3) RGB, ``Frame.depth`` float32 (H, W) metric z along the optical
+  axis, 0 where nothing was hit; image row 0 is the top.
+- ``Camera.intrinsics``: fx = fy = H / (2 tan(fov_y / 2)), cx = W / 2, cy = H / 2, where pixel
+  (row r, column c) is centred at (c + 0.5, r + 0.5). Subtract 0.5 from cx and cy for tools that
+  put pixel centres on integers (OpenCV).
+"""
+
+try:
+    from . import _core  # noqa: F401 (fail here with a clear message)
+except ImportError as _error:  # pragma: no cover - depends on how the package was found
+    import os as _os
+
+    raise ImportError(
+        f"ambfplus was imported from {_os.path.dirname(__file__)}, which holds no compiled engine "
+        "(ambfplus._core). Install the package (pip install .) and run from outside the source "
+        "folder, or use the installed command (ambfplus ...)."
+    ) from _error
+
+from ._core import (
+    AssetNotFound,
+    Camera,
+    ConfigError,
+    Error,
+    Frame,
+    Light,
+    Model,
+    Object,
+    PluginError,
+    RenderError,
+    RigidBody,
+    Simulator,
+    World,
+    __version__,
+    gl_info,
+    write_image,
+)
+from .transforms import make_pose, rpy_matrix
+
+__all__ = [
+    "AssetNotFound",
+    "Camera",
+    "ConfigError",
+    "Error",
+    "Frame",
+    "Light",
+    "Model",
+    "Object",
+    "PluginError",
+    "RenderError",
+    "RigidBody",
+    "Simulator",
+    "World",
+    "__version__",
+    "gl_info",
+    "make_pose",
+    "rpy_matrix",
+    "write_image",
+]

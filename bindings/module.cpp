@@ -1,0 +1,47 @@
+#include <pybind11/pybind11.h>
+
+#include <cstdlib>
+
+#include "ambfplus/log.h"
+#include "ambfplus/version.h"
+#include "bindings.h"
+
+namespace py = pybind11;
+
+namespace {
+
+// Routes engine log messages to Python's logging ("ambfplus" logger), taking the GIL for it.
+void log_to_python(ambfplus::LogLevel level, const std::string& message) {
+  if (!Py_IsInitialized()) return;
+  py::gil_scoped_acquire gil;
+  try {
+    py::module_::import("logging")
+        .attr("getLogger")("ambfplus")
+        .attr("log")(static_cast<int>(level), message);
+  } catch (py::error_already_set& e) {
+    e.discard_as_unraisable("ambfplus log message");
+  }
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_core, m) {
+  m.doc() = "ambfplus engine bindings (use the ambfplus package, not this module)";
+  m.attr("__version__") = ambfplus::version();
+
+  ambfplus::bindings::register_errors(m);
+  ambfplus::bindings::register_io(m);
+  ambfplus::bindings::register_render(m);
+  ambfplus::bindings::register_capture(m);
+  ambfplus::bindings::register_scene(m);
+
+  // Info and above go to Python, whose logging decides what to show (debug only on request, by
+  // AMBFPLUS_LOG_LEVEL=debug, since every message takes the GIL).
+  if (std::getenv("AMBFPLUS_LOG_LEVEL") == nullptr) {
+    ambfplus::set_log_level(ambfplus::LogLevel::kInfo);
+  }
+  ambfplus::set_log_sink(&log_to_python);
+  // Back to stderr before the interpreter goes away.
+  py::module_::import("atexit").attr("register")(
+      py::cpp_function([]() { ambfplus::set_log_sink({}); }));
+}

@@ -1,0 +1,177 @@
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <time.h>
+
+#include <chrono>
+#include <sstream>
+#include <vector>
+
+#include "ambfplus/capture/frame.h"
+#include "ambfplus/scene/camera.h"
+#include "bindings.h"
+
+namespace py = pybind11;
+
+namespace ambfplus::bindings {
+namespace {
+
+// A NumPy view of a frame's buffer whose base is the frame, so the frame (and the buffer) lives
+// as long as any view of it.
+template <typename T>
+py::object view(py::object frame, ImageBuffer<T>& buffer, bool drop_channel_axis) {
+  if (buffer.empty()) return py::none();
+  const auto h = static_cast<py::ssize_t>(buffer.height());
+  const auto w = static_cast<py::ssize_t>(buffer.width());
+  const auto c = static_cast<py::ssize_t>(buffer.channels());
+  const auto s = static_cast<py::ssize_t>(sizeof(T));
+  if (drop_channel_axis) {
+    return py::array_t<T>({h, w}, {w * c * s, c * s}, buffer.data(), frame);
+  }
+  return py::array_t<T>({h, w, c}, {w * c * s, c * s, s}, buffer.data(), frame);
+}
+
+// Checks a caller's array and returns its data pointer.
+template <typename T>
+T* checked_output(const py::handle& value, const char* key,
+                  std::initializer_list<py::ssize_t> shape) {
+  if (!py::isinstance<py::array>(value)) {
+    throw py::type_error(std::string("out['") + key + "'] must be a NumPy array");
+  }
+  auto array = py::reinterpret_borrow<py::array>(value);
+  std::ostringstream want;
+  want << "(";
+  for (auto it = shape.begin(); it != shape.end(); ++it) {
+    want << (it == shape.begin() ? "" : ", ") << *it;
+  }
+  want << (shape.size() == 1 ? ",)" : ")");
+  const bool dtype_ok = array.dtype().is(py::dtype::of<T>());
+  bool shape_ok = static_cast<std::size_t>(array.ndim()) == shape.size();
+  if (shape_ok) {
+    std::size_t i = 0;
+    for (py::ssize_t d : shape)
+      shape_ok = shape_ok && array.shape(static_cast<py::ssize_t>(i++)) == d;
+  }
+  const bool contiguous = (array.flags() & py::array::c_style) != 0;
+  if (!dtype_ok || !shape_ok || !contiguous || !array.writeable()) {
+    throw py::value_error(std::string("out['") + key + "'] must be a writable C-contiguous " +
+                          py::str(py::dtype::of<T>()).cast<std::string>() + " array of shape " +
+                          want.str() + ", got " + py::str(array.dtype()).cast<std::string>() + " " +
+                          py::str(array.attr("shape")).cast<std::string>() +
+                          (contiguous ? "" : " (not C-contiguous)") +
+                          (array.writeable() ? "" : " (read-only)"));
+  }
+  return static_cast<T*>(array.mutable_data());
+}
+
+// CPU seconds of the whole process (all threads, the rasteriser's included).
+double process_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+}  // namespace
+
+py::object capture(Camera& camera, py::object out) {
+  if (out.is_none()) {
+    auto frame = std::make_shared<Frame>();
+    {
+      py::gil_scoped_release release;
+      camera.capture(*frame);
+    }
+    return py::cast(frame);
+  }
+  if (py::isinstance<Frame>(out)) {
+    Frame& frame = out.cast<Frame&>();
+    py::gil_scoped_release release;
+    camera.capture(frame);
+    return out;
+  }
+  if (py::isinstance<py::dict>(out)) {
+    auto buffers = py::reinterpret_borrow<py::dict>(out);
+    const py::ssize_t h = camera.height(), w = camera.width();
+    auto frame = std::make_shared<Frame>();
+    CaptureBuffers targets;
+    for (auto item : buffers) {
+      const std::string key = py::str(item.first);
+      if (key == "rgb") {
+        targets.rgb = checked_output<std::uint8_t>(item.second, "rgb", {h, w, 3});
+        frame->rgb.attach(targets.rgb, camera.height(), camera.width(), 3);
+      } else if (key == "depth") {
+        targets.depth = checked_output<float>(item.second, "depth", {h, w});
+        frame->depth.attach(targets.depth, camera.height(), camera.width(), 1);
+      } else {
+        throw py::value_error("out has an unknown key '" + key +
+                              "': expected 'rgb' and/or 'depth'");
+      }
+    }
+    py::object result = py::cast(frame);
+    // The frame's views point into the caller's arrays: keep those alive with it.
+    result.attr("_out") = buffers;
+    {
+      py::gil_scoped_release release;
+      camera.capture(targets, *frame);
+    }
+    return result;
+  }
+  throw py::type_error("out must be None, a Frame, or a dict of arrays {'rgb': ..., 'depth': ...}");
+}
+
+void register_capture(py::module_& m) {
+  py::class_<Frame, std::shared_ptr<Frame>>(m, "Frame", py::dynamic_attr(),
+                                            "One capture of a camera: images, time and geometry.")
+      .def_property_readonly(
+          "rgb", [](py::object self) { return view(self, self.cast<Frame&>().rgb, false); },
+          "uint8 (H, W, 3) RGB view of the frame's colour image (row 0 at the top), or None")
+      .def_property_readonly(
+          "depth", [](py::object self) { return view(self, self.cast<Frame&>().depth, true); },
+          "float32 (H, W) view: metric z along the optical axis, 0 where nothing was hit")
+      .def_readonly("width", &Frame::width)
+      .def_readonly("height", &Frame::height)
+      .def_readonly("time", &Frame::time, "simulation time of the capture, seconds")
+      .def_readonly("step", &Frame::step, "simulation step index of the capture")
+      .def_readonly("camera", &Frame::camera, "name of the camera")
+      .def_property_readonly(
+          "intrinsics", [](const Frame& f) { return Eigen::Matrix3d(f.intrinsics); },
+          "3x3 K; pixel (row r, column c) is centred at (c + 0.5, r + 0.5)")
+      .def_property_readonly(
+          "pose", [](const Frame& f) { return Eigen::Matrix4d(f.pose); },
+          "4x4 world from camera (OpenCV camera frame) at the capture")
+      .def("__repr__", [](const Frame& f) {
+        std::ostringstream s;
+        s << "<Frame camera='" << f.camera << "' " << f.width << "x" << f.height
+          << " step=" << f.step << " time=" << f.time << ">";
+        return s.str();
+      });
+
+  // The baseline of the capture benchmark: the same draw and readback, in C++, into buffers
+  // allocated once, with no Python in the loop.
+  m.def(
+      "_benchmark_bare_capture",
+      [](Camera& camera, int iterations) {
+        std::vector<std::uint8_t> rgb(static_cast<std::size_t>(camera.width()) * camera.height() *
+                                      3);
+        std::vector<float> depth(static_cast<std::size_t>(camera.width()) * camera.height());
+        Frame frame;
+        double wall = 0, cpu = 0;
+        {
+          py::gil_scoped_release release;
+          const CaptureBuffers buffers{rgb.data(), depth.data()};
+          camera.capture(buffers, frame);  // warm-up: context, program, buffers
+          const auto t0 = std::chrono::steady_clock::now();
+          const double c0 = process_cpu_seconds();
+          for (int i = 0; i < iterations; ++i) camera.capture(buffers, frame);
+          cpu = process_cpu_seconds() - c0;
+          wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        }
+        py::dict d;
+        d["wall_seconds"] = wall / iterations;
+        d["cpu_seconds"] = cpu / iterations;
+        return d;
+      },
+      py::arg("camera"), py::arg("iterations"));
+}
+
+}  // namespace ambfplus::bindings

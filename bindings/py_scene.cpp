@@ -1,0 +1,393 @@
+#include <pybind11/eigen.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <optional>
+#include <sstream>
+
+#include "ambfplus/scene/simulator.h"
+#include "bindings.h"
+
+namespace py = pybind11;
+
+namespace ambfplus::bindings {
+namespace {
+
+using Vec3 = Eigen::Vector3d;
+using Mat4 = Eigen::Matrix4d;
+
+// Every handle given to Python shares ownership of the simulator, so no handle outlives the
+// objects it points into, whatever order Python drops them in.
+template <typename T>
+std::shared_ptr<T> handle(T* p, World& world) {
+  return std::shared_ptr<T>(world.simulator().shared_from_this(), p);
+}
+
+py::object to_python(Object* o) {
+  if (o == nullptr) return py::none();
+  World& w = o->world();
+  switch (o->kind()) {
+    case ObjectKind::kRigidBody:
+      return py::cast(handle(static_cast<RigidBody*>(o), w));
+    case ObjectKind::kCamera:
+      return py::cast(handle(static_cast<Camera*>(o), w));
+    case ObjectKind::kLight:
+      return py::cast(handle(static_cast<Light*>(o), w));
+  }
+  return py::cast(handle(o, w));
+}
+
+template <typename T>
+py::list to_python_list(const std::vector<T*>& objects) {
+  py::list out;
+  for (T* o : objects) out.append(to_python(o));
+  return out;
+}
+
+std::array<float, 4> rgba(const std::vector<double>& c, const char* what) {
+  if (c.size() != 3 && c.size() != 4) {
+    throw py::value_error(std::string(what) + " must be (r, g, b) or (r, g, b, a) in 0..1");
+  }
+  std::array<float, 4> out{0, 0, 0, 1};
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    if (!(c[i] >= 0.0 && c[i] <= 1.0)) {
+      throw py::value_error(std::string(what) + " components must be in 0..1");
+    }
+    out[i] = static_cast<float>(c[i]);
+  }
+  return out;
+}
+
+std::array<float, 3> rgb(const std::vector<double>& c, const char* what) {
+  if (c.size() != 3) throw py::value_error(std::string(what) + " must be (r, g, b)");
+  const auto four = rgba(c, what);
+  return {four[0], four[1], four[2]};
+}
+
+// Rejects a dimension given for a shape it does not apply to.
+void reject(bool given, const char* key, Shape::Kind kind) {
+  if (given) {
+    throw py::value_error(std::string(key) + " does not apply to a " + shape_kind_name(kind) +
+                          " body");
+  }
+}
+
+RigidBody& add_body(Model& model, const std::string& name, const std::string& shape,
+                    std::optional<Vec3> size, std::optional<double> radius,
+                    std::optional<double> height, std::optional<std::string> mesh, double scale,
+                    std::optional<Mat4> pose, double mass, std::optional<std::vector<double>> color,
+                    std::optional<double> specular, std::optional<double> shininess) {
+  RigidBodySpec spec;
+  spec.name = name;
+  spec.shape.kind = parse_shape_kind(shape.empty() ? (mesh ? "mesh" : "box") : shape);
+  const Shape::Kind kind = spec.shape.kind;
+  const auto need = [&](bool given, const char* key) {
+    if (!given) {
+      throw py::value_error("body '" + name + "': a " + shape_kind_name(kind) + " needs " + key);
+    }
+  };
+  switch (kind) {
+    case Shape::Kind::kBox:
+      need(size.has_value(), "size=(x, y, z)");
+      reject(radius.has_value(), "radius", kind);
+      reject(height.has_value(), "height", kind);
+      spec.shape.size = *size;
+      break;
+    case Shape::Kind::kSphere:
+      need(radius.has_value(), "radius");
+      reject(size.has_value(), "size", kind);
+      reject(height.has_value(), "height", kind);
+      spec.shape.radius = *radius;
+      break;
+    case Shape::Kind::kCylinder:
+    case Shape::Kind::kCapsule:
+    case Shape::Kind::kCone:
+      need(radius.has_value() && height.has_value(), "radius and height");
+      reject(size.has_value(), "size", kind);
+      spec.shape.radius = *radius;
+      spec.shape.height = *height;
+      break;
+    case Shape::Kind::kPlane:
+      reject(size.has_value(), "size", kind);
+      reject(radius.has_value(), "radius", kind);
+      reject(height.has_value(), "height", kind);
+      break;
+    case Shape::Kind::kMesh:
+      need(mesh.has_value(), "mesh='file'");
+      reject(size.has_value(), "size", kind);
+      reject(radius.has_value(), "radius", kind);
+      reject(height.has_value(), "height", kind);
+      spec.shape.mesh = *mesh;
+      spec.shape.scale = scale;
+      break;
+  }
+  if (kind != Shape::Kind::kMesh) {
+    if (mesh) throw py::value_error("mesh= needs shape='mesh' (or no shape)");
+    if (scale != 1.0) throw py::value_error("scale applies to mesh bodies only");
+  }
+  if (pose) spec.pose = *pose;
+  spec.mass = mass;
+  if (color) spec.material.color = rgba(*color, "color");
+  if (specular) spec.material.specular = static_cast<float>(*specular);
+  if (shininess) spec.material.shininess = static_cast<float>(*shininess);
+  RigidBody* body = nullptr;
+  {
+    py::gil_scoped_release release;  // mesh files can take a while to read
+    body = &model.add_body(spec);
+  }
+  return *body;
+}
+
+Camera& add_camera(Model& model, const std::string& name, int width, int height, double fov_y,
+                   double near, double far, std::optional<Mat4> pose,
+                   const std::vector<double>& background) {
+  CameraSpec spec;
+  spec.name = name;
+  spec.width = width;
+  spec.height = height;
+  spec.fov_y = fov_y;
+  spec.near = near;
+  spec.far = far;
+  if (pose) spec.pose = *pose;
+  spec.background = rgb(background, "background");
+  return model.add_camera(spec);
+}
+
+Light& add_light(Model& model, const std::string& name, const std::string& type,
+                 const Vec3& position, const Vec3& direction, const std::vector<double>& color,
+                 double intensity, double spot_cutoff, double spot_exponent,
+                 const Vec3& attenuation) {
+  LightSpec spec;
+  spec.name = name;
+  spec.type = parse_light_type(type);
+  spec.position = position;
+  spec.direction = direction;
+  spec.color = rgb(color, "color");
+  spec.intensity = static_cast<float>(intensity);
+  spec.spot_cutoff = static_cast<float>(spot_cutoff);
+  spec.spot_exponent = static_cast<float>(spot_exponent);
+  for (int i = 0; i < 3; ++i) spec.attenuation[i] = static_cast<float>(attenuation[i]);
+  return model.add_light(spec);
+}
+
+// The add_* methods, shared by Model and World (which adds to its default model).
+template <typename Class, typename GetModel>
+void def_adders(Class& cls, GetModel get_model) {
+  cls.def(
+         "add_body",
+         [get_model](typename Class::type& self, const std::string& name, const std::string& shape,
+                     std::optional<Vec3> size, std::optional<double> radius,
+                     std::optional<double> height, std::optional<std::string> mesh, double scale,
+                     std::optional<Mat4> pose, double mass,
+                     std::optional<std::vector<double>> color, std::optional<double> specular,
+                     std::optional<double> shininess) {
+           Model& model = get_model(self);
+           return handle(&add_body(model, name, shape, size, radius, height, mesh, scale, pose,
+                                   mass, color, specular, shininess),
+                         model.world());
+         },
+         py::arg("name"), py::arg("shape") = "", py::kw_only(), py::arg("size") = py::none(),
+         py::arg("radius") = py::none(), py::arg("height") = py::none(),
+         py::arg("mesh") = py::none(), py::arg("scale") = 1.0, py::arg("pose") = py::none(),
+         py::arg("mass") = 1.0, py::arg("color") = py::none(), py::arg("specular") = py::none(),
+         py::arg("shininess") = py::none(),
+         "Adds a rigid body: shape is box (size = full extents), sphere (radius), cylinder, "
+         "capsule or cone (radius, height along z; a capsule's height includes its caps), plane "
+         "(z = 0, infinite) or mesh (mesh = file, scale); pose is a 4x4 world-from-body matrix.")
+      .def(
+          "add_camera",
+          [get_model](typename Class::type& self, const std::string& name, int width, int height,
+                      double fov_y, double near, double far, std::optional<Mat4> pose,
+                      const std::vector<double>& background) {
+            Model& model = get_model(self);
+            return handle(
+                &add_camera(model, name, width, height, fov_y, near, far, pose, background),
+                model.world());
+          },
+          py::arg("name"), py::arg("width") = 640, py::arg("height") = 480, py::arg("fov_y") = 0.7,
+          py::arg("near") = 0.1, py::arg("far") = 10.0, py::kw_only(), py::arg("pose") = py::none(),
+          py::arg("background") = std::vector<double>{0.0, 0.0, 0.0},
+          "Adds a pinhole camera (OpenCV frame: x right, y down, z forward); fov_y is the "
+          "vertical field of view in radians, near and far the clipping distances in metres.")
+      .def(
+          "add_light",
+          [get_model](typename Class::type& self, const std::string& name, const std::string& type,
+                      const Vec3& position, const Vec3& direction, const std::vector<double>& color,
+                      double intensity, double spot_cutoff, double spot_exponent,
+                      const Vec3& attenuation) {
+            Model& model = get_model(self);
+            return handle(&add_light(model, name, type, position, direction, color, intensity,
+                                     spot_cutoff, spot_exponent, attenuation),
+                          model.world());
+          },
+          py::arg("name"), py::arg("type") = "directional", py::kw_only(),
+          py::arg("position") = Vec3(0, 0, 0), py::arg("direction") = Vec3(0, 0, -1),
+          py::arg("color") = std::vector<double>{1.0, 1.0, 1.0}, py::arg("intensity") = 1.0,
+          py::arg("spot_cutoff") = 0.7, py::arg("spot_exponent") = 0.7,
+          py::arg("attenuation") = Vec3(1, 0, 0),
+          "Adds a directional, point or spot light shining along direction. A world without "
+          "lights is lit by a headlight at each camera.");
+}
+
+std::string repr_object(const Object& o) {
+  std::ostringstream s;
+  s << "<" << object_kind_name(o.kind()) << " '" << o.name() << "' id=" << o.id() << ">";
+  return s.str();
+}
+
+}  // namespace
+
+void register_scene(py::module_& m) {
+  py::class_<Simulator, std::shared_ptr<Simulator>> simulator(
+      m, "Simulator", "The top of the hierarchy Simulator > World > Model > Object.");
+  py::class_<World, std::shared_ptr<World>> world(
+      m, "World", "The scene (models and their objects) and the simulation clock.");
+  py::class_<Model, std::shared_ptr<Model>> model(
+      m, "Model", "A group of objects; names are unique across the whole world.");
+  py::class_<Object, std::shared_ptr<Object>> object(m, "Object",
+                                                     "Anything in a world with a unique name.");
+  py::class_<RigidBody, Object, std::shared_ptr<RigidBody>> body(
+      m, "RigidBody", "A rigid body: a shape with mass and a material.");
+  py::class_<Camera, Object, std::shared_ptr<Camera>> camera(
+      m, "Camera", "A pinhole camera; pose is world from camera in the OpenCV frame.");
+  py::class_<Light, Object, std::shared_ptr<Light>> light(
+      m, "Light", "A directional, point or spot light shining along its +z axis.");
+
+  simulator
+      .def(py::init([](double time_step, const std::string& world_name) {
+             SimulatorOptions options;
+             options.time_step = time_step;
+             options.world_name = world_name;
+             return Simulator::create(options);
+           }),
+           py::arg("time_step") = 0.001, py::arg("world_name") = "World")
+      .def_property_readonly("world", [](Simulator& s) { return handle(&s.world(), s.world()); })
+      .def(
+          "step",
+          [](Simulator& s, std::int64_t n) {
+            py::gil_scoped_release release;
+            s.step(n);
+          },
+          py::arg("n") = 1, "Advances the world by n fixed steps.");
+
+  world
+      .def(py::init([](double time_step, const std::string& name) {
+             SimulatorOptions options;
+             options.time_step = time_step;
+             options.world_name = name;
+             auto sim = Simulator::create(options);
+             return handle(&sim->world(), sim->world());
+           }),
+           py::arg("time_step") = 0.001, py::arg("name") = "World",
+           "Creates a simulator with an empty world and returns the world.")
+      .def_property_readonly("name", &World::name)
+      .def_property_readonly("simulator", [](World& w) { return w.simulator().shared_from_this(); })
+      .def_property_readonly("time", &World::time, "simulation time, seconds")
+      .def_property_readonly("step_index", &World::step_index, "fixed steps taken so far")
+      .def_property_readonly("time_step", &World::time_step, "seconds per fixed step")
+      .def(
+          "step",
+          [](World& w, std::int64_t n) {
+            py::gil_scoped_release release;
+            w.step(n);
+          },
+          py::arg("n") = 1, "Advances the clock by n fixed steps.")
+      .def_property_readonly("default_model",
+                             [](World& w) { return handle(&w.default_model(), w); })
+      .def_property_readonly("models",
+                             [](World& w) {
+                               py::list out;
+                               for (Model* m : w.models()) out.append(handle(m, w));
+                               return out;
+                             })
+      .def(
+          "add_model",
+          [](World& w, const std::string& name) { return handle(&w.add_model(name), w); },
+          py::arg("name"))
+      .def(
+          "get",
+          [](World& w, const std::string& name) {
+            Object* o = w.find(name);
+            if (o == nullptr) throw py::key_error("no object named '" + name + "' in the world");
+            return to_python(o);
+          },
+          py::arg("name"), "The object with exactly this name; KeyError if there is none.")
+      .def("__getitem__",
+           [](World& w, const std::string& name) {
+             Object* o = w.find(name);
+             if (o == nullptr) throw py::key_error(name);
+             return to_python(o);
+           })
+      .def("__contains__",
+           [](World& w, const std::string& name) { return w.find(name) != nullptr; })
+      .def("__len__", [](World& w) { return w.objects().size(); })
+      .def_property_readonly("objects", [](World& w) { return to_python_list(w.objects()); })
+      .def_property_readonly(
+          "bodies", [](World& w) { return to_python_list(w.objects_of_kind<RigidBody>()); })
+      .def_property_readonly("cameras",
+                             [](World& w) { return to_python_list(w.objects_of_kind<Camera>()); })
+      .def_property_readonly("lights",
+                             [](World& w) { return to_python_list(w.objects_of_kind<Light>()); })
+      .def("__repr__", [](World& w) {
+        std::ostringstream s;
+        s << "<World '" << w.name() << "' objects=" << w.objects().size()
+          << " step=" << w.step_index() << ">";
+        return s.str();
+      });
+  def_adders(world, [](World& w) -> Model& { return w.default_model(); });
+
+  model.def_property_readonly("name", &Model::name)
+      .def_property_readonly("world", [](Model& md) { return handle(&md.world(), md.world()); })
+      .def_property_readonly("objects", [](Model& md) { return to_python_list(md.objects()); })
+      .def("__repr__", [](Model& md) { return "<Model '" + md.name() + "'>"; });
+  def_adders(model, [](Model& md) -> Model& { return md; });
+
+  object.def_property_readonly("name", &Object::name)
+      .def_property_readonly("id", &Object::id, "stable instance id (>= 1) used by segmentation")
+      .def_property_readonly("kind", [](Object& o) { return object_kind_name(o.kind()); })
+      .def_property_readonly("model", [](Object& o) { return handle(&o.model(), o.world()); })
+      .def_property(
+          "pose", [](Object& o) { return Mat4(o.pose().matrix()); },
+          [](Object& o, const Mat4& m) { o.set_pose(checked_pose(m)); },
+          "4x4 world-from-object rigid transform (a copy; assign to change it)")
+      .def("__repr__", &repr_object);
+
+  body.def_property_readonly("shape", [](RigidBody& b) { return shape_kind_name(b.shape().kind); })
+      .def_property_readonly("mass", &RigidBody::mass)
+      .def_property_readonly("size", [](RigidBody& b) { return Vec3(b.shape().size); })
+      .def_property_readonly("radius", [](RigidBody& b) { return b.shape().radius; })
+      .def_property_readonly("height", [](RigidBody& b) { return b.shape().height; })
+      .def_property_readonly("mesh", [](RigidBody& b) { return b.shape().mesh; })
+      .def_property(
+          "color", [](RigidBody& b) { return b.material().color; },
+          [](RigidBody& b, const std::vector<double>& c) {
+            Material m = b.material();
+            m.color = rgba(c, "color");
+            b.set_material(m);
+          },
+          "RGBA in 0..1");
+
+  camera.def_property_readonly("width", &Camera::width)
+      .def_property_readonly("height", &Camera::height)
+      .def_property_readonly("fov_y", &Camera::fov_y, "vertical field of view, radians")
+      .def_property_readonly("near", &Camera::near)
+      .def_property_readonly("far", &Camera::far)
+      .def_property_readonly("intrinsics", &Camera::intrinsics,
+                             "3x3 K: fx = fy = H / (2 tan(fov_y / 2)), cx = W / 2, cy = H / 2; "
+                             "pixel (row r, column c) is centred at (c + 0.5, r + 0.5)")
+      .def_property_readonly("projection", &Camera::projection,
+                             "4x4 OpenGL clip-from-camera matrix used to render")
+      .def("look_at", &Camera::look_at, py::arg("eye"), py::arg("target"),
+           py::arg("up") = Vec3(0, 0, 1),
+           "Places the camera at eye looking at target, with image up along up.")
+      .def("capture", &capture, py::arg("out") = py::none(),
+           "Renders (GIL released) and returns a Frame of NumPy views; out=Frame refills that "
+           "frame in place, out={'rgb': a, 'depth': b} renders into preallocated arrays.");
+
+  light.def_property_readonly("type", [](Light& l) { return light_type_name(l.type()); })
+      .def_property_readonly("direction", &Light::direction)
+      .def_property_readonly("color", &Light::color)
+      .def_property_readonly("intensity", &Light::intensity);
+}
+
+}  // namespace ambfplus::bindings

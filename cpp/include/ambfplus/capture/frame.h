@@ -1,0 +1,37 @@
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include <Eigen/Geometry>
+
+#include "ambfplus/capture/image_buffer.h"
+#include "ambfplus/export.h"
+
+namespace ambfplus {
+
+/// One camera capture: images plus the geometry and time they were taken at.
+///
+/// Conventions: image row 0 is the top; rgb is uint8 RGB; depth is metric z along the optical
+/// axis (0 where nothing was hit). The intrinsics map a camera-frame point (x right, y down,
+/// z forward) to continuous pixel coordinates in which pixel (row r, column c) covers
+/// [c, c+1) x [r, r+1) and is centred at (c + 0.5, r + 0.5).
+class AMBFPLUS_API Frame {
+ public:
+  Frame() = default;
+  Frame(Frame&&) noexcept = default;
+  Frame& operator=(Frame&&) noexcept = default;
+
+  ImageBuffer<std::uint8_t> rgb;  ///< height x width x 3
+  ImageBuffer<float> depth;       ///< height x width
+
+  int width = 0;
+  int height = 0;
+  double time = 0.0;      ///< simulation time of the capture, seconds
+  std::int64_t step = 0;  ///< simulation step index of the capture
+  std::string camera;     ///< name of the camera that took it
+  Eigen::Matrix3d intrinsics = Eigen::Matrix3d::Identity();
+  Eigen::Matrix4d pose = Eigen::Matrix4d::Identity();  ///< world from camera (OpenCV frame)
+};
+
+}  // namespace ambfplus

@@ -1,0 +1,54 @@
+#pragma once
+
+#include <stdexcept>
+#include <string>
+
+#include "ambfplus/export.h"
+
+namespace ambfplus {
+
+/// Base of every error the engine raises on purpose.
+class AMBFPLUS_API Error : public std::runtime_error {
+ public:
+  explicit Error(const std::string& message) : std::runtime_error(message) {}
+};
+
+/// A scene or data file that cannot be used: names the file, the key or line, and what was
+/// expected.
+class AMBFPLUS_API ConfigError : public Error {
+ public:
+  ConfigError(const std::string& file, const std::string& reason)
+      : Error(file.empty() ? reason : file + ": " + reason), file_(file) {}
+  /// The file at fault ("" when the error is not tied to one).
+  const std::string& file() const { return file_; }
+
+ private:
+  std::string file_;
+};
+
+/// A file the scene refers to does not exist.
+class AMBFPLUS_API AssetNotFound : public Error {
+ public:
+  explicit AssetNotFound(const std::string& path, const std::string& context = "")
+      : Error((context.empty() ? std::string() : context + ": ") + "file not found: " + path),
+        path_(path) {}
+  /// The path that was looked for.
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
+/// The renderer cannot do what was asked (no usable EGL device, shader errors, GL errors).
+class AMBFPLUS_API RenderError : public Error {
+ public:
+  explicit RenderError(const std::string& message) : Error(message) {}
+};
+
+/// A plugin cannot be loaded or initialised.
+class AMBFPLUS_API PluginError : public Error {
+ public:
+  explicit PluginError(const std::string& message) : Error(message) {}
+};
+
+}  // namespace ambfplus

@@ -1,0 +1,31 @@
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "ambfplus/export.h"
+
+namespace ambfplus {
+
+/// A triangle mesh in one frame, ready for rendering or collision.
+struct AMBFPLUS_API MeshData {
+  /// 3 floats per vertex, or 4 (homogeneous, w = 0 for points at infinity) when position_size is 4.
+  std::vector<float> positions;
+  /// 3 floats per vertex, unit length.
+  std::vector<float> normals;
+  /// 3 indices per triangle.
+  std::vector<std::uint32_t> indices;
+  int position_size = 3;
+
+  std::size_t vertex_count() const { return positions.size() / position_size; }
+  std::size_t triangle_count() const { return indices.size() / 3; }
+};
+
+/// Reads every mesh in a file (OBJ, STL, PLY, glTF, 3DS, ... through assimp) into one MeshData,
+/// with node transforms applied and positions multiplied by scale. Throws AssetNotFound when the
+/// file does not exist and ConfigError (naming the file and assimp's reason) when it cannot be
+/// read.
+AMBFPLUS_API MeshData load_mesh(const std::string& path, double scale = 1.0);
+
+}  // namespace ambfplus

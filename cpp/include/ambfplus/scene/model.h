@@ -1,0 +1,49 @@
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "ambfplus/export.h"
+#include "ambfplus/scene/camera.h"
+#include "ambfplus/scene/light.h"
+#include "ambfplus/scene/rigid_body.h"
+
+namespace ambfplus {
+
+class World;
+
+/// A group of objects loaded or built together (an AMBF multibody file, or the world's own
+/// objects). Names are unique across the whole world, not only within a model.
+class AMBFPLUS_API Model {
+ public:
+  ~Model();
+  Model(const Model&) = delete;
+  Model& operator=(const Model&) = delete;
+
+  const std::string& name() const { return name_; }
+  World& world() const { return *world_; }
+  /// Objects in creation order.
+  const std::vector<Object*>& objects() const { return objects_; }
+
+  /// Creates a body. Throws std::invalid_argument for a bad spec or a taken name, AssetNotFound
+  /// or ConfigError for a mesh that cannot be read.
+  RigidBody& add_body(const RigidBodySpec& spec);
+  /// Creates a camera. Throws std::invalid_argument for a bad spec or a taken name.
+  Camera& add_camera(const CameraSpec& spec);
+  /// Creates a light. Throws std::invalid_argument for a bad spec or a taken name.
+  Light& add_light(const LightSpec& spec);
+
+ private:
+  friend class World;
+  Model(World& world, std::string name);
+  template <typename T>
+  T& adopt(std::unique_ptr<T> object);
+
+  World* world_;
+  std::string name_;
+  std::vector<std::unique_ptr<Object>> owned_;
+  std::vector<Object*> objects_;
+};
+
+}  // namespace ambfplus

@@ -1,0 +1,56 @@
+#pragma once
+
+#include <string>
+
+#include <Eigen/Geometry>
+
+#include "ambfplus/export.h"
+
+namespace ambfplus {
+
+class Model;
+class World;
+
+/// What kind of object a scene object is.
+enum class ObjectKind { kRigidBody, kCamera, kLight };
+
+/// Name of an ObjectKind as users see it ("body", "camera", "light").
+AMBFPLUS_API const char* object_kind_name(ObjectKind kind);
+
+/// Anything that lives in a world under a name unique within that world.
+///
+/// Objects are created by their model and live as long as their world; handles to them (in C++
+/// references, in Python objects) must not outlive the world, which the bindings guarantee.
+class AMBFPLUS_API Object {
+ public:
+  virtual ~Object();
+  Object(const Object&) = delete;
+  Object& operator=(const Object&) = delete;
+
+  virtual ObjectKind kind() const = 0;
+  /// Unique within the world.
+  const std::string& name() const { return name_; }
+  /// Stable instance id (>= 1, never reused in a world); segmentation images use it.
+  int id() const { return id_; }
+  Model& model() const { return *model_; }
+  World& world() const;
+
+  /// World from object.
+  const Eigen::Isometry3d& pose() const { return pose_; }
+  virtual void set_pose(const Eigen::Isometry3d& pose) { pose_ = pose; }
+
+ protected:
+  Object(Model& model, std::string name, int id);
+
+ private:
+  Model* model_;
+  std::string name_;
+  int id_;
+  Eigen::Isometry3d pose_ = Eigen::Isometry3d::Identity();
+};
+
+/// Throws std::invalid_argument unless m is a rigid transform (orthonormal rotation with det +1,
+/// last row 0 0 0 1, finite), tolerating rounding of tol.
+AMBFPLUS_API Eigen::Isometry3d checked_pose(const Eigen::Matrix4d& m, double tol = 1e-6);
+
+}  // namespace ambfplus

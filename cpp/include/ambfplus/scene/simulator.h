@@ -1,0 +1,37 @@
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "ambfplus/export.h"
+#include "ambfplus/scene/world.h"
+
+namespace ambfplus {
+
+/// Options fixed when a simulator is created.
+struct AMBFPLUS_API SimulatorOptions {
+  double time_step = 0.001;  ///< seconds per fixed step
+  std::string world_name = "World";
+};
+
+/// The top of the hierarchy: Simulator > World > Model > Object. Owns its world; every handle
+/// the bindings give out keeps the simulator alive.
+class AMBFPLUS_API Simulator : public std::enable_shared_from_this<Simulator> {
+ public:
+  /// Creates a simulator with an empty world. Throws std::invalid_argument for bad options.
+  static std::shared_ptr<Simulator> create(const SimulatorOptions& options = {});
+  ~Simulator();
+  Simulator(const Simulator&) = delete;
+  Simulator& operator=(const Simulator&) = delete;
+
+  World& world() { return *world_; }
+  /// Advances the world by n fixed steps.
+  void step(std::int64_t n = 1) { world_->step(n); }
+
+ private:
+  explicit Simulator(const SimulatorOptions& options);
+  std::unique_ptr<World> world_;
+};
+
+}  // namespace ambfplus

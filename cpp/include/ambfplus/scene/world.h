@@ -1,0 +1,81 @@
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "ambfplus/export.h"
+#include "ambfplus/scene/model.h"
+
+namespace ambfplus {
+
+class Simulator;
+namespace render {
+class SceneRenderer;
+}
+
+/// The scene: models and their objects, and the simulation clock.
+class AMBFPLUS_API World {
+ public:
+  ~World();
+  World(const World&) = delete;
+  World& operator=(const World&) = delete;
+
+  const std::string& name() const { return name_; }
+  Simulator& simulator() const { return *simulator_; }
+
+  /// The model that holds objects added to the world directly.
+  Model& default_model() { return *models_.front(); }
+  /// Creates an empty model. Throws std::invalid_argument if the name is taken.
+  Model& add_model(const std::string& name);
+  /// Models in creation order, the default model first.
+  std::vector<Model*> models() const;
+
+  /// The object with exactly this name, or nullptr.
+  Object* find(const std::string& name) const;
+  /// All objects in creation order.
+  std::vector<Object*> objects() const;
+  template <typename T>
+  std::vector<T*> objects_of_kind() const;
+
+  /// Advances the clock by n fixed steps.
+  void step(std::int64_t n = 1);
+  /// Fixed step, seconds.
+  double time_step() const { return time_step_; }
+  /// Simulation time, seconds (step_index * time_step, without accumulated rounding).
+  double time() const { return static_cast<double>(step_index_) * time_step_; }
+  std::int64_t step_index() const { return step_index_; }
+
+  /// The world's renderer (created on first use; internal to the engine).
+  render::SceneRenderer& renderer();
+
+ private:
+  friend class Simulator;
+  friend class Model;
+  World(Simulator& simulator, std::string name, double time_step);
+  int claim_name(const std::string& name, const char* what);
+  void register_object(Object* object);
+
+  Simulator* simulator_;
+  std::string name_;
+  double time_step_;
+  std::int64_t step_index_ = 0;
+  int next_id_ = 1;
+  std::vector<std::unique_ptr<Model>> models_;
+  std::map<std::string, Object*> by_name_;
+  std::vector<Object*> objects_;
+  std::unique_ptr<render::SceneRenderer> renderer_;
+};
+
+template <typename T>
+std::vector<T*> World::objects_of_kind() const {
+  std::vector<T*> out;
+  for (Object* o : objects_) {
+    if (auto* t = dynamic_cast<T*>(o)) out.push_back(t);
+  }
+  return out;
+}
+
+}  // namespace ambfplus

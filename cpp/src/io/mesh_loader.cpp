@@ -1,0 +1,59 @@
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#include <assimp/Importer.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <system_error>
+
+#include "ambfplus/errors.h"
+#include "ambfplus/io/mesh.h"
+
+namespace ambfplus {
+
+MeshData load_mesh(const std::string& path, double scale) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    if (std::filesystem::is_directory(path, ec)) {
+      throw ConfigError(path, "is a directory, expected a mesh file");
+    }
+    throw AssetNotFound(path, "mesh");
+  }
+  Assimp::Importer importer;
+  // Points and lines carry no surface; drop them so a file of only those reads as empty.
+  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
+                              aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+  const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                         aiProcess_GenSmoothNormals | aiProcess_PreTransformVertices |
+                         aiProcess_SortByPType | aiProcess_FindInvalidData;
+  const aiScene* scene = importer.ReadFile(path, flags);
+  if (scene == nullptr) {
+    throw ConfigError(path, std::string("cannot read mesh: ") + importer.GetErrorString());
+  }
+  MeshData mesh;
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+    const aiMesh* in = scene->mMeshes[m];
+    if (!(in->mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) continue;
+    const auto base = static_cast<std::uint32_t>(mesh.vertex_count());
+    for (unsigned v = 0; v < in->mNumVertices; ++v) {
+      const aiVector3D& p = in->mVertices[v];
+      const aiVector3D n = in->mNormals ? in->mNormals[v] : aiVector3D(0, 0, 1);
+      for (float c : {p.x, p.y, p.z}) {
+        if (!std::isfinite(c)) throw ConfigError(path, "mesh has non-finite vertex coordinates");
+        mesh.positions.push_back(static_cast<float>(c * scale));
+      }
+      mesh.normals.insert(mesh.normals.end(), {n.x, n.y, n.z});
+    }
+    for (unsigned f = 0; f < in->mNumFaces; ++f) {
+      const aiFace& face = in->mFaces[f];
+      if (face.mNumIndices != 3) continue;
+      for (unsigned i = 0; i < 3; ++i) mesh.indices.push_back(base + face.mIndices[i]);
+    }
+  }
+  if (mesh.indices.empty()) {
+    throw ConfigError(path, "mesh file holds no triangles");
+  }
+  return mesh;
+}
+
+}  // namespace ambfplus

@@ -1,0 +1,57 @@
+#pragma once
+
+#include <epoxy/gl.h>
+
+#include <map>
+#include <memory>
+
+#include "ambfplus/scene/camera.h"
+
+namespace ambfplus {
+class World;
+struct MeshData;
+}  // namespace ambfplus
+
+namespace ambfplus::render {
+
+/// A mesh in GPU buffers.
+struct GpuMesh {
+  GLuint vao = 0;
+  GLuint buffers[3] = {0, 0, 0};  // positions, normals, indices
+  GLsizei index_count = 0;
+};
+
+/// Off-screen colour, metric-depth and depth-test buffers of one camera's size.
+struct RenderTarget {
+  GLuint framebuffer = 0;
+  GLuint renderbuffers[3] = {0, 0, 0};  // colour (RGBA8), depth (R32F), depth test (D32F)
+  int width = 0;
+  int height = 0;
+};
+
+/// Draws a world's bodies for its cameras into off-screen buffers and reads them back. Owns the
+/// GL objects of one world; every call takes the process's context (Context::Scope).
+class SceneRenderer {
+ public:
+  explicit SceneRenderer(World& world);
+  ~SceneRenderer();
+  SceneRenderer(const SceneRenderer&) = delete;
+  SceneRenderer& operator=(const SceneRenderer&) = delete;
+
+  /// Renders camera's view and reads it into buffers (null ones are skipped).
+  void render(const Camera& camera, const CaptureBuffers& buffers);
+  /// Renders camera's view and leaves it in the GPU (for measuring readback separately).
+  void draw(const Camera& camera);
+  /// Reads the last draw of camera into buffers.
+  void read(const Camera& camera, const CaptureBuffers& buffers);
+
+ private:
+  GpuMesh& mesh_for(const MeshData* mesh);
+  RenderTarget& target_for(const Camera& camera);
+
+  World& world_;
+  std::map<const MeshData*, GpuMesh> meshes_;
+  std::map<int, RenderTarget> targets_;  // by camera id
+};
+
+}  // namespace ambfplus::render

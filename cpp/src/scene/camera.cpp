@@ -1,0 +1,118 @@
+#include "ambfplus/scene/camera.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "ambfplus/scene/world.h"
+#include "render/scene_renderer.h"
+
+namespace ambfplus {
+
+Camera::Camera(Model& model, const CameraSpec& spec, int id)
+    : Object(model, spec.name, id),
+      width_(spec.width),
+      height_(spec.height),
+      fov_y_(spec.fov_y),
+      near_(spec.near),
+      far_(spec.far),
+      background_(spec.background) {
+  const std::string who = "camera '" + spec.name + "': ";
+  if (width_ <= 0 || height_ <= 0 || width_ > 16384 || height_ > 16384) {
+    throw std::invalid_argument(who + "width and height must be in 1..16384, got " +
+                                std::to_string(width_) + "x" + std::to_string(height_));
+  }
+  if (!(fov_y_ > 0.0 && fov_y_ < M_PI)) {
+    throw std::invalid_argument(who + "fov_y must be in (0, pi) radians, got " +
+                                std::to_string(fov_y_));
+  }
+  if (!(near_ > 0.0 && far_ > near_ && std::isfinite(far_))) {
+    throw std::invalid_argument(who + "clipping planes need 0 < near < far, got near " +
+                                std::to_string(near_) + ", far " + std::to_string(far_));
+  }
+  set_pose(checked_pose(spec.pose));
+}
+
+void Camera::look_at(const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
+                     const Eigen::Vector3d& up) {
+  const Eigen::Vector3d forward = target - eye;
+  if (!(forward.norm() > 0.0)) {
+    throw std::invalid_argument("camera '" + name() + "': look_at needs target != eye");
+  }
+  const Eigen::Vector3d z = forward.normalized();
+  // OpenCV frame: x right, y down, z forward. Image up (-y) follows `up` projected on the image.
+  const Eigen::Vector3d right = z.cross(up);
+  if (!(right.norm() > 1e-9 * up.norm()) || !(up.norm() > 0.0)) {
+    throw std::invalid_argument("camera '" + name() +
+                                "': look_at needs an up vector not parallel to the view direction");
+  }
+  const Eigen::Vector3d x = right.normalized();
+  const Eigen::Vector3d y = z.cross(x);
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear().col(0) = x;
+  pose.linear().col(1) = y;
+  pose.linear().col(2) = z;
+  pose.translation() = eye;
+  set_pose(pose);
+}
+
+Eigen::Matrix3d Camera::intrinsics() const {
+  const double f = height_ / (2.0 * std::tan(fov_y_ / 2.0));
+  Eigen::Matrix3d k;
+  k << f, 0, width_ / 2.0, 0, f, height_ / 2.0, 0, 0, 1;
+  return k;
+}
+
+Eigen::Matrix4d Camera::projection() const {
+  // Reversed z (near -> 1, far -> 0) with a zero-to-one clip range keeps a float depth buffer
+  // precise at every distance. x and y map continuous pixel coordinates straight to window
+  // coordinates, so GL's bottom-up row order reads back with image row 0 first.
+  const Eigen::Matrix3d k = intrinsics();
+  const double w = width_, h = height_, n = near_, f = far_;
+  Eigen::Matrix4d p = Eigen::Matrix4d::Zero();
+  p(0, 0) = 2 * k(0, 0) / w;
+  p(0, 2) = 2 * k(0, 2) / w - 1;
+  p(1, 1) = 2 * k(1, 1) / h;
+  p(1, 2) = 2 * k(1, 2) / h - 1;
+  p(2, 2) = -n / (f - n);
+  p(2, 3) = n * f / (f - n);
+  p(3, 2) = 1;
+  return p;
+}
+
+Frame Camera::capture() {
+  Frame frame;
+  capture(frame);
+  return frame;
+}
+
+void Camera::capture(Frame& frame) {
+  auto check = [&](bool empty, int h, int w, int c, int want_c, const char* what) {
+    if (!empty && (h != height_ || w != width_ || c != want_c)) {
+      throw std::invalid_argument(
+          "camera '" + name() + "': the frame's " + what + " is " + std::to_string(h) + "x" +
+          std::to_string(w) + "x" + std::to_string(c) + ", the camera makes " +
+          std::to_string(height_) + "x" + std::to_string(width_) + "x" + std::to_string(want_c));
+    }
+  };
+  check(frame.rgb.empty(), frame.rgb.height(), frame.rgb.width(), frame.rgb.channels(), 3, "rgb");
+  check(frame.depth.empty(), frame.depth.height(), frame.depth.width(), frame.depth.channels(), 1,
+        "depth");
+  if (frame.rgb.empty()) frame.rgb.allocate(height_, width_, 3);
+  if (frame.depth.empty()) frame.depth.allocate(height_, width_, 1);
+  capture(CaptureBuffers{frame.rgb.data(), frame.depth.data()}, frame);
+}
+
+void Camera::capture(const CaptureBuffers& buffers, Frame& frame) {
+  World& w = world();
+  w.renderer().render(*this, buffers);
+  frame.width = width_;
+  frame.height = height_;
+  frame.time = w.time();
+  frame.step = w.step_index();
+  frame.camera = name();
+  frame.intrinsics = intrinsics();
+  frame.pose = pose().matrix();
+}
+
+}  // namespace ambfplus

@@ -1,0 +1,46 @@
+#include "ambfplus/scene/model.h"
+
+#include "ambfplus/scene/world.h"
+
+#include <stdexcept>
+#include <string>
+
+namespace ambfplus {
+
+Model::Model(World& world, std::string name) : world_(&world), name_(std::move(name)) {}
+
+Model::~Model() = default;
+
+template <typename T>
+T& Model::adopt(std::unique_ptr<T> object) {
+  T& ref = *object;
+  objects_.push_back(object.get());
+  world_->register_object(object.get());
+  owned_.push_back(std::move(object));
+  return ref;
+}
+
+RigidBody& Model::add_body(const RigidBodySpec& spec) {
+  const int id = world_->claim_name(spec.name, "body");
+  // The constructor loads or builds geometry and may throw; nothing is registered before that.
+  return adopt(std::unique_ptr<RigidBody>(new RigidBody(*this, spec, id)));
+}
+
+Camera& Model::add_camera(const CameraSpec& spec) {
+  const int id = world_->claim_name(spec.name, "camera");
+  return adopt(std::unique_ptr<Camera>(new Camera(*this, spec, id)));
+}
+
+Light& Model::add_light(const LightSpec& spec) {
+  const int id = world_->claim_name(spec.name, "light");
+  int same_type = 0;
+  for (const Light* l : world_->objects_of_kind<Light>()) same_type += l->type() == spec.type;
+  if (same_type >= kMaxLightsPerType) {
+    throw std::invalid_argument("cannot add light '" + spec.name + "': the world already has " +
+                                std::to_string(kMaxLightsPerType) + " " +
+                                light_type_name(spec.type) + " lights, the most it can draw");
+  }
+  return adopt(std::unique_ptr<Light>(new Light(*this, spec, id)));
+}
+
+}  // namespace ambfplus

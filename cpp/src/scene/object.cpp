@@ -1,0 +1,51 @@
+#include "ambfplus/scene/object.h"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "ambfplus/scene/model.h"
+
+namespace ambfplus {
+
+const char* object_kind_name(ObjectKind kind) {
+  switch (kind) {
+    case ObjectKind::kRigidBody:
+      return "body";
+    case ObjectKind::kCamera:
+      return "camera";
+    case ObjectKind::kLight:
+      return "light";
+  }
+  return "object";
+}
+
+Object::Object(Model& model, std::string name, int id)
+    : model_(&model), name_(std::move(name)), id_(id) {}
+
+Object::~Object() = default;
+
+World& Object::world() const { return model_->world(); }
+
+Eigen::Isometry3d checked_pose(const Eigen::Matrix4d& m, double tol) {
+  if (!m.allFinite()) throw std::invalid_argument("pose has non-finite entries");
+  const Eigen::RowVector4d last = m.row(3);
+  if ((last - Eigen::RowVector4d(0, 0, 0, 1)).cwiseAbs().maxCoeff() > tol) {
+    std::ostringstream s;
+    s << "pose must have last row [0 0 0 1], got [" << last << "]";
+    throw std::invalid_argument(s.str());
+  }
+  const Eigen::Matrix3d r = m.topLeftCorner<3, 3>();
+  const double orthonormality =
+      (r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  if (orthonormality > tol || r.determinant() < 0) {
+    throw std::invalid_argument(
+        "pose must be a rigid transform: its 3x3 block must be a rotation (orthonormal, det +1)");
+  }
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.matrix() = m;
+  pose.matrix().row(3) << 0, 0, 0, 1;
+  return pose;
+}
+
+}  // namespace ambfplus

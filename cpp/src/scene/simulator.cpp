@@ -1,0 +1,21 @@
+#include "ambfplus/scene/simulator.h"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace ambfplus {
+
+std::shared_ptr<Simulator> Simulator::create(const SimulatorOptions& options) {
+  if (!(options.time_step > 0.0) || !std::isfinite(options.time_step)) {
+    throw std::invalid_argument("time_step must be a positive number of seconds, got " +
+                                std::to_string(options.time_step));
+  }
+  return std::shared_ptr<Simulator>(new Simulator(options));
+}
+
+Simulator::Simulator(const SimulatorOptions& options)
+    : world_(new World(*this, options.world_name, options.time_step)) {}
+
+Simulator::~Simulator() = default;
+
+}  // namespace ambfplus

@@ -1,0 +1,72 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+
+#include "ambfplus/errors.h"
+#include "ambfplus/render/gl_info.h"
+#include "ambfplus/scene/simulator.h"
+#include "render/egl_context.h"
+
+namespace ambfplus {
+namespace {
+
+TEST(Render, ContextReportsOpenGL45) {
+  const GlInfo info = gl_info();
+  EXPECT_FALSE(info.renderer.empty());
+  EXPECT_NE(info.version.find("4."), std::string::npos) << info.version;
+  EXPECT_TRUE(info.profile == "compatibility" || info.profile == "core");
+}
+
+// A box face parallel to the image plane has one depth everywhere it covers, and the capture
+// stamps the clock and the camera's geometry.
+TEST(Render, FrontalFaceHasExactDepthAndFrameCarriesTime) {
+  auto sim = Simulator::create();
+  World& world = sim->world();
+  RigidBodySpec box;
+  box.name = "box";
+  box.shape.size = {0.4, 0.4, 0.2};
+  world.default_model().add_body(box);
+  CameraSpec spec;
+  spec.name = "cam";
+  spec.width = 64;
+  spec.height = 48;
+  spec.near = 0.01;
+  Camera& cam = world.default_model().add_camera(spec);
+  cam.look_at({0, 0, 1.1}, {0, 0, 0}, {0, 1, 0});
+  world.step(7);
+  const Frame frame = cam.capture();
+  ASSERT_EQ(frame.depth.size(), 64u * 48u);
+  EXPECT_EQ(frame.step, 7);
+  EXPECT_DOUBLE_EQ(frame.time, 0.007);
+  // The top face (z = 0.1) is 1.0 m away along the optical axis.
+  const float centre = frame.depth.data()[24 * 64 + 32];
+  EXPECT_NEAR(centre, 1.0f, 1e-5f);
+  // Corners see nothing.
+  EXPECT_EQ(frame.depth.data()[0], 0.0f);
+  EXPECT_EQ(frame.rgb.data()[0], 0);
+}
+
+TEST(Render, MissingShaderFileIsAssetNotFound) {
+  render::Context::Scope scope;
+  EXPECT_THROW(render::Program("/nonexistent/a.vert", "/nonexistent/a.frag"), AssetNotFound);
+}
+
+TEST(Render, ShaderErrorsNameTheFileAndCarryTheLog) {
+  const std::string dir = ::testing::TempDir();
+  const std::string vert = dir + "/ok.vert", frag = dir + "/broken.frag";
+  std::ofstream(vert) << "#version 450 core\nvoid main() { gl_Position = vec4(0); }\n";
+  std::ofstream(frag) << "#version 450 core\nout vec4 c;\nvoid main() { c = undeclared; }\n";
+  render::Context::Scope scope;
+  try {
+    render::Program program(vert, frag);
+    FAIL() << "a broken shader compiled";
+  } catch (const RenderError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find(frag), std::string::npos) << message;
+    EXPECT_NE(message.find("undeclared"), std::string::npos) << message;
+  }
+}
+
+}  // namespace
+}  // namespace ambfplus

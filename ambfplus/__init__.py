@@ -13,8 +13,11 @@ Conventions (SI units; world frame right-handed, z up):
 try:
     from . import _core  # noqa: F401 (fail here with a clear message)
 except ImportError as _error:  # pragma: no cover - depends on how the package was found
+    import glob as _glob
     import os as _os
 
+    if _glob.glob(_os.path.join(_os.path.dirname(__file__), "_core*.so")):
+        raise  # the engine is there but does not load: the original error says why
     raise ImportError(
         f"ambfplus was imported from {_os.path.dirname(__file__)}, which holds no compiled engine "
         "(ambfplus._core). Install the package (pip install .) and run from outside the source "
@@ -27,6 +30,7 @@ from ._core import (
     ConfigError,
     Error,
     Frame,
+    Label,
     Light,
     Model,
     Object,
@@ -34,12 +38,20 @@ from ._core import (
     RenderError,
     RigidBody,
     Simulator,
+    Volume,
+    VolumeData,
     World,
     __version__,
     gl_info,
+    load_nrrd,
+    load_slice_stack,
+    phantom,
+    read_label_table,
     write_image,
+    write_label_table,
 )
-from .transforms import make_pose, rpy_matrix
+from .transforms import make_pose, rotation_between, rpy_matrix
+from .volumes import convert_volume, load_volume
 
 __all__ = [
     "AssetNotFound",
@@ -47,6 +59,7 @@ __all__ = [
     "ConfigError",
     "Error",
     "Frame",
+    "Label",
     "Light",
     "Model",
     "Object",
@@ -54,10 +67,20 @@ __all__ = [
     "RenderError",
     "RigidBody",
     "Simulator",
+    "Volume",
+    "VolumeData",
     "World",
     "__version__",
     "gl_info",
+    "load_nrrd",
+    "load_slice_stack",
     "make_pose",
+    "phantom",
+    "read_label_table",
+    "rotation_between",
     "rpy_matrix",
+    "convert_volume",
+    "load_volume",
     "write_image",
+    "write_label_table",
 ]

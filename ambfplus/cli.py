@@ -1,4 +1,4 @@
-"""The ``ambfplus`` command line: ``ambfplus demo``, ``ambfplus info``."""
+"""The ``ambfplus`` command line: ``demo``, ``convert``, ``info``."""
 
 from __future__ import annotations
 
@@ -11,6 +11,7 @@ import numpy as np
 
 from . import __version__, gl_info, write_image
 from .scenes import demo_scene
+from .volumes import convert_volume
 
 # The demo fails when the scene covers less than this share of the image.
 MIN_COVERAGE = 0.25
@@ -44,11 +45,18 @@ def run_demo(out: Path, width: int, height: int) -> int:
     lit = frame.rgb[covered]
     contrast = float(lit.std()) if lit.size else 0.0
 
+    world_volumes = world.volumes
+    colours = np.zeros((65536, 3), np.uint8)
+    if world_volumes:
+        for label in world_volumes[0].data.label_table:
+            colours[label.id] = label.color
     depth_units = np.round(frame.depth * DEPTH_PNG_SCALE)
     depth_png = np.clip(depth_units, 0, 65535).astype(np.uint16)
     write_image(str(out / "rgb.png"), frame.rgb)
     write_image(str(out / "depth.png"), depth_png)
     write_image(str(out / "depth_preview.png"), colorize_depth(frame.depth))
+    write_image(str(out / "label.png"), frame.label)
+    write_image(str(out / "label_preview.png"), colours[frame.label])
     meta = {
         "ambfplus_version": __version__,
         "camera": frame.camera,
@@ -61,6 +69,11 @@ def run_demo(out: Path, width: int, height: int) -> int:
         "pose_world_from_camera": frame.pose.tolist(),
         "camera_frame": "OpenCV: x right, y down, z forward",
         "depth_png": f"uint16, depth in metres * {DEPTH_PNG_SCALE:g}; 0 where nothing was hit",
+        "label_png": "uint16 volume label ids (0 = none); label_preview.png shows their colours",
+        "labels": [
+            {"id": label.id, "name": label.name, "color": list(label.color)}
+            for label in (world_volumes[0].data.label_table if world_volumes else [])
+        ],
         "coverage": coverage,
         "gl": gl_info(),
     }
@@ -69,7 +82,8 @@ def run_demo(out: Path, width: int, height: int) -> int:
     valid = frame.depth[covered]
     print(f"ambfplus {__version__}: {gl_info()['renderer']}")
     print(
-        f"wrote {out}/rgb.png, depth.png, depth_preview.png, frame.json ({width}x{height}): "
+        f"wrote {out}/rgb.png, depth.png, depth_preview.png, label.png, label_preview.png, "
+        f"frame.json ({width}x{height}): "
         f"scene covers {coverage:.1%} of pixels, depth {valid.min():.4f}..{valid.max():.4f} m"
         if valid.size
         else f"wrote {out}: the scene covers no pixel"
@@ -92,10 +106,56 @@ def main(argv: list[str] | None = None) -> int:
     demo.add_argument("--out", type=Path, default=Path("demo_out"), help="output folder")
     demo.add_argument("--width", type=int, default=640)
     demo.add_argument("--height", type=int, default=480)
+    convert = commands.add_parser(
+        "convert",
+        help="convert anatomy volumes: NRRD/Slicer segmentation -> slice stack + volume ADF, "
+        "slice stack or ADF -> NRRD, any -> surface mesh (.stl/.ply)",
+    )
+    convert.add_argument(
+        "input", type=Path, help=".nrrd, .seg.nrrd, a volume ADF (.yaml) or a slice folder"
+    )
+    convert.add_argument(
+        "output", type=Path, help="a folder (slice stack + ADF), .nrrd, .stl or .ply"
+    )
+    convert.add_argument("--prefix", default="plane00", help="slice file prefix")
+    convert.add_argument("--labels", type=Path, help="label table (CSV/YAML) for slices")
+    size = convert.add_mutually_exclusive_group()
+    size.add_argument(
+        "--dimensions",
+        type=float,
+        nargs=3,
+        metavar=("X", "Y", "Z"),
+        help="a slice folder's size, metres",
+    )
+    size.add_argument(
+        "--voxel-size",
+        type=float,
+        nargs=3,
+        metavar=("X", "Y", "Z"),
+        help="a slice folder's voxel size, metres",
+    )
+    convert.add_argument("--threshold", type=float, help="segment an intensity NRRD at this value")
+    convert.add_argument(
+        "--label", type=int, default=0, help="mesh only this label id (default: every solid voxel)"
+    )
     commands.add_parser("info", help="print the version and the OpenGL device")
     args = parser.parse_args(argv)
     if args.command == "demo":
         return run_demo(args.out, args.width, args.height)
+    if args.command == "convert":
+        print(
+            convert_volume(
+                args.input,
+                args.output,
+                prefix=args.prefix,
+                labels=args.labels,
+                dimensions=args.dimensions,
+                voxel_size=args.voxel_size,
+                threshold=args.threshold,
+                label=args.label,
+            )
+        )
+        return 0
     if args.command == "info":
         print(json.dumps({"version": __version__, "gl": gl_info()}, indent=2))
         return 0

@@ -4,80 +4,54 @@ from __future__ import annotations
 
 import math
 
-from ._core import Camera, World
-from .transforms import make_pose
+import numpy as np
+
+from ._core import World, phantom
+from .transforms import make_pose, rotation_between
 
 # The paper's stereo camera: focal length about 1135 px at 640x480, about 250 mm from the anatomy.
 PAPER_FOCAL_PX = 1135.0
 PAPER_FOV_Y = 2.0 * math.atan(240.0 / PAPER_FOCAL_PX)
 
 
-def demo_scene(width: int = 640, height: int = 480) -> tuple[World, Camera]:
-    """A drill over a stand-in for the anatomy (a bone block with a skull-like dome), lit from two
-    sides and seen from 250 mm by a camera with the paper's focal length.
-
-    Returns the world and its camera. The anatomy becomes a segmented CT volume once volumes exist.
-    """
-    world = World()
-    world.add_light("key", "directional", direction=(-0.4, 0.5, -1.0), intensity=0.85)
-    world.add_light("fill", "point", position=(0.2, -0.25, 0.35), intensity=0.35)
-    world.add_body(
-        "table",
-        "box",
-        size=(0.5, 0.4, 0.02),
-        pose=make_pose((0, 0, -0.01)),
-        mass=0,
-        color=(0.28, 0.36, 0.45),
+def add_drill(world: World, tip: tuple[float, float, float], direction, burr_radius: float = 0.003):
+    """A drill built from primitives: a burr at `tip`, a shaft and a handle along `direction`
+    (from the tip towards the surgeon's hand). Returns the burr, shaft and handle bodies."""
+    tip_pose = make_pose(tip, rotation=rotation_between((0, 0, 1), direction))
+    grey = (0.72, 0.74, 0.8)
+    burr = world.add_body(
+        "burr", "sphere", radius=burr_radius, pose=tip_pose, mass=0.01, color=grey, specular=0.6
     )
-    world.add_body(
-        "bone_block",
-        "box",
-        size=(0.09, 0.07, 0.03),
-        pose=make_pose((0, 0, 0.015)),
-        mass=0,
-        color=(0.9, 0.86, 0.74),
-    )
-    world.add_body(
-        "dome",
-        "sphere",
-        radius=0.03,
-        pose=make_pose((0.005, 0.0, 0.03)),
-        mass=0,
-        color=(0.95, 0.91, 0.8),
-    )
-    world.add_body(
-        "canal",
-        "cylinder",
-        radius=0.004,
-        height=0.1,
-        mass=0,
-        color=(0.85, 0.3, 0.25),
-        pose=make_pose((-0.02, 0.0, 0.031), rpy=(math.pi / 2, 0, 0.3)),
-    )
-    # The drill: a shaft tilted towards the dome, a burr at its tip and a handle.
-    tip = (0.022, -0.012, 0.058)
-    tilt = make_pose(tip, rpy=(-0.5, -0.3, 0.0))
-    world.add_body("burr", "sphere", radius=0.003, pose=tilt, mass=0.01, color=(0.75, 0.75, 0.8))
-    shaft = tilt @ make_pose((0, 0, 0.035))
-    world.add_body(
+    shaft = world.add_body(
         "shaft",
         "cylinder",
-        radius=0.0015,
-        height=0.064,
-        pose=shaft,
+        radius=0.0012,
+        height=0.06,
         mass=0.02,
-        color=(0.7, 0.72, 0.78),
+        pose=tip_pose @ make_pose((0, 0, 0.03)),
+        color=grey,
+        specular=0.6,
     )
-    handle = tilt @ make_pose((0, 0, 0.09))
-    world.add_body(
+    handle = world.add_body(
         "handle",
         "capsule",
-        radius=0.007,
-        height=0.06,
-        pose=handle,
+        radius=0.006,
+        height=0.08,
         mass=0.2,
+        pose=tip_pose @ make_pose((0, 0, 0.1)),
         color=(0.2, 0.45, 0.75),
     )
+    return burr, shaft, handle
+
+
+def demo_scene(width: int = 640, height: int = 480, resolution: int = 192):
+    """The built-in temporal-bone phantom with a drill over its lateral face, seen from 150 mm by
+    a camera with the paper's focal length. Returns the world and its camera."""
+    world = World()
+    world.add_light("key", "directional", direction=(-0.3, 0.4, -1.0), intensity=0.8)
+    world.add_light("fill", "point", position=(0.15, -0.2, 0.3), intensity=0.3)
+    world.add_volume("anatomy", phantom(resolution), pose=np.eye(4))
+    add_drill(world, tip=(0.004, -0.002, 0.0125), direction=(-0.3, 0.45, 1.0))
     camera = world.add_camera("camera", width, height, PAPER_FOV_Y, 0.01, 10.0)
-    camera.look_at(eye=(0.12, -0.16, 0.19), target=(0.0, 0.0, 0.03))
+    camera.look_at(eye=(0.035, -0.075, 0.13), target=(0.0, 0.0, 0.004))
     return world, camera

@@ -35,3 +35,21 @@ def make_pose(
         pose[:3, :3] = np.asarray(rotation, dtype=float).reshape(3, 3)
     pose[:3, 3] = np.asarray(position, dtype=float).reshape(3)
     return pose
+
+
+def rotation_between(a: Sequence[float], b: Sequence[float]) -> np.ndarray:
+    """The smallest rotation taking direction a to direction b (3x3)."""
+    u = np.asarray(a, float) / np.linalg.norm(a)
+    v = np.asarray(b, float) / np.linalg.norm(b)
+    axis = np.cross(u, v)
+    s, c = np.linalg.norm(axis), float(u @ v)
+    if s < 1e-12:
+        if c > 0:
+            return np.eye(3)
+        # Opposite: half a turn about any axis perpendicular to u.
+        p = np.cross(u, [1.0, 0.0, 0.0] if abs(u[0]) < 0.9 else [0.0, 1.0, 0.0])
+        p /= np.linalg.norm(p)
+        return 2 * np.outer(p, p) - np.eye(3)
+    k = axis / s
+    kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+    return np.eye(3) + s * kx + (1 - c) * (kx @ kx)

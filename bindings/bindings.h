@@ -9,18 +9,32 @@ void register_errors(pybind11::module_& m);
 void register_io(pybind11::module_& m);
 void register_render(pybind11::module_& m);
 void register_capture(pybind11::module_& m);
+void register_volume(pybind11::module_& m);
 void register_scene(pybind11::module_& m);
 
 }  // namespace ambfplus::bindings
 
+#include <array>
+#include <optional>
+
 namespace ambfplus {
 class Camera;
-}
+class VolumeData;
+struct VolumeHit;
+struct VoxelBox;
+}  // namespace ambfplus
 
 namespace ambfplus::bindings {
 
 /// Camera.capture(out=None): renders with the GIL released. out may be None (a new Frame), a Frame
 /// (refilled in place) or a dict of preallocated arrays {"rgb": ..., "depth": ...}.
 pybind11::object capture(Camera& camera, pybind11::object out);
+
+/// A ray hit as dict(distance, position, normal, label), or None when it missed.
+pybind11::object hit_dict(const VolumeHit& hit);
+
+/// Voxels [lo, hi) of a volume, the whole grid where a bound is missing.
+VoxelBox box_from(std::optional<std::array<int, 3>> lo, std::optional<std::array<int, 3>> hi,
+                  const VolumeData& volume);
 
 }  // namespace ambfplus::bindings

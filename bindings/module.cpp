@@ -33,6 +33,7 @@ PYBIND11_MODULE(_core, m) {
   ambfplus::bindings::register_io(m);
   ambfplus::bindings::register_render(m);
   ambfplus::bindings::register_capture(m);
+  ambfplus::bindings::register_volume(m);
   ambfplus::bindings::register_scene(m);
 
   // Info and above go to Python, whose logging decides what to show (debug only on request, by

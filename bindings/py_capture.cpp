@@ -102,9 +102,12 @@ py::object capture(Camera& camera, py::object out) {
       } else if (key == "depth") {
         targets.depth = checked_output<float>(item.second, "depth", {h, w});
         frame->depth.attach(targets.depth, camera.height(), camera.width(), 1);
+      } else if (key == "label") {
+        targets.label = checked_output<std::uint16_t>(item.second, "label", {h, w});
+        frame->label.attach(targets.label, camera.height(), camera.width(), 1);
       } else {
         throw py::value_error("out has an unknown key '" + key +
-                              "': expected 'rgb' and/or 'depth'");
+                              "': expected 'rgb', 'depth' and/or 'label'");
       }
     }
     py::object result = py::cast(frame);
@@ -116,7 +119,8 @@ py::object capture(Camera& camera, py::object out) {
     }
     return result;
   }
-  throw py::type_error("out must be None, a Frame, or a dict of arrays {'rgb': ..., 'depth': ...}");
+  throw py::type_error(
+      "out must be None, a Frame, or a dict of arrays {'rgb': ..., 'depth': ..., 'label': ...}");
 }
 
 void register_capture(py::module_& m) {
@@ -128,6 +132,9 @@ void register_capture(py::module_& m) {
       .def_property_readonly(
           "depth", [](py::object self) { return view(self, self.cast<Frame&>().depth, true); },
           "float32 (H, W) view: metric z along the optical axis, 0 where nothing was hit")
+      .def_property_readonly(
+          "label", [](py::object self) { return view(self, self.cast<Frame&>().label, true); },
+          "uint16 (H, W) view: the volume label id seen at each pixel, 0 elsewhere")
       .def_readonly("width", &Frame::width)
       .def_readonly("height", &Frame::height)
       .def_readonly("time", &Frame::time, "simulation time of the capture, seconds")
@@ -154,11 +161,12 @@ void register_capture(py::module_& m) {
         std::vector<std::uint8_t> rgb(static_cast<std::size_t>(camera.width()) * camera.height() *
                                       3);
         std::vector<float> depth(static_cast<std::size_t>(camera.width()) * camera.height());
+        std::vector<std::uint16_t> label(depth.size());
         Frame frame;
         double wall = 0, cpu = 0;
         {
           py::gil_scoped_release release;
-          const CaptureBuffers buffers{rgb.data(), depth.data()};
+          const CaptureBuffers buffers{rgb.data(), depth.data(), label.data()};
           camera.capture(buffers, frame);  // warm-up: context, program, buffers
           const auto t0 = std::chrono::steady_clock::now();
           const double c0 = process_cpu_seconds();

@@ -1,10 +1,13 @@
 #include <pybind11/eigen.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
 
 #include <optional>
 #include <sstream>
 
+#include "ambfplus/adf/volume_adf.h"
+#include "ambfplus/render/render_stats.h"
 #include "ambfplus/scene/simulator.h"
 #include "bindings.h"
 
@@ -33,6 +36,8 @@ py::object to_python(Object* o) {
       return py::cast(handle(static_cast<Camera*>(o), w));
     case ObjectKind::kLight:
       return py::cast(handle(static_cast<Light*>(o), w));
+    case ObjectKind::kVolume:
+      return py::cast(handle(static_cast<Volume*>(o), w));
   }
   return py::cast(handle(o, w));
 }
@@ -226,7 +231,26 @@ void def_adders(Class& cls, GetModel get_model) {
           py::arg("spot_cutoff") = 0.7, py::arg("spot_exponent") = 0.7,
           py::arg("attenuation") = Vec3(1, 0, 0),
           "Adds a directional, point or spot light shining along direction. A world without "
-          "lights is lit by a headlight at each camera.");
+          "lights is lit by a headlight at each camera.")
+      .def(
+          "add_volume",
+          [get_model](typename Class::type& self, const std::string& name,
+                      std::shared_ptr<VolumeData> data, std::optional<Mat4> pose, double iso,
+                      double quality, double optical_density) {
+            Model& model = get_model(self);
+            VolumeSpec spec;
+            spec.name = name;
+            spec.data = std::move(data);
+            if (pose) spec.pose = *pose;
+            spec.iso = iso;
+            spec.quality = quality;
+            spec.optical_density = optical_density;
+            return handle(&model.add_volume(spec), model.world());
+          },
+          py::arg("name"), py::arg("data"), py::kw_only(), py::arg("pose") = py::none(),
+          py::arg("iso") = 0.5, py::arg("quality") = 0.5, py::arg("optical_density") = 1.0,
+          "Places volume data in the world; pose is world from the volume frame (centred on the "
+          "grid). Several volumes may share one VolumeData.");
 }
 
 std::string repr_object(const Object& o) {
@@ -252,6 +276,8 @@ void register_scene(py::module_& m) {
       m, "Camera", "A pinhole camera; pose is world from camera in the OpenCV frame.");
   py::class_<Light, Object, std::shared_ptr<Light>> light(
       m, "Light", "A directional, point or spot light shining along its +z axis.");
+  py::class_<Volume, Object, std::shared_ptr<Volume>> volume(
+      m, "Volume", "Segmented volume data placed in a world, rendered by ray casting.");
 
   simulator
       .def(py::init([](double time_step, const std::string& world_name) {
@@ -328,6 +354,22 @@ void register_scene(py::module_& m) {
                              [](World& w) { return to_python_list(w.objects_of_kind<Camera>()); })
       .def_property_readonly("lights",
                              [](World& w) { return to_python_list(w.objects_of_kind<Light>()); })
+      .def_property_readonly("volumes",
+                             [](World& w) { return to_python_list(w.objects_of_kind<Volume>()); })
+      .def(
+          "load_volumes",
+          [](World& w, const std::filesystem::path& path,
+             std::optional<std::filesystem::path> labels) {
+            std::vector<Volume*> loaded;
+            {
+              py::gil_scoped_release release;
+              loaded = load_adf_volumes(w, path.string(), labels ? labels->string() : "");
+            }
+            return to_python_list(loaded);
+          },
+          py::arg("path"), py::arg("labels") = py::none(),
+          "Loads the volumes: of an AMBF model file (its bodies and joints come with ADF "
+          "loading) into a new model; labels (CSV/YAML) overrides their label tables.")
       .def("__repr__", [](World& w) {
         std::ostringstream s;
         s << "<World '" << w.name() << "' objects=" << w.objects().size()
@@ -383,6 +425,67 @@ void register_scene(py::module_& m) {
       .def("capture", &capture, py::arg("out") = py::none(),
            "Renders (GIL released) and returns a Frame of NumPy views; out=Frame refills that "
            "frame in place, out={'rgb': a, 'depth': b} renders into preallocated arrays.");
+
+  volume.def_property_readonly("data", &Volume::data)
+      .def_property_readonly(
+          "labels",
+          [](Volume& v) {
+            const py::object data = py::cast(v.data());
+            return py::object(data.attr("labels"));  // an accessor would outlive `data`
+          },
+          "the data's label grid view (see VolumeData.labels)")
+      .def_property("iso", &Volume::iso, &Volume::set_iso, "iso level of the smoothed occupancy")
+      .def_property_readonly("quality", &Volume::quality)
+      .def_property_readonly("optical_density", &Volume::optical_density)
+      .def_property("empty_space_skipping", &Volume::empty_space_skipping,
+                    &Volume::set_empty_space_skipping,
+                    "rays skip empty bricks (off: every half voxel, the naive baseline)")
+      .def_property_readonly("world_from_voxel", &Volume::world_from_voxel,
+                             "4x4: voxel (i, j, k)'s centre is this times (i, j, k, 1)")
+      .def("world_to_voxel", &Volume::world_to_voxel, py::arg("point"),
+           "fractional voxel indices (centres at integers) of a world point")
+      .def("voxel_to_world", &Volume::voxel_to_world, py::arg("ijk"))
+      .def(
+          "remove_sphere",
+          [](Volume& v, const Vec3& c, double r, bool only_removable) {
+            py::gil_scoped_release release;
+            return v.remove_sphere(c, r, only_removable);
+          },
+          py::arg("center"), py::arg("radius"), py::arg("only_removable") = true,
+          "clears voxels within radius of a world-frame centre; returns how many")
+      .def(
+          "raycast",
+          [](Volume& v, const Vec3& origin, const Vec3& direction) -> py::object {
+            VolumeHit h;
+            {
+              py::gil_scoped_release release;
+              h = v.raycast(origin, direction);
+            }
+            return hit_dict(h);
+          },
+          py::arg("origin"), py::arg("direction"),
+          "first iso-surface hit of a world-frame ray: dict(distance, position, normal, label) "
+          "or None")
+      .def(
+          "mark_dirty",
+          [](Volume& v, std::optional<std::array<int, 3>> lo,
+             std::optional<std::array<int, 3>> hi) {
+            v.data()->mark_dirty(box_from(lo, hi, *v.data()));
+          },
+          py::arg("lo") = py::none(), py::arg("hi") = py::none())
+      .def("reset", [](Volume& v) { v.data()->reset(); })
+      .def_property_readonly(
+          "last_upload",
+          [](Volume& v) {
+            const VolumeUploadStats s = last_volume_upload(v);
+            py::dict d;
+            d["rendered"] = s.rendered;
+            d["full"] = s.full;
+            d["voxels"] = s.voxels;
+            d["seconds"] = s.seconds;
+            return d;
+          },
+          "what the last render sent to the GPU: rendered, full, voxels, seconds");
 
   light.def_property_readonly("type", [](Light& l) { return light_type_name(l.type()); })
       .def_property_readonly("direction", &Light::direction)

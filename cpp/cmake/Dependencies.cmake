@@ -42,4 +42,20 @@ add_library(ambfplus_dep_gl INTERFACE)
 target_link_libraries(ambfplus_dep_gl INTERFACE PkgConfig::EPOXY OpenGL::EGL OpenGL::OpenGL)
 add_library(ambfplus::dep_gl ALIAS ambfplus_dep_gl)
 
+# yaml-cpp: ADF scene files and label tables (0.7 exports the target `yaml-cpp`, no namespace).
+find_package(yaml-cpp REQUIRED)
+add_library(ambfplus_dep_yaml INTERFACE)
+if(TARGET yaml-cpp::yaml-cpp)
+  target_link_libraries(ambfplus_dep_yaml INTERFACE yaml-cpp::yaml-cpp)
+else()
+  target_link_libraries(ambfplus_dep_yaml INTERFACE yaml-cpp)
+endif()
+add_library(ambfplus::dep_yaml ALIAS ambfplus_dep_yaml)
+
+# zlib: gzip-encoded NRRD volumes.
+find_package(ZLIB REQUIRED)
+add_library(ambfplus_dep_zlib INTERFACE)
+target_link_libraries(ambfplus_dep_zlib INTERFACE ZLIB::ZLIB)
+add_library(ambfplus::dep_zlib ALIAS ambfplus_dep_zlib)
+
 find_package(Threads REQUIRED)

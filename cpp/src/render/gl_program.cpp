@@ -41,8 +41,30 @@ std::string info_log(GLuint object, GetIv get_iv, GetLog get_log) {
   return log.data();
 }
 
+// The source with each `#include "file"` line replaced by that file (found beside the includer).
+std::string with_includes(const std::string& source, const std::string& path, int depth = 0) {
+  if (depth > 8) throw RenderError(path + ": #include nested too deep");
+  std::istringstream in(source);
+  std::ostringstream out;
+  std::string line;
+  while (std::getline(in, line)) {
+    const std::size_t at = line.find("#include");
+    const std::size_t open = line.find('"');
+    const std::size_t close = line.rfind('"');
+    if (at != std::string::npos && line.find_first_not_of(" \t") == at &&
+        open != std::string::npos && close > open) {
+      const std::string name = line.substr(open + 1, close - open - 1);
+      const std::string included = (std::filesystem::path(path).parent_path() / name).string();
+      out << with_includes(read_text(included), included, depth + 1) << "\n";
+    } else {
+      out << line << "\n";
+    }
+  }
+  return out.str();
+}
+
 GLuint compile(GLenum stage, const std::string& path, const std::string& defines) {
-  const std::string source = with_defines(read_text(path), defines);
+  const std::string source = with_defines(with_includes(read_text(path), path), defines);
   const GLuint shader = glCreateShader(stage);
   const char* text = source.c_str();
   glShaderSource(shader, 1, &text, nullptr);

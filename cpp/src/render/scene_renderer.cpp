@@ -7,6 +7,8 @@
 #include "ambfplus/errors.h"
 #include "ambfplus/scene/world.h"
 #include "render/egl_context.h"
+#include "render/light_set.h"
+#include "render/volume_renderer.h"
 
 namespace ambfplus::render {
 namespace {
@@ -15,105 +17,32 @@ constexpr float kAmbient = 0.15f;
 
 Eigen::Matrix4f to_float(const Eigen::Matrix4d& m) { return m.cast<float>(); }
 
-// The world's lights in the camera frame, grouped by type as mesh.frag wants them. A world
-// without lights gets a headlight shining along the camera's view.
-struct LightSet {
-  std::vector<float> dir_direction, dir_color;
-  std::vector<float> point_position, point_color, point_attenuation;
-  std::vector<float> spot_position, spot_direction, spot_color, spot_attenuation, spot_cos_cutoff,
-      spot_exponent;
-  int directional = 0, point = 0, spot = 0;
-
-  static void push3(std::vector<float>& v, const Eigen::Vector3f& x) {
-    v.insert(v.end(), {x.x(), x.y(), x.z()});
-  }
-
-  LightSet(const World& world, const Eigen::Isometry3d& camera_from_world) {
-    for (const Light* light : world.objects_of_kind<Light>()) {
-      const Eigen::Vector3f p = (camera_from_world * light->pose().translation()).cast<float>();
-      const Eigen::Vector3f d = (camera_from_world.linear() * light->direction()).cast<float>();
-      const Eigen::Vector3f c =
-          Eigen::Vector3f(light->color()[0], light->color()[1], light->color()[2]) *
-          light->intensity();
-      const Eigen::Vector3f k(light->attenuation()[0], light->attenuation()[1],
-                              light->attenuation()[2]);
-      switch (light->type()) {
-        case LightSpec::Type::kDirectional:
-          ++directional;
-          push3(dir_direction, d);
-          push3(dir_color, c);
-          break;
-        case LightSpec::Type::kPoint:
-          ++point;
-          push3(point_position, p);
-          push3(point_color, c);
-          push3(point_attenuation, k);
-          break;
-        case LightSpec::Type::kSpot:
-          ++spot;
-          push3(spot_position, p);
-          push3(spot_direction, d);
-          push3(spot_color, c);
-          push3(spot_attenuation, k);
-          spot_cos_cutoff.push_back(std::cos(light->spot_cutoff()));
-          spot_exponent.push_back(light->spot_exponent());
-          break;
-      }
-    }
-    if (directional + point + spot == 0) {
-      directional = 1;
-      push3(dir_direction, Eigen::Vector3f(0, 0, 1));
-      push3(dir_color, Eigen::Vector3f::Constant(0.85f));
-    }
-  }
-
-  // The shader variant for these counts.
-  std::string defines() const {
-    return "#define DIRECTIONAL_LIGHTS " + std::to_string(directional) + "\n#define POINT_LIGHTS " +
-           std::to_string(point) + "\n#define SPOT_LIGHTS " + std::to_string(spot) + "\n";
-  }
-
-  void upload(Program& program) const {
-    auto vec3s = [&](const char* name, const std::vector<float>& v) {
-      if (!v.empty())
-        glUniform3fv(program.uniform(name), static_cast<GLsizei>(v.size() / 3), v.data());
-    };
-    auto floats = [&](const char* name, const std::vector<float>& v) {
-      if (!v.empty()) glUniform1fv(program.uniform(name), static_cast<GLsizei>(v.size()), v.data());
-    };
-    vec3s("u_directional_direction", dir_direction);
-    vec3s("u_directional_color", dir_color);
-    vec3s("u_point_position", point_position);
-    vec3s("u_point_color", point_color);
-    vec3s("u_point_attenuation", point_attenuation);
-    vec3s("u_spot_position", spot_position);
-    vec3s("u_spot_direction", spot_direction);
-    vec3s("u_spot_color", spot_color);
-    vec3s("u_spot_attenuation", spot_attenuation);
-    floats("u_spot_cos_cutoff", spot_cos_cutoff);
-    floats("u_spot_exponent", spot_exponent);
-  }
-};
-
 }  // namespace
 
 SceneRenderer::SceneRenderer(World& world) : world_(world) {}
 
 SceneRenderer::~SceneRenderer() {
-  if ((meshes_.empty() && targets_.empty()) || !Context::exists()) return;
+  if ((meshes_.empty() && targets_.empty() && volumes_.empty()) || !Context::exists()) return;
   try {
     Context::Scope scope;
+    volumes_.clear();
     for (auto& [key, m] : meshes_) {
       glDeleteVertexArrays(1, &m.vao);
       glDeleteBuffers(3, m.buffers);
     }
     for (auto& [key, t] : targets_) {
       glDeleteFramebuffers(1, &t.framebuffer);
-      glDeleteRenderbuffers(3, t.renderbuffers);
+      glDeleteRenderbuffers(4, t.renderbuffers);
     }
   } catch (const Error&) {
     // The context is gone (e.g. after a fork); its objects went with it.
+    for (auto& v : volumes_) v.second.release();
   }
+}
+
+const VolumeUpload* SceneRenderer::last_upload(const VolumeData* data) const {
+  auto it = volumes_.find(data);
+  return it == volumes_.end() ? nullptr : &it->second->last_upload();
 }
 
 GpuMesh& SceneRenderer::mesh_for(const MeshData* mesh) {
@@ -149,9 +78,9 @@ RenderTarget& SceneRenderer::target_for(const Camera& camera) {
   t.width = camera.width();
   t.height = camera.height();
   glGenFramebuffers(1, &t.framebuffer);
-  glGenRenderbuffers(3, t.renderbuffers);
-  const GLenum formats[3] = {GL_RGBA8, GL_R32F, GL_DEPTH_COMPONENT32F};
-  for (int i = 0; i < 3; ++i) {
+  glGenRenderbuffers(4, t.renderbuffers);
+  const GLenum formats[4] = {GL_RGBA8, GL_R32F, GL_R16UI, GL_DEPTH_COMPONENT32F};
+  for (int i = 0; i < 4; ++i) {
     glBindRenderbuffer(GL_RENDERBUFFER, t.renderbuffers[i]);
     glRenderbufferStorage(GL_RENDERBUFFER, formats[i], t.width, t.height);
   }
@@ -160,12 +89,14 @@ RenderTarget& SceneRenderer::target_for(const Camera& camera) {
                             t.renderbuffers[0]);
   glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_RENDERBUFFER,
                             t.renderbuffers[1]);
-  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER,
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT2, GL_RENDERBUFFER,
                             t.renderbuffers[2]);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER,
+                            t.renderbuffers[3]);
   const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
   if (status != GL_FRAMEBUFFER_COMPLETE) {
     glDeleteFramebuffers(1, &t.framebuffer);
-    glDeleteRenderbuffers(3, t.renderbuffers);
+    glDeleteRenderbuffers(4, t.renderbuffers);
     throw RenderError("camera '" + camera.name() + "': off-screen framebuffer of " +
                       std::to_string(t.width) + "x" + std::to_string(t.height) +
                       " is incomplete (status 0x" + std::to_string(status) + ")");
@@ -182,8 +113,8 @@ void SceneRenderer::draw(const Camera& camera) {
   RenderTarget& target = target_for(camera);
 
   glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
-  const GLenum draw_buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
-  glDrawBuffers(2, draw_buffers);
+  const GLenum draw_buffers[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
+  glDrawBuffers(3, draw_buffers);
   glViewport(0, 0, target.width, target.height);
   // Reversed z: clear to 0 (far), keep the greater depth.
   glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
@@ -200,6 +131,8 @@ void SceneRenderer::draw(const Camera& camera) {
   const GLfloat clear_depth = 0.0f;
   glClearBufferfv(GL_COLOR, 0, clear_color);
   glClearBufferfv(GL_COLOR, 1, clear_depth_image);
+  const GLuint clear_label[4] = {0, 0, 0, 0};
+  glClearBufferuiv(GL_COLOR, 2, clear_label);
   glClearBufferfv(GL_DEPTH, 0, &clear_depth);
 
   program.use();
@@ -229,6 +162,13 @@ void SceneRenderer::draw(const Camera& camera) {
     glDrawElements(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr);
   }
   glBindVertexArray(0);
+  // Volumes after the meshes: their rays write depth, so each pixel keeps the nearer surface.
+  for (const Volume* volume : world_.objects_of_kind<Volume>()) {
+    auto& gpu = volumes_[volume->data().get()];
+    if (!gpu) gpu = std::make_unique<GpuVolume>(volume->data());
+    gpu->sync(volume->iso());
+    gpu->draw(*volume, camera, camera_from_world, lights);
+  }
   check_gl("drawing the scene");
 }
 
@@ -245,6 +185,11 @@ void SceneRenderer::read(const Camera& camera, const CaptureBuffers& buffers) {
   if (buffers.depth != nullptr) {
     glReadBuffer(GL_COLOR_ATTACHMENT1);
     glReadPixels(0, 0, target.width, target.height, GL_RED, GL_FLOAT, buffers.depth);
+  }
+  if (buffers.label != nullptr) {
+    glReadBuffer(GL_COLOR_ATTACHMENT2);
+    glReadPixels(0, 0, target.width, target.height, GL_RED_INTEGER, GL_UNSIGNED_SHORT,
+                 buffers.label);
   }
   check_gl("reading back a capture");
 }

@@ -9,10 +9,14 @@
 
 namespace ambfplus {
 class World;
+class VolumeData;
 struct MeshData;
 }  // namespace ambfplus
 
 namespace ambfplus::render {
+
+class GpuVolume;
+struct VolumeUpload;
 
 /// A mesh in GPU buffers.
 struct GpuMesh {
@@ -24,7 +28,8 @@ struct GpuMesh {
 /// Off-screen colour, metric-depth and depth-test buffers of one camera's size.
 struct RenderTarget {
   GLuint framebuffer = 0;
-  GLuint renderbuffers[3] = {0, 0, 0};  // colour (RGBA8), depth (R32F), depth test (D32F)
+  // colour (RGBA8), depth (R32F), label (R16UI), depth test (D32F)
+  GLuint renderbuffers[4] = {0, 0, 0, 0};
   int width = 0;
   int height = 0;
 };
@@ -44,6 +49,8 @@ class SceneRenderer {
   void draw(const Camera& camera);
   /// Reads the last draw of camera into buffers.
   void read(const Camera& camera, const CaptureBuffers& buffers);
+  /// What the last sync of this volume data sent to the GPU (nullptr before its first draw).
+  const VolumeUpload* last_upload(const VolumeData* data) const;
 
  private:
   GpuMesh& mesh_for(const MeshData* mesh);
@@ -52,6 +59,7 @@ class SceneRenderer {
   World& world_;
   std::map<const MeshData*, GpuMesh> meshes_;
   std::map<int, RenderTarget> targets_;  // by camera id
+  std::map<const VolumeData*, std::unique_ptr<GpuVolume>> volumes_;
 };
 
 }  // namespace ambfplus::render

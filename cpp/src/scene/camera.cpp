@@ -98,9 +98,12 @@ void Camera::capture(Frame& frame) {
   check(frame.rgb.empty(), frame.rgb.height(), frame.rgb.width(), frame.rgb.channels(), 3, "rgb");
   check(frame.depth.empty(), frame.depth.height(), frame.depth.width(), frame.depth.channels(), 1,
         "depth");
+  check(frame.label.empty(), frame.label.height(), frame.label.width(), frame.label.channels(), 1,
+        "label");
   if (frame.rgb.empty()) frame.rgb.allocate(height_, width_, 3);
   if (frame.depth.empty()) frame.depth.allocate(height_, width_, 1);
-  capture(CaptureBuffers{frame.rgb.data(), frame.depth.data()}, frame);
+  if (frame.label.empty()) frame.label.allocate(height_, width_, 1);
+  capture(CaptureBuffers{frame.rgb.data(), frame.depth.data(), frame.label.data()}, frame);
 }
 
 void Camera::capture(const CaptureBuffers& buffers, Frame& frame) {

@@ -43,4 +43,9 @@ Light& Model::add_light(const LightSpec& spec) {
   return adopt(std::unique_ptr<Light>(new Light(*this, spec, id)));
 }
 
+Volume& Model::add_volume(const VolumeSpec& spec) {
+  const int id = world_->claim_name(spec.name, "volume");
+  return adopt(std::unique_ptr<Volume>(new Volume(*this, spec, id)));
+}
+
 }  // namespace ambfplus

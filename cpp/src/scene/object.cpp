@@ -16,6 +16,8 @@ const char* object_kind_name(ObjectKind kind) {
       return "camera";
     case ObjectKind::kLight:
       return "light";
+    case ObjectKind::kVolume:
+      return "volume";
   }
   return "object";
 }

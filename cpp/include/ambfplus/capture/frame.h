@@ -22,8 +22,9 @@ class AMBFPLUS_API Frame {
   Frame(Frame&&) noexcept = default;
   Frame& operator=(Frame&&) noexcept = default;
 
-  ImageBuffer<std::uint8_t> rgb;  ///< height x width x 3
-  ImageBuffer<float> depth;       ///< height x width
+  ImageBuffer<std::uint8_t> rgb;     ///< height x width x 3
+  ImageBuffer<float> depth;          ///< height x width
+  ImageBuffer<std::uint16_t> label;  ///< height x width: volume label ids, 0 elsewhere
 
   int width = 0;
   int height = 0;

@@ -25,8 +25,9 @@ struct AMBFPLUS_API CameraSpec {
 
 /// Where a capture writes its images; null pointers are not captured.
 struct CaptureBuffers {
-  std::uint8_t* rgb = nullptr;  ///< height x width x 3, tightly packed
-  float* depth = nullptr;       ///< height x width, tightly packed
+  std::uint8_t* rgb = nullptr;     ///< height x width x 3, tightly packed
+  float* depth = nullptr;          ///< height x width, tightly packed
+  std::uint16_t* label = nullptr;  ///< height x width, tightly packed
 };
 
 /// A pinhole camera in the OpenCV frame (x right, y down, z forward). pose() is world from camera.

@@ -8,6 +8,7 @@
 #include "ambfplus/scene/camera.h"
 #include "ambfplus/scene/light.h"
 #include "ambfplus/scene/rigid_body.h"
+#include "ambfplus/scene/volume.h"
 
 namespace ambfplus {
 
@@ -33,6 +34,8 @@ class AMBFPLUS_API Model {
   Camera& add_camera(const CameraSpec& spec);
   /// Creates a light. Throws std::invalid_argument for a bad spec or a taken name.
   Light& add_light(const LightSpec& spec);
+  /// Places a volume. Throws std::invalid_argument for a bad spec or a taken name.
+  Volume& add_volume(const VolumeSpec& spec);
 
  private:
   friend class World;

@@ -12,9 +12,9 @@ class Model;
 class World;
 
 /// What kind of object a scene object is.
-enum class ObjectKind { kRigidBody, kCamera, kLight };
+enum class ObjectKind { kRigidBody, kCamera, kLight, kVolume };
 
-/// Name of an ObjectKind as users see it ("body", "camera", "light").
+/// Name of an ObjectKind as users see it ("body", "camera", "light", "volume").
 AMBFPLUS_API const char* object_kind_name(ObjectKind kind);
 
 /// Anything that lives in a world under a name unique within that world.

@@ -1,0 +1,414 @@
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include <cstring>
+#include <optional>
+#include <sstream>
+
+#include "ambfplus/adf/volume_adf.h"
+#include "ambfplus/render/render_stats.h"
+#include "ambfplus/scene/simulator.h"
+#include "ambfplus/volume/phantom.h"
+#include "ambfplus/volume/volume_io.h"
+#include "bindings.h"
+
+namespace py = pybind11;
+
+namespace ambfplus::bindings {
+namespace {
+
+using Vec3 = Eigen::Vector3d;
+
+// A Fortran-order (i fastest) NumPy view of a grid owned by the VolumeData behind `owner`.
+py::array grid_view(py::object owner, const VolumeData& v, void* data, py::dtype dtype,
+                    bool writeable) {
+  const auto& n = v.shape();
+  const auto size = static_cast<py::ssize_t>(dtype.itemsize());
+  py::array a(dtype, {py::ssize_t(n[0]), py::ssize_t(n[1]), py::ssize_t(n[2])},
+              {size, size * n[0], size * n[0] * n[1]}, data, owner);
+  if (!writeable) {
+    py::detail::array_proxy(a.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+  }
+  return a;
+}
+
+py::dtype label_dtype(LabelType t) {
+  return t == LabelType::kUInt8 ? py::dtype::of<std::uint8_t>() : py::dtype::of<std::uint16_t>();
+}
+
+py::tuple box_tuple(const VoxelBox& b) {
+  return py::make_tuple(py::make_tuple(b.lo[0], b.lo[1], b.lo[2]),
+                        py::make_tuple(b.hi[0], b.hi[1], b.hi[2]));
+}
+
+py::object edit_dict(const VolumeEdit& e) {
+  py::dict d;
+  d["revision"] = e.revision;
+  d["kind"] = e.kind;
+  d["box"] = box_tuple(e.box);
+  d["changed"] = e.changed;
+  py::array_t<std::int32_t> voxels({py::ssize_t(e.voxels.size()), py::ssize_t(3)});
+  auto v = voxels.mutable_unchecked<2>();
+  for (std::size_t i = 0; i < e.voxels.size(); ++i) {
+    for (int a = 0; a < 3; ++a) v(py::ssize_t(i), a) = e.voxels[i][a];
+  }
+  d["voxels"] = voxels;
+  d["old_labels"] =
+      py::array_t<std::uint16_t>(py::ssize_t(e.old_labels.size()), e.old_labels.data());
+  return d;
+}
+
+LabelTable table_from(const py::object& labels) {
+  if (labels.is_none()) return LabelTable();
+  if (py::isinstance<py::str>(labels) || py::hasattr(labels, "__fspath__")) {
+    return read_label_table(py::module_::import("os").attr("fspath")(labels).cast<std::string>());
+  }
+  return LabelTable(labels.cast<std::vector<Label>>());
+}
+
+std::shared_ptr<VolumeData> from_array(py::array labels, std::optional<Vec3> dimensions,
+                                       std::optional<Vec3> voxel_size, const py::object& table) {
+  if (labels.ndim() != 3) throw py::value_error("labels must be a 3D array (nx, ny, nz)");
+  const bool u8 = labels.dtype().is(py::dtype::of<std::uint8_t>());
+  const bool u16 = labels.dtype().is(py::dtype::of<std::uint16_t>());
+  if (!u8 && !u16) {
+    throw py::type_error("labels must be uint8 or uint16, got " +
+                         py::str(labels.dtype()).cast<std::string>());
+  }
+  const std::array<int, 3> shape = {int(labels.shape(0)), int(labels.shape(1)),
+                                    int(labels.shape(2))};
+  Vec3 dims;
+  if (dimensions && voxel_size) throw py::value_error("give dimensions or voxel_size, not both");
+  if (dimensions) {
+    dims = *dimensions;
+  } else if (voxel_size) {
+    dims = voxel_size->cwiseProduct(Vec3(shape[0], shape[1], shape[2]));
+  } else {
+    throw py::value_error("give the volume's size: dimensions=(x, y, z) metres or voxel_size=");
+  }
+  LabelTable t = table_from(table);
+  const LabelType type = u8 ? LabelType::kUInt8 : LabelType::kUInt16;
+  auto v = std::make_shared<VolumeData>(shape, dims, type, t);
+  // Copy in, i fastest, whatever the array's own layout.
+  py::array f = py::module_::import("numpy").attr("asfortranarray")(labels);
+  std::memcpy(v->label_data(), f.data(), static_cast<std::size_t>(v->voxel_count()) * f.itemsize());
+  if (t.empty()) {
+    // Name the ids present.
+    const auto counts = v->label_counts();
+    for (std::size_t id = 1; id < counts.size(); ++id) {
+      if (counts[id] > 0)
+        t.add(
+            Label{std::uint16_t(id), "label_" + std::to_string(id), {200, 200, 200}, true, false});
+    }
+    v->set_label_table(t);
+  }
+  v->commit();
+  return v;
+}
+
+}  // namespace
+
+VoxelBox box_from(std::optional<std::array<int, 3>> lo, std::optional<std::array<int, 3>> hi,
+                  const VolumeData& v) {
+  VoxelBox b{{0, 0, 0}, v.shape()};
+  if (lo) b.lo = *lo;
+  if (hi) b.hi = *hi;
+  return b;
+}
+
+py::object hit_dict(const VolumeHit& h) {
+  if (!h.hit) return py::none();
+  py::dict d;
+  d["distance"] = h.t;
+  d["position"] = h.position;
+  d["normal"] = h.normal;
+  d["label"] = h.label;
+  return d;
+}
+
+void register_volume(py::module_& m) {
+  py::class_<Label>(m, "Label", "One structure of a segmented volume (id 0 means no label).")
+      .def(py::init([](int id, std::string name, std::array<int, 3> color, bool removable,
+                       bool critical) {
+             if (id < 1 || id > 65535) throw py::value_error("label id must be in 1..65535");
+             Label l;
+             l.id = static_cast<std::uint16_t>(id);
+             l.name = std::move(name);
+             for (int c = 0; c < 3; ++c) {
+               if (color[c] < 0 || color[c] > 255) throw py::value_error("color must be 0..255");
+               l.color[c] = static_cast<std::uint8_t>(color[c]);
+             }
+             l.removable = removable;
+             l.critical = critical;
+             return l;
+           }),
+           py::arg("id"), py::arg("name"), py::arg("color") = std::array<int, 3>{255, 255, 255},
+           py::arg("removable") = true, py::arg("critical") = false)
+      .def_readonly("id", &Label::id)
+      .def_readonly("name", &Label::name)
+      .def_property_readonly(
+          "color",
+          [](const Label& l) { return py::make_tuple(l.color[0], l.color[1], l.color[2]); })
+      .def_readonly("removable", &Label::removable)
+      .def_readonly("critical", &Label::critical)
+      .def("__eq__",
+           [](const Label& a, const Label& b) {
+             return a.id == b.id && a.name == b.name && a.color == b.color &&
+                    a.removable == b.removable && a.critical == b.critical;
+           })
+      .def("__repr__", [](const Label& l) {
+        std::ostringstream s;
+        s << "Label(" << l.id << ", '" << l.name << "', color=(" << int(l.color[0]) << ", "
+          << int(l.color[1]) << ", " << int(l.color[2]) << ")"
+          << (l.removable ? "" : ", removable=False") << (l.critical ? ", critical=True" : "")
+          << ")";
+        return s.str();
+      });
+
+  py::class_<VolumeData, std::shared_ptr<VolumeData>> data(
+      m, "VolumeData",
+      "A segmented volume: label grid (a view, indexed [i, j, k]), label table, size, edits.");
+  data.def(py::init(&from_array), py::arg("labels"), py::kw_only(),
+           py::arg("dimensions") = py::none(), py::arg("voxel_size") = py::none(),
+           py::arg("label_table") = py::none(),
+           "A volume from a (nx, ny, nz) uint8/uint16 label array (copied), its size in metres "
+           "and its labels (a list of Label or a CSV/YAML file; named label_<id> when absent).")
+      .def_property_readonly(
+          "labels",
+          [](py::object self) {
+            auto& v = self.cast<VolumeData&>();
+            return grid_view(self, v, v.label_data(), label_dtype(v.label_type()), true);
+          },
+          "(nx, ny, nz) view of the label grid, i fastest in memory; after writing through it, "
+          "call mark_dirty() so renderers see the change")
+      .def_property_readonly(
+          "intensity",
+          [](py::object self) -> py::object {
+            auto& v = self.cast<VolumeData&>();
+            if (v.intensity_type() == IntensityType::kNone) return py::none();
+            return grid_view(self, v, v.intensity_data(),
+                             v.intensity_type() == IntensityType::kInt16
+                                 ? py::dtype::of<std::int16_t>()
+                                 : py::dtype::of<float>(),
+                             true);
+          },
+          "(nx, ny, nz) view of the intensity (CT) grid, or None")
+      .def_property_readonly(
+          "smoothed_occupancy",
+          [](py::object self) {
+            auto& v = self.cast<VolumeData&>();
+            auto& field = const_cast<std::vector<std::uint8_t>&>(v.smoothed_occupancy());
+            return grid_view(self, v, field.data(), py::dtype::of<std::uint8_t>(), false);
+          },
+          "read-only (nx, ny, nz) view of the blurred occupancy (0..255) whose 0.5 level is the "
+          "rendered surface")
+      .def_property_readonly("shape",
+                             [](const VolumeData& v) {
+                               return py::make_tuple(v.shape()[0], v.shape()[1], v.shape()[2]);
+                             })
+      .def_property(
+          "dimensions", [](const VolumeData& v) { return Vec3(v.dimensions()); },
+          &VolumeData::set_dimensions, "full extents along x, y, z, metres")
+      .def_property_readonly("voxel_size", &VolumeData::voxel_size)
+      .def_property_readonly("label_type",
+                             [](const VolumeData& v) {
+                               return v.label_type() == LabelType::kUInt8 ? "uint8" : "uint16";
+                             })
+      .def_property(
+          "label_table", [](const VolumeData& v) { return v.label_table().labels(); },
+          [](VolumeData& v, const std::vector<Label>& labels) {
+            v.set_label_table(LabelTable(labels));
+          })
+      .def(
+          "label",
+          [](const VolumeData& v, const py::object& key) {
+            const Label* l = py::isinstance<py::str>(key)
+                                 ? v.label_table().find(key.cast<std::string>())
+                                 : v.label_table().find(key.cast<std::uint16_t>());
+            if (l == nullptr) throw py::key_error(py::str(key).cast<std::string>());
+            return *l;
+          },
+          py::arg("id_or_name"))
+      .def(
+          "label_counts",
+          [](const VolumeData& v) {
+            const auto counts = v.label_counts();
+            return py::array_t<std::int64_t>(py::ssize_t(counts.size()), counts.data());
+          },
+          "voxels per label id (index = id; index 0 counts the empty voxels)")
+      .def("voxel_center", &VolumeData::voxel_center, py::arg("i"), py::arg("j"), py::arg("k"),
+           "centre of voxel (i, j, k) in the volume frame")
+      .def_property_readonly(
+          "patient_from_volume",
+          [](const VolumeData& v) { return Eigen::Matrix4d(v.patient_from_volume()); })
+      .def_property_readonly("source", &VolumeData::source)
+      .def_property_readonly("revision", &VolumeData::revision)
+      .def(
+          "remove_sphere",
+          [](VolumeData& v, const Vec3& c, double r, bool only_removable) {
+            py::gil_scoped_release release;
+            return v.remove_sphere(c, r, only_removable);
+          },
+          py::arg("center"), py::arg("radius"), py::arg("only_removable") = true,
+          "clears the voxels whose centres are within radius of center (volume frame, metres)")
+      .def(
+          "set_region",
+          [](VolumeData& v, std::array<int, 3> lo, std::array<int, 3> hi, int label) {
+            if (label < 0 || label > 65535) throw py::value_error("label must be 0..65535");
+            return v.set_region(VoxelBox{lo, hi}, static_cast<std::uint16_t>(label));
+          },
+          py::arg("lo"), py::arg("hi"), py::arg("label"), "sets voxels [lo, hi) to label")
+      .def(
+          "mark_dirty",
+          [](VolumeData& v, std::optional<std::array<int, 3>> lo,
+             std::optional<std::array<int, 3>> hi) { v.mark_dirty(box_from(lo, hi, v)); },
+          py::arg("lo") = py::none(), py::arg("hi") = py::none(),
+          "declares voxels [lo, hi) (default: all) changed through the labels view")
+      .def("reset", &VolumeData::reset, "restores the labels as loaded (or last committed)")
+      .def("commit", &VolumeData::commit, "makes the current labels what reset() restores")
+      .def_property_readonly(
+          "edit_log",
+          [](const VolumeData& v) {
+            py::list out;
+            for (const VolumeEdit& e : v.edit_log()) out.append(edit_dict(e));
+            return out;
+          },
+          "the edits so far: dicts of revision, kind, box, changed, voxels, old_labels")
+      .def(
+          "take_edit_log",
+          [](VolumeData& v) {
+            py::list out;
+            for (const VolumeEdit& e : v.take_edit_log()) out.append(edit_dict(e));
+            return out;
+          },
+          "returns the edit log and starts a new one")
+      .def(
+          "raycast",
+          [](VolumeData& v, const Vec3& origin, const Vec3& direction, double iso) {
+            VolumeHit h;
+            {
+              py::gil_scoped_release release;
+              h = v.raycast(origin, direction, iso);
+            }
+            return hit_dict(h);
+          },
+          py::arg("origin"), py::arg("direction"), py::arg("iso") = 0.5,
+          "first iso-surface hit of a volume-frame ray: dict(distance, position, normal, label) "
+          "or None")
+      .def(
+          "save_nrrd",
+          [](const VolumeData& v, const std::filesystem::path& path, const std::string& what,
+             bool gzip) {
+            py::gil_scoped_release release;
+            save_nrrd(v, path.string(), what, gzip);
+          },
+          py::arg("path"), py::arg("what") = "labels", py::arg("gzip") = true)
+      .def(
+          "save_slice_stack",
+          [](const VolumeData& v, const std::filesystem::path& folder, const std::string& prefix,
+             const std::string& format) {
+            py::gil_scoped_release release;
+            save_slice_stack(v, folder.string(), prefix, format);
+          },
+          py::arg("folder"), py::arg("prefix") = "plane00", py::arg("format") = "png")
+      .def(
+          "save_mesh",
+          [](VolumeData& v, const std::filesystem::path& path, int label, double iso) {
+            py::gil_scoped_release release;
+            return write_surface_mesh(v, path.string(), static_cast<std::uint16_t>(label), iso);
+          },
+          py::arg("path"), py::arg("label") = 0, py::arg("iso") = 0.5,
+          "writes the iso-surface (of one label, or of all when 0) as .stl or .ply; returns the "
+          "triangle count")
+      .def("__repr__", [](const VolumeData& v) {
+        std::ostringstream s;
+        s << "<VolumeData " << v.shape()[0] << "x" << v.shape()[1] << "x" << v.shape()[2] << " "
+          << (v.label_type() == LabelType::kUInt8 ? "uint8" : "uint16") << ", "
+          << v.label_table().size() << " labels, " << v.dimensions().transpose() * 1000 << " mm>";
+        return s.str();
+      });
+
+  m.def(
+      "load_slice_stack",
+      [](const std::filesystem::path& folder, const std::string& prefix, const std::string& format,
+         int count, std::optional<Vec3> dimensions, std::optional<Vec3> voxel_size,
+         const py::object& labels, int alpha_threshold) {
+        if (dimensions && voxel_size)
+          throw py::value_error("give dimensions or voxel_size, not both");
+        if (!dimensions && !voxel_size) {
+          throw py::value_error(
+              "give the stack's size: dimensions=(x, y, z) metres or voxel_size=");
+        }
+        SliceStackSpec spec;
+        spec.folder = folder.string();
+        spec.prefix = prefix;
+        spec.format = format;
+        spec.count = count;
+        spec.labels = table_from(labels);
+        spec.alpha_threshold = alpha_threshold;
+        std::shared_ptr<VolumeData> v;
+        {
+          py::gil_scoped_release release;
+          v = load_slice_stack(spec);
+        }
+        const auto& n = v->shape();
+        v->set_dimensions(dimensions ? *dimensions
+                                     : voxel_size->cwiseProduct(Vec3(n[0], n[1], n[2])));
+        return v;
+      },
+      py::arg("folder"), py::arg("prefix") = "plane00", py::arg("format") = "png",
+      py::arg("count") = -1, py::kw_only(), py::arg("dimensions") = py::none(),
+      py::arg("voxel_size") = py::none(), py::arg("labels") = py::none(),
+      py::arg("alpha_threshold") = 128,
+      "Loads an AMBF slice stack: pixel (row r, column c) of slice k is voxel (c, H-1-r, k).");
+
+  m.def(
+      "load_nrrd",
+      [](const std::filesystem::path& path, const std::string& kind,
+         std::optional<double> threshold) {
+        NrrdOptions o;
+        if (kind == "auto") {
+          o.kind = NrrdOptions::Kind::kAuto;
+        } else if (kind == "labels") {
+          o.kind = NrrdOptions::Kind::kLabels;
+        } else if (kind == "intensity") {
+          o.kind = NrrdOptions::Kind::kIntensity;
+        } else if (kind == "segmentation") {
+          o.kind = NrrdOptions::Kind::kSegmentation;
+        } else {
+          throw py::value_error("kind must be auto, labels, intensity or segmentation");
+        }
+        o.threshold = threshold;
+        py::gil_scoped_release release;
+        return load_nrrd(path.string(), o);
+      },
+      py::arg("path"), py::arg("kind") = "auto", py::arg("threshold") = py::none(),
+      "Loads an NRRD label map, intensity volume (segmented by threshold) or 3D Slicer "
+      "segmentation (.seg.nrrd).");
+
+  m.def(
+      "phantom",
+      [](int resolution, std::uint32_t seed) {
+        py::gil_scoped_release release;
+        return make_temporal_bone_phantom(resolution, seed);
+      },
+      py::arg("resolution") = 128, py::arg("seed") = 0,
+      "The built-in procedural temporal bone (48 mm cube, lateral face towards +z).");
+
+  m.def(
+      "read_label_table",
+      [](const std::filesystem::path& path) { return read_label_table(path.string()).labels(); },
+      py::arg("path"));
+
+  m.def(
+      "write_label_table",
+      [](const std::filesystem::path& path, const std::vector<Label>& labels) {
+        write_label_table(path.string(), LabelTable(labels));
+      },
+      py::arg("path"), py::arg("labels"));
+}
+
+}  // namespace ambfplus::bindings

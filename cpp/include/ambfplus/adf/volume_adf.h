@@ -1,0 +1,38 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "ambfplus/export.h"
+#include "ambfplus/scene/volume.h"
+#include "ambfplus/volume/volume_io.h"
+
+namespace ambfplus {
+
+class World;
+
+/// A `VOLUME <identifier>` block of an AMBF model file, read but not yet loaded.
+struct AMBFPLUS_API AdfVolumeBlock {
+  std::string identifier;  ///< the block's key, e.g. "VOLUME mastoidectomy_volume_low"
+  std::string name;        ///< its `name` (spaces removed); the identifier's tail when absent
+  Eigen::Matrix4d pose = Eigen::Matrix4d::Identity();  ///< `location` (position, r-p-y)
+  SliceStackSpec images;         ///< `images` (path made absolute) and `dimensions` x `scale`
+  std::string labels;            ///< ambfplus extension `labels:` (CSV/YAML), absolute, or ""
+  double iso = 0.5;              ///< `iso-surface value`
+  double quality = 0.5;          ///< `quality`
+  double optical_density = 1.0;  ///< `optical density`
+  bool custom_shaders = false;   ///< `shaders:` is set (AMBF GLSL; our ray caster is used)
+};
+
+/// Reads the volumes an AMBF model file lists under `volumes:`. Throws AssetNotFound for a missing
+/// file and ConfigError naming the file, line and key for YAML errors, a listed block that is
+/// absent, or a block without `images`.
+AMBFPLUS_API std::vector<AdfVolumeBlock> read_adf_volumes(const std::string& path);
+
+/// Loads the volumes of an AMBF model file into a new model of the world (named after the file),
+/// each from its slice stack. A non-empty `labels` (CSV/YAML) overrides the blocks' tables.
+/// Returns them in file order.
+AMBFPLUS_API std::vector<Volume*> load_adf_volumes(World& world, const std::string& path,
+                                                   const std::string& labels = "");
+
+}  // namespace ambfplus

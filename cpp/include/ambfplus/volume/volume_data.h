@@ -1,0 +1,196 @@
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <deque>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "ambfplus/export.h"
+#include "ambfplus/volume/label_table.h"
+
+namespace ambfplus {
+
+/// A half-open box of voxels [lo, hi) along i, j, k.
+struct AMBFPLUS_API VoxelBox {
+  std::array<int, 3> lo{0, 0, 0};
+  std::array<int, 3> hi{0, 0, 0};
+
+  bool empty() const;
+  std::int64_t count() const;
+  /// The smallest box holding both (an empty box is ignored).
+  VoxelBox united(const VoxelBox& other) const;
+  /// This box cut to [0, shape).
+  VoxelBox clipped(const std::array<int, 3>& shape) const;
+  /// This box grown by margin voxels on every side.
+  VoxelBox grown(int margin) const;
+  bool operator==(const VoxelBox& o) const { return lo == o.lo && hi == o.hi; }
+};
+
+/// Element type of a label grid.
+enum class LabelType { kUInt8, kUInt16 };
+/// Element type of an intensity (CT) grid.
+enum class IntensityType { kNone, kInt16, kFloat32 };
+
+/// One change to a volume's labels, in order of revision.
+struct AMBFPLUS_API VolumeEdit {
+  std::int64_t revision = 0;
+  std::string kind;  ///< "remove_sphere", "set_region", "mark_dirty" or "reset"
+  VoxelBox box;      ///< voxels that may have changed
+  /// Voxels whose label changed, or -1 when unknown (an edit made through the NumPy view).
+  std::int64_t changed = -1;
+  /// remove_sphere: the removed voxels (i, j, k) and the labels they had.
+  std::vector<std::array<int, 3>> voxels;
+  std::vector<std::uint16_t> old_labels;
+};
+
+/// Where a ray meets a volume's iso-surface (volume frame, metres).
+struct AMBFPLUS_API VolumeHit {
+  bool hit = false;
+  double t = 0.0;  ///< distance along the (unit) ray direction
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();  ///< outward, unit
+  std::uint16_t label = 0;
+};
+
+/// A segmented volume: a label grid with its table, an optional intensity grid, its physical size,
+/// an edit history and the derived fields rendering and haptics read.
+///
+/// Grid and frame conventions (AMBF's): voxel (i, j, k) is stored at i + nx * (j + ny * k), i
+/// fastest. The volume frame is centred on the grid: voxel (i, j, k) spans
+/// [-D/2 + (i, j, k) * s, -D/2 + (i + 1, j + 1, k + 1) * s) with D the dimensions (metres, full
+/// extents) and s = D / n the voxel size; x runs along i, y along j, z along k.
+/// In "voxel units" u = (p + D/2) / s a voxel covers [i, i + 1) with its centre at i + 0.5.
+class AMBFPLUS_API VolumeData {
+ public:
+  /// A grid of zeros. Throws std::invalid_argument for a non-positive shape or dimension, or a
+  /// table whose ids do not fit the label type.
+  VolumeData(const std::array<int, 3>& shape, const Eigen::Vector3d& dimensions, LabelType type,
+             LabelTable table);
+  VolumeData(const VolumeData&) = delete;
+  VolumeData& operator=(const VolumeData&) = delete;
+
+  const std::array<int, 3>& shape() const { return shape_; }
+  std::int64_t voxel_count() const;
+  const Eigen::Vector3d& dimensions() const { return dimensions_; }
+  /// Resizes the physical box (metres, full extents); throws std::invalid_argument if not > 0.
+  void set_dimensions(const Eigen::Vector3d& dimensions);
+  Eigen::Vector3d voxel_size() const;
+  LabelType label_type() const { return label_type_; }
+  const LabelTable& label_table() const { return table_; }
+  /// Replaces the table; throws std::invalid_argument if an id does not fit the label type.
+  void set_label_table(LabelTable table);
+
+  /// The label grid (1 or 2 bytes per voxel, by label_type()). Writes through it are not seen by
+  /// renderers until mark_dirty() names the changed box.
+  void* label_data() { return labels_.data(); }
+  const void* label_data() const { return labels_.data(); }
+  std::uint16_t label(int i, int j, int k) const;
+  std::size_t linear_index(int i, int j, int k) const {
+    return static_cast<std::size_t>(i) +
+           static_cast<std::size_t>(shape_[0]) *
+               (static_cast<std::size_t>(j) + static_cast<std::size_t>(shape_[1]) * k);
+  }
+
+  IntensityType intensity_type() const { return intensity_type_; }
+  void* intensity_data() { return intensity_.empty() ? nullptr : intensity_.data(); }
+  /// Allocates a zeroed intensity grid of this type (kNone removes it).
+  void set_intensity_type(IntensityType type);
+
+  /// Centre of voxel (i, j, k) in the volume frame.
+  Eigen::Vector3d voxel_center(int i, int j, int k) const;
+  /// Volume-frame point to continuous voxel units.
+  Eigen::Vector3d to_voxel_units(const Eigen::Vector3d& p) const;
+  /// Continuous voxel units to a volume-frame point.
+  Eigen::Vector3d from_voxel_units(const Eigen::Vector3d& u) const;
+
+  /// Where the grid sat in its source's patient space (e.g. an NRRD's LPS frame), metres:
+  /// patient-from-volume-frame, identity when unknown.
+  const Eigen::Matrix4d& patient_from_volume() const { return patient_from_volume_; }
+  void set_patient_from_volume(const Eigen::Matrix4d& m) { patient_from_volume_ = m; }
+  /// The file the grid came from ("" if built in memory).
+  const std::string& source() const { return source_; }
+  void set_source(const std::string& s) { source_ = s; }
+
+  /// Voxels per label id (index = id), over the whole grid.
+  std::vector<std::int64_t> label_counts() const;
+
+  // --- Editing: every edit bumps revision() and records its box for renderers and the log.
+
+  /// Clears the voxels whose centres lie within radius of center (volume frame); with
+  /// only_removable, voxels whose label is not removable stay. Returns how many were cleared.
+  std::int64_t remove_sphere(const Eigen::Vector3d& center, double radius,
+                             bool only_removable = true);
+  /// Sets every voxel of the box to label (0 clears). Returns how many changed.
+  std::int64_t set_region(const VoxelBox& box, std::uint16_t label);
+  /// Declares that the labels in box were changed directly (through the NumPy view).
+  void mark_dirty(const VoxelBox& box);
+  /// Restores the labels the volume had when it was loaded or last committed.
+  void reset();
+  /// Makes the current labels the state reset() returns to.
+  void commit();
+
+  /// Increases with every edit.
+  std::int64_t revision() const { return revision_; }
+  /// The union of the boxes edited after `since`: returns false when nothing changed, and the
+  /// whole grid when the history no longer reaches back that far.
+  bool dirty_since(std::int64_t since, VoxelBox* box) const;
+  const std::deque<VolumeEdit>& edit_log() const { return edit_log_; }
+  /// Hands over the edit log and starts a new one.
+  std::deque<VolumeEdit> take_edit_log();
+
+  // --- Derived fields, brought up to date on access.
+
+  /// Occupancy (label != 0) blurred by a separable binomial kernel [1 4 6 4 1] / 16, 0..255:
+  /// trilinear interpolation of it gives a smooth iso-surface at 0.5 that sits on flat voxel
+  /// boundaries, with normals free of voxel steps.
+  const std::vector<std::uint8_t>& smoothed_occupancy();
+  /// How far (voxels) a label change reaches into the smoothed occupancy.
+  static constexpr int kSmoothRadius = 2;
+  /// Bricks of kBrickSize^3 voxels: for each, the largest smoothed occupancy that trilinear
+  /// sampling anywhere inside it can see (its voxels and a one-voxel margin), i fastest.
+  const std::vector<std::uint8_t>& brick_max();
+  std::array<int, 3> brick_shape() const;
+  static constexpr int kBrickSize = 4;
+  /// Normals are the gradient of the smoothed occupancy over a tetrahedron this many voxels
+  /// along each axis from the hit.
+  static constexpr double kNormalSpan = 1.2;
+
+  /// First crossing of the iso-surface (0..1 on the smoothed occupancy) by the ray origin + t *
+  /// direction (volume frame): samples half a voxel apart from where the ray enters the grid,
+  /// bisection between the last sample below and the first at or above the level. The label is
+  /// that of the voxel a quarter voxel further along the ray, or if that is empty of the solid
+  /// voxel with the largest trilinear weight at the hit. (The GPU ray caster does the same.)
+  VolumeHit raycast(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                    double iso = 0.5, double max_distance = 1e9);
+
+ private:
+  void record(VolumeEdit edit);
+  void update_derived();
+  void smooth_box(const VoxelBox& box);
+  void update_bricks(const VoxelBox& box);
+
+  std::array<int, 3> shape_;
+  Eigen::Vector3d dimensions_;
+  LabelType label_type_;
+  LabelTable table_;
+  std::vector<std::uint8_t> labels_;    // raw bytes, 1 or 2 per voxel
+  std::vector<std::uint8_t> original_;  // what reset() restores
+  IntensityType intensity_type_ = IntensityType::kNone;
+  std::vector<std::uint8_t> intensity_;
+  Eigen::Matrix4d patient_from_volume_ = Eigen::Matrix4d::Identity();
+  std::string source_;
+
+  std::int64_t revision_ = 0;
+  std::deque<std::pair<std::int64_t, VoxelBox>> dirty_;  // recent edits, oldest first
+  std::int64_t dirty_floor_ = 0;  // edits at or before this revision are no longer listed
+  std::deque<VolumeEdit> edit_log_;
+
+  std::vector<std::uint8_t> smoothed_;
+  std::vector<std::uint8_t> bricks_;
+  std::int64_t derived_revision_ = -1;
+};
+
+}  // namespace ambfplus

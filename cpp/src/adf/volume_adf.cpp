@@ -1,0 +1,166 @@
+#include "ambfplus/adf/volume_adf.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <filesystem>
+
+#include "ambfplus/errors.h"
+#include "ambfplus/log.h"
+#include "ambfplus/scene/world.h"
+
+namespace fs = std::filesystem;
+
+namespace ambfplus {
+namespace {
+
+std::string remove_spaces(std::string s) {
+  s.erase(std::remove(s.begin(), s.end(), ' '), s.end());
+  return s;
+}
+
+// A child node's value as T, or a ConfigError naming the file, line and key.
+template <typename T>
+T value(const std::string& path, const YAML::Node& node, const std::string& where,
+        const std::string& key) {
+  try {
+    return node.as<T>();
+  } catch (const YAML::Exception&) {
+    throw ConfigError(path, "line " + std::to_string(node.Mark().line + 1) + ": " + where + ": '" +
+                                key + "' has the wrong type");
+  }
+}
+
+Eigen::Vector3d xyz(const std::string& path, const YAML::Node& n, const std::string& where,
+                    const std::string& key, const Eigen::Vector3d& fallback) {
+  if (!n) return fallback;
+  Eigen::Vector3d v = fallback;
+  const char* axes[3] = {"x", "y", "z"};
+  for (int a = 0; a < 3; ++a) {
+    if (n[axes[a]]) v[a] = value<double>(path, n[axes[a]], where, key + "." + axes[a]);
+  }
+  return v;
+}
+
+Eigen::Matrix3d rpy(double r, double p, double y) {
+  return (Eigen::AngleAxisd(y, Eigen::Vector3d::UnitZ()) *
+          Eigen::AngleAxisd(p, Eigen::Vector3d::UnitY()) *
+          Eigen::AngleAxisd(r, Eigen::Vector3d::UnitX()))
+      .toRotationMatrix();
+}
+
+}  // namespace
+
+std::vector<AdfVolumeBlock> read_adf_volumes(const std::string& path) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) throw AssetNotFound(path, "ADF file");
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(path, "line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
+  }
+  if (!root.IsMap()) throw ConfigError(path, "expected a mapping of keys at the top level");
+  const fs::path dir = fs::absolute(fs::path(path).parent_path());
+  std::vector<AdfVolumeBlock> out;
+  const YAML::Node list = root["volumes"];
+  if (!list) return out;
+  if (!list.IsSequence()) {
+    throw ConfigError(path, "line " + std::to_string(list.Mark().line + 1) +
+                                ": 'volumes' must be a list of block names");
+  }
+  for (const YAML::Node& entry : list) {
+    const std::string id = value<std::string>(path, entry, "volumes", "volumes");
+    const YAML::Node block = root[id];
+    if (!block) {
+      throw ConfigError(path, "line " + std::to_string(entry.Mark().line + 1) +
+                                  ": 'volumes' lists '" + id +
+                                  "' but the file has no block of that name");
+    }
+    AdfVolumeBlock v;
+    v.identifier = id;
+    v.name = block["name"] ? remove_spaces(value<std::string>(path, block["name"], id, "name"))
+                           : remove_spaces(id.substr(id.find(' ') + 1));
+    const YAML::Node location = block["location"];
+    if (location) {
+      const Eigen::Vector3d p =
+          xyz(path, location["position"], id, "location.position", Eigen::Vector3d::Zero());
+      double r = 0, pi = 0, y = 0;
+      if (const YAML::Node o = location["orientation"]) {
+        if (o["r"]) r = value<double>(path, o["r"], id, "location.orientation.r");
+        if (o["p"]) pi = value<double>(path, o["p"], id, "location.orientation.p");
+        if (o["y"]) y = value<double>(path, o["y"], id, "location.orientation.y");
+      }
+      v.pose.topLeftCorner<3, 3>() = rpy(r, pi, y);
+      v.pose.topRightCorner<3, 1>() = p;
+    }
+    const double scale = block["scale"] ? value<double>(path, block["scale"], id, "scale") : 1.0;
+    v.images.dimensions =
+        xyz(path, block["dimensions"], id, "dimensions", Eigen::Vector3d::Ones()) * scale;
+    const YAML::Node images = block["images"];
+    if (!images || !images["path"]) {
+      throw ConfigError(path, "line " + std::to_string(block.Mark().line + 1) + ": " + id +
+                                  ": needs images: {path, prefix, format, count}");
+    }
+    const fs::path folder = value<std::string>(path, images["path"], id, "images.path");
+    v.images.folder = (folder.is_absolute() ? folder : dir / folder).lexically_normal().string();
+    if (images["prefix"])
+      v.images.prefix = value<std::string>(path, images["prefix"], id, "images.prefix");
+    if (images["format"])
+      v.images.format = value<std::string>(path, images["format"], id, "images.format");
+    if (images["count"]) v.images.count = value<int>(path, images["count"], id, "images.count");
+    if (block["labels"]) {
+      const fs::path labels = value<std::string>(path, block["labels"], id, "labels");
+      v.labels = (labels.is_absolute() ? labels : dir / labels).lexically_normal().string();
+    }
+    if (block["iso-surface value"])
+      v.iso = value<double>(path, block["iso-surface value"], id, "iso-surface value");
+    if (block["quality"]) v.quality = value<double>(path, block["quality"], id, "quality");
+    if (block["optical density"]) {
+      v.optical_density = value<double>(path, block["optical density"], id, "optical density");
+    }
+    v.custom_shaders = static_cast<bool>(block["shaders"]);
+    out.push_back(std::move(v));
+  }
+  return out;
+}
+
+std::vector<Volume*> load_adf_volumes(World& world, const std::string& path,
+                                      const std::string& labels) {
+  const std::vector<AdfVolumeBlock> blocks = read_adf_volumes(path);
+  std::string model_name = fs::path(path).stem().string();
+  for (int n = 1; [&] {
+         for (Model* m : world.models()) {
+           if (m->name() == model_name) return true;
+         }
+         return false;
+       }();
+       ++n) {
+    model_name = fs::path(path).stem().string() + std::to_string(n);
+  }
+  Model& model = world.add_model(model_name);
+  std::vector<Volume*> out;
+  for (const AdfVolumeBlock& b : blocks) {
+    SliceStackSpec images = b.images;
+    const std::string table = labels.empty() ? b.labels : labels;
+    if (!table.empty()) images.labels = read_label_table(table);
+    VolumeSpec spec;
+    spec.name = b.name;
+    spec.data = load_slice_stack(images);
+    spec.pose = b.pose;
+    spec.iso = b.iso;
+    spec.quality = b.quality;
+    spec.optical_density = b.optical_density;
+    if (b.custom_shaders) {
+      log(LogLevel::kInfo, path + ": " + b.identifier +
+                               " declares AMBF volume shaders; ambfplus ray casts volumes itself");
+    }
+    try {
+      out.push_back(&model.add_volume(spec));
+    } catch (const std::invalid_argument& e) {
+      throw ConfigError(path, b.identifier + ": " + e.what());
+    }
+  }
+  return out;
+}
+
+}  // namespace ambfplus

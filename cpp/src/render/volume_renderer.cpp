@@ -1,0 +1,291 @@
+#include "render/volume_renderer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+
+#include "ambfplus/render/render_stats.h"
+#include "ambfplus/scene/world.h"
+#include "render/egl_context.h"
+#include "render/scene_renderer.h"
+
+namespace ambfplus::render {
+
+std::vector<std::uint8_t> brick_distances(const std::vector<std::uint8_t>& brick_max,
+                                          const std::array<int, 3>& n, double level) {
+  std::vector<std::uint8_t> d(brick_max.size());
+  for (std::size_t v = 0; v < d.size(); ++v) d[v] = brick_max[v] >= level ? 0 : 255;
+  auto at = [&](int i, int j, int k) -> std::uint8_t& {
+    return d[static_cast<std::size_t>(i) +
+             std::size_t(n[0]) * (std::size_t(j) + std::size_t(n[1]) * k)];
+  };
+  // Two raster passes over the 26-neighbourhood give the exact chessboard distance.
+  auto relax = [&](int i, int j, int k, int sign) {
+    std::uint8_t& here = at(i, j, k);
+    if (here == 0) return;
+    for (int dk = -1; dk <= 1; ++dk) {
+      for (int dj = -1; dj <= 1; ++dj) {
+        for (int di = -1; di <= 1; ++di) {
+          // Neighbours already visited in this pass's order.
+          const int order = dk != 0 ? dk : dj != 0 ? dj : di;
+          if (order * sign >= 0) continue;
+          const int a = i + di, b = j + dj, c = k + dk;
+          if (a < 0 || b < 0 || c < 0 || a >= n[0] || b >= n[1] || c >= n[2]) continue;
+          const int candidate = at(a, b, c) + 1;
+          if (candidate < here) here = static_cast<std::uint8_t>(candidate);
+        }
+      }
+    }
+  };
+  for (int k = 0; k < n[2]; ++k)
+    for (int j = 0; j < n[1]; ++j)
+      for (int i = 0; i < n[0]; ++i) relax(i, j, k, +1);
+  for (int k = n[2] - 1; k >= 0; --k)
+    for (int j = n[1] - 1; j >= 0; --j)
+      for (int i = n[0] - 1; i >= 0; --i) relax(i, j, k, -1);
+  return d;
+}
+
+namespace {
+
+GLuint make_texture_3d(GLenum filter, GLenum wrap) {
+  GLuint t = 0;
+  glGenTextures(1, &t);
+  glBindTexture(GL_TEXTURE_3D, t);
+  glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MIN_FILTER, filter);
+  glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MAG_FILTER, filter);
+  for (GLenum axis : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R}) {
+    glTexParameteri(GL_TEXTURE_3D, axis, wrap);
+  }
+  const GLfloat border[4] = {0, 0, 0, 0};
+  glTexParameterfv(GL_TEXTURE_3D, GL_TEXTURE_BORDER_COLOR, border);
+  return t;
+}
+
+// Sends box of a grid stored i fastest with `shape` to a 3D texture, reading it in place.
+void upload_sub_box(GLuint texture, const VoxelBox& box, const std::array<int, 3>& shape,
+                    GLenum format, GLenum type, const void* data) {
+  glBindTexture(GL_TEXTURE_3D, texture);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glPixelStorei(GL_UNPACK_ROW_LENGTH, shape[0]);
+  glPixelStorei(GL_UNPACK_IMAGE_HEIGHT, shape[1]);
+  glPixelStorei(GL_UNPACK_SKIP_PIXELS, box.lo[0]);
+  glPixelStorei(GL_UNPACK_SKIP_ROWS, box.lo[1]);
+  glPixelStorei(GL_UNPACK_SKIP_IMAGES, box.lo[2]);
+  glTexSubImage3D(GL_TEXTURE_3D, 0, box.lo[0], box.lo[1], box.lo[2], box.hi[0] - box.lo[0],
+                  box.hi[1] - box.lo[1], box.hi[2] - box.lo[2], format, type, data);
+  for (GLenum p : {GL_UNPACK_ROW_LENGTH, GL_UNPACK_IMAGE_HEIGHT, GL_UNPACK_SKIP_PIXELS,
+                   GL_UNPACK_SKIP_ROWS, GL_UNPACK_SKIP_IMAGES}) {
+    glPixelStorei(p, 0);
+  }
+}
+
+// The 36 corners of the unit cube's 12 triangles, counter-clockwise seen from outside.
+const float kCube[] = {
+    0, 0, 0, 0, 1, 0, 1, 1, 0, 0, 0, 0, 1, 1, 0, 1, 0, 0,  // z = 0
+    0, 0, 1, 1, 0, 1, 1, 1, 1, 0, 0, 1, 1, 1, 1, 0, 1, 1,  // z = 1
+    0, 0, 0, 1, 0, 0, 1, 0, 1, 0, 0, 0, 1, 0, 1, 0, 0, 1,  // y = 0
+    0, 1, 0, 0, 1, 1, 1, 1, 1, 0, 1, 0, 1, 1, 1, 1, 1, 0,  // y = 1
+    0, 0, 0, 0, 0, 1, 0, 1, 1, 0, 0, 0, 0, 1, 1, 0, 1, 0,  // x = 0
+    1, 0, 0, 1, 1, 0, 1, 1, 1, 1, 0, 0, 1, 1, 1, 1, 0, 1,  // x = 1
+};
+
+}  // namespace
+
+GpuVolume::GpuVolume(std::shared_ptr<VolumeData> data) : data_(std::move(data)) {
+  const auto& n = data_->shape();
+  occupancy_ = make_texture_3d(GL_LINEAR, GL_CLAMP_TO_BORDER);
+  glTexImage3D(GL_TEXTURE_3D, 0, GL_R8, n[0], n[1], n[2], 0, GL_RED, GL_UNSIGNED_BYTE, nullptr);
+  labels_ = make_texture_3d(GL_NEAREST, GL_CLAMP_TO_EDGE);
+  const bool wide = data_->label_type() == LabelType::kUInt16;
+  glTexImage3D(GL_TEXTURE_3D, 0, wide ? GL_R16UI : GL_R8UI, n[0], n[1], n[2], 0, GL_RED_INTEGER,
+               wide ? GL_UNSIGNED_SHORT : GL_UNSIGNED_BYTE, nullptr);
+  const auto b = data_->brick_shape();
+  bricks_ = make_texture_3d(GL_NEAREST, GL_CLAMP_TO_EDGE);
+  glTexImage3D(GL_TEXTURE_3D, 0, GL_R8UI, b[0], b[1], b[2], 0, GL_RED_INTEGER, GL_UNSIGNED_BYTE,
+               nullptr);
+  glGenTextures(1, &colors_);
+  glBindTexture(GL_TEXTURE_2D, colors_);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glGenVertexArrays(1, &vao_);
+  glGenBuffers(1, &vbo_);
+  glBindVertexArray(vao_);
+  glBindBuffer(GL_ARRAY_BUFFER, vbo_);
+  glBufferData(GL_ARRAY_BUFFER, sizeof(kCube), kCube, GL_STATIC_DRAW);
+  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
+  glEnableVertexAttribArray(0);
+  glBindVertexArray(0);
+  check_gl("creating volume textures");
+}
+
+GpuVolume::~GpuVolume() {
+  const GLuint textures[4] = {occupancy_, labels_, bricks_, colors_};
+  glDeleteTextures(4, textures);
+  glDeleteBuffers(1, &vbo_);
+  glDeleteVertexArrays(1, &vao_);
+}
+
+void GpuVolume::upload_box(const VoxelBox& box) {
+  const auto& n = data_->shape();
+  const bool wide = data_->label_type() == LabelType::kUInt16;
+  upload_sub_box(labels_, box, n, GL_RED_INTEGER, wide ? GL_UNSIGNED_SHORT : GL_UNSIGNED_BYTE,
+                 data_->label_data());
+  // The smoothed field changes kSmoothRadius voxels around every changed label.
+  upload_sub_box(occupancy_, box.grown(VolumeData::kSmoothRadius).clipped(n), n, GL_RED,
+                 GL_UNSIGNED_BYTE, data_->smoothed_occupancy().data());
+}
+
+void GpuVolume::upload_colors() {
+  const LabelTable& table = data_->label_table();
+  if (table.labels().size() == uploaded_table_.size() &&
+      std::equal(
+          uploaded_table_.begin(), uploaded_table_.end(), table.labels().begin(),
+          [](const Label& a, const Label& b) { return a.id == b.id && a.color == b.color; })) {
+    return;
+  }
+  const int rows = table.max_id() / 256 + 1;
+  std::vector<std::uint8_t> rgba(static_cast<std::size_t>(rows) * 256 * 4, 255);
+  for (const Label& l : table.labels()) {
+    for (int c = 0; c < 3; ++c) rgba[l.id * 4 + c] = l.color[c];
+  }
+  glBindTexture(GL_TEXTURE_2D, colors_);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, 256, rows, 0, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+  uploaded_table_ = table.labels();
+}
+
+void GpuVolume::update_distances(const VoxelBox& changed, double level, bool full) {
+  const std::vector<std::uint8_t>& max = data_->brick_max();
+  const auto b = data_->brick_shape();
+  constexpr int B = VolumeData::kBrickSize;
+  // Bricks whose sampling footprint the change can reach.
+  VoxelBox bricks;
+  for (int a = 0; a < 3; ++a) {
+    bricks.lo[a] = std::max(0, (changed.lo[a] - VolumeData::kSmoothRadius - 1) / B);
+    bricks.hi[a] = std::min(b[a], (changed.hi[a] + VolumeData::kSmoothRadius + 1) / B + 1);
+  }
+  auto at = [&](int i, int j, int k) {
+    return static_cast<std::size_t>(i) +
+           std::size_t(b[0]) * (std::size_t(j) + std::size_t(b[1]) * k);
+  };
+  if (!full) {
+    // Removing material only empties bricks, which leaves every other distance a safe lower
+    // bound: mark emptied bricks 1 and keep the rest. A brick that filled needs the full map.
+    for (int k = bricks.lo[2]; k < bricks.hi[2] && !full; ++k)
+      for (int j = bricks.lo[1]; j < bricks.hi[1] && !full; ++j)
+        for (int i = bricks.lo[0]; i < bricks.hi[0]; ++i) {
+          const std::size_t n = at(i, j, k);
+          const bool occupied = max[n] >= level;
+          if (occupied && distances_[n] != 0) {
+            full = true;
+            break;
+          }
+          if (!occupied && distances_[n] == 0) distances_[n] = 1;
+        }
+  }
+  if (full) {
+    distances_ = brick_distances(max, b, level);
+    bricks = VoxelBox{{0, 0, 0}, b};
+  }
+  upload_sub_box(bricks_, bricks, b, GL_RED_INTEGER, GL_UNSIGNED_BYTE, distances_.data());
+  brick_level_ = level;
+}
+
+void GpuVolume::sync(double iso) {
+  const auto start = std::chrono::steady_clock::now();
+  upload_colors();
+  VoxelBox box;
+  const bool first = revision_ < 0;
+  const bool changed = first ? true : data_->dirty_since(revision_, &box);
+  if (first) box = VoxelBox{{0, 0, 0}, data_->shape()};
+  // Bricks that may hold the surface: those whose largest value can reach the level (one step
+  // of 8-bit filtering below it, so rounding never hides a surface).
+  const double level = std::max(0.0, iso * 255.0 - 1.0);
+  if (changed && !box.empty()) upload_box(box);
+  if (level != brick_level_ || (changed && !box.empty())) {
+    update_distances(box, level, first || level != brick_level_);
+  }
+  check_gl("uploading a volume");
+  if (changed) {
+    last_upload_.full = first;
+    last_upload_.voxels = box.count();
+    last_upload_.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+  revision_ = data_->revision();
+}
+
+void GpuVolume::draw(const Volume& volume, const Camera& camera,
+                     const Eigen::Isometry3d& camera_from_world, const LightSet& lights) {
+  const std::string defines =
+      lights.defines() + "#define EMPTY_SPACE_SKIPPING " +
+      (volume.empty_space_skipping() ? "1" : "0") + "\n" +
+      (std::getenv("AMBFPLUS_DEBUG_VOLUME_STEPS") ? "#define DEBUG_STEPS 1\n" : "");
+  Program& program = Context::get().program("volume.vert", "volume.frag", defines);
+  program.use();
+  const Eigen::Vector3d s = data_->voxel_size();
+  Eigen::Matrix4d volume_from_voxel = Eigen::Matrix4d::Identity();
+  volume_from_voxel.topLeftCorner<3, 3>() = s.asDiagonal();
+  volume_from_voxel.topRightCorner<3, 1>() = -data_->dimensions() / 2;
+  const Eigen::Matrix4d camera_from_voxel =
+      camera_from_world.matrix() * volume.pose().matrix() * volume_from_voxel;
+  const Eigen::Matrix4d clip_from_voxel = camera.projection() * camera_from_voxel;
+  const Eigen::Vector3d eye = (camera_from_voxel.inverse() * Eigen::Vector4d(0, 0, 0, 1)).head<3>();
+  const Eigen::Matrix3d normal_from_voxel =
+      camera_from_voxel.topLeftCorner<3, 3>().inverse().transpose();
+  const auto& n = data_->shape();
+  const Eigen::Matrix4f clip_f = clip_from_voxel.cast<float>();
+  const Eigen::Matrix4f camera_f = camera_from_voxel.cast<float>();
+  const Eigen::Matrix3f normal_f = normal_from_voxel.cast<float>();
+  glUniform3f(program.uniform("u_shape"), float(n[0]), float(n[1]), float(n[2]));
+  glUniform3f(program.uniform("u_eye"), float(eye.x()), float(eye.y()), float(eye.z()));
+  glUniformMatrix4fv(program.uniform("u_clip_from_voxel"), 1, GL_FALSE, clip_f.data());
+  glUniformMatrix4fv(program.uniform("u_camera_from_voxel"), 1, GL_FALSE, camera_f.data());
+  glUniformMatrix3fv(program.uniform("u_normal_from_voxel"), 1, GL_FALSE, normal_f.data());
+  glUniform1f(program.uniform("u_level"), static_cast<float>(volume.iso()));
+  glUniform1i(program.uniform("u_brick_size"), VolumeData::kBrickSize);
+  glUniform1f(program.uniform("u_ambient"), 0.2f);
+  glUniform1f(program.uniform("u_specular"), volume.specular());
+  glUniform1f(program.uniform("u_shininess"), volume.shininess());
+  lights.upload(program);
+  const struct {
+    const char* name;
+    GLenum target;
+    GLuint texture;
+  } units[4] = {{"u_occupancy", GL_TEXTURE_3D, occupancy_},
+                {"u_labels", GL_TEXTURE_3D, labels_},
+                {"u_bricks", GL_TEXTURE_3D, bricks_},
+                {"u_colors", GL_TEXTURE_2D, colors_}};
+  for (int u = 0; u < 4; ++u) {
+    glActiveTexture(GL_TEXTURE0 + u);
+    glBindTexture(units[u].target, units[u].texture);
+    glUniform1i(program.uniform(units[u].name), u);
+  }
+  glActiveTexture(GL_TEXTURE0);
+  // One fragment per covered pixel, also with the camera inside the box: draw the back faces.
+  glEnable(GL_CULL_FACE);
+  glCullFace(GL_FRONT);
+  glBindVertexArray(vao_);
+  glDrawArrays(GL_TRIANGLES, 0, 36);
+  glBindVertexArray(0);
+  glDisable(GL_CULL_FACE);
+  check_gl("ray casting a volume");
+}
+
+}  // namespace ambfplus::render
+
+namespace ambfplus {
+
+VolumeUploadStats last_volume_upload(const Volume& volume) {
+  VolumeUploadStats stats;
+  const auto* upload = volume.world().renderer().last_upload(volume.data().get());
+  if (upload == nullptr) return stats;
+  stats.rendered = true;
+  stats.full = upload->full;
+  stats.voxels = upload->voxels;
+  stats.seconds = upload->seconds;
+  return stats;
+}
+
+}  // namespace ambfplus

@@ -1,0 +1,234 @@
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include <algorithm>
+#include <filesystem>
+#include <map>
+#include <unordered_map>
+
+#include "ambfplus/errors.h"
+#include "ambfplus/volume/volume_io.h"
+#include "util/strings.h"
+#include "volume/grid_access.h"
+
+namespace fs = std::filesystem;
+
+namespace ambfplus {
+namespace {
+
+// Slice files by index: "<prefix><digits>.<format>", any padding, extension in any case.
+std::map<int, fs::path> find_slices(const SliceStackSpec& spec) {
+  std::error_code ec;
+  if (!fs::is_directory(spec.folder, ec)) throw AssetNotFound(spec.folder, "slice folder");
+  std::map<int, fs::path> slices;
+  const std::string ext = "." + to_lower(spec.format);
+  for (const auto& entry : fs::directory_iterator(spec.folder, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (to_lower(entry.path().extension().string()) != ext) continue;
+    if (name.compare(0, spec.prefix.size(), spec.prefix) != 0) continue;
+    const std::string digits =
+        name.substr(spec.prefix.size(), name.size() - spec.prefix.size() - ext.size());
+    if (digits.empty() || digits.size() > 9 ||
+        !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; })) {
+      continue;
+    }
+    const int index = std::stoi(digits);
+    if (spec.count >= 0 && index > spec.count) continue;
+    auto [it, inserted] = slices.emplace(index, entry.path());
+    if (!inserted) {
+      throw ConfigError(entry.path().string(), "slice " + std::to_string(index) +
+                                                   " also exists as " + it->second.string());
+    }
+  }
+  return slices;
+}
+
+cv::Mat read_slice(const fs::path& path) {
+  cv::Mat image;
+  try {
+    image = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
+  } catch (const cv::Exception& e) {
+    throw ConfigError(path.string(), std::string("cannot decode the image: ") + e.what());
+  }
+  if (image.empty())
+    throw ConfigError(path.string(),
+                      "cannot decode the image (corrupt or not "
+                      "an image)");
+  if (image.depth() == CV_16U) image.convertTo(image, CV_8U, 1.0 / 257.0);
+  if (image.depth() != CV_8U) {
+    throw ConfigError(path.string(), "expected 8- or 16-bit pixels");
+  }
+  return image;
+}
+
+std::uint32_t pack(std::uint8_t r, std::uint8_t g, std::uint8_t b) {
+  return (std::uint32_t(r) << 16) | (std::uint32_t(g) << 8) | b;
+}
+
+}  // namespace
+
+std::shared_ptr<VolumeData> load_slice_stack(const SliceStackSpec& spec) {
+  const std::map<int, fs::path> slices = find_slices(spec);
+  if (slices.empty() || slices.begin()->first != 0) {
+    throw AssetNotFound((fs::path(spec.folder) / (spec.prefix + "0." + spec.format)).string(),
+                        "first slice of the stack");
+  }
+  // The stack is slices 0..n-1; a gap before a present slice is an error, not the stack's end.
+  int n = 0;
+  while (slices.count(n)) ++n;
+  if (slices.size() != static_cast<std::size_t>(n)) {
+    const auto after = slices.upper_bound(n);
+    throw ConfigError(
+        (fs::path(spec.folder) / (spec.prefix + std::to_string(n) + "." + spec.format)).string(),
+        "slice " + std::to_string(n) + " is missing but slice " + std::to_string(after->first) +
+            " (" + after->second.filename().string() + ") exists");
+  }
+
+  // Read every slice once; colours map to labels through a cache.
+  std::vector<cv::Mat> images;
+  images.reserve(n);
+  for (int k = 0; k < n; ++k) {
+    cv::Mat image = read_slice(slices.at(k));
+    if (k > 0 && (image.rows != images[0].rows || image.cols != images[0].cols)) {
+      throw ConfigError(slices.at(k).string(), "slice is " + std::to_string(image.cols) + "x" +
+                                                   std::to_string(image.rows) + " but slice 0 is " +
+                                                   std::to_string(images[0].cols) + "x" +
+                                                   std::to_string(images[0].rows));
+    }
+    if (k > 0 && image.channels() != images[0].channels()) {
+      throw ConfigError(slices.at(k).string(), "slice has " + std::to_string(image.channels()) +
+                                                   " channels but slice 0 has " +
+                                                   std::to_string(images[0].channels()));
+    }
+    images.push_back(std::move(image));
+  }
+  const int width = images[0].cols, height = images[0].rows, channels = images[0].channels();
+
+  LabelTable table = spec.labels;
+  std::unordered_map<std::uint32_t, std::uint16_t> colour_to_label;
+  if (channels >= 3 && table.empty()) {
+    // One label per colour found, most frequent first (ties by colour value).
+    std::unordered_map<std::uint32_t, std::int64_t> counts;
+    for (const cv::Mat& image : images) {
+      for (int r = 0; r < height; ++r) {
+        const std::uint8_t* px = image.ptr<std::uint8_t>(r);
+        for (int c = 0; c < width; ++c, px += channels) {
+          const bool solid =
+              channels == 4 ? px[3] >= spec.alpha_threshold : (px[0] | px[1] | px[2]) != 0;
+          if (solid) ++counts[pack(px[2], px[1], px[0])];
+        }
+      }
+    }
+    std::vector<std::pair<std::uint32_t, std::int64_t>> order(counts.begin(), counts.end());
+    std::sort(order.begin(), order.end(), [](const auto& a, const auto& b) {
+      return a.second != b.second ? a.second > b.second : a.first < b.first;
+    });
+    if (order.size() > 65535) {
+      throw ConfigError(spec.folder, "the slices hold " + std::to_string(order.size()) +
+                                         " colours, more than 65535 labels: give a label table");
+    }
+    for (std::size_t i = 0; i < order.size(); ++i) {
+      Label l;
+      l.id = static_cast<std::uint16_t>(i + 1);
+      l.name = "label_" + std::to_string(l.id);
+      l.color = {std::uint8_t(order[i].first >> 16), std::uint8_t(order[i].first >> 8),
+                 std::uint8_t(order[i].first)};
+      table.add(l);
+      colour_to_label[order[i].first] = l.id;
+    }
+  }
+  if (channels == 1 && table.empty()) {
+    // Grey slices carry label ids; name the ids found.
+    std::vector<bool> seen(256, false);
+    for (const cv::Mat& image : images) {
+      for (int r = 0; r < height; ++r) {
+        const std::uint8_t* px = image.ptr<std::uint8_t>(r);
+        for (int c = 0; c < width; ++c) seen[px[c]] = true;
+      }
+    }
+    for (int v = 1; v < 256; ++v) {
+      if (!seen[v]) continue;
+      Label l;
+      l.id = static_cast<std::uint16_t>(v);
+      l.name = "label_" + std::to_string(v);
+      l.color = {std::uint8_t(v), std::uint8_t(v), std::uint8_t(v)};
+      table.add(l);
+    }
+  }
+  if (channels == 2) {
+    throw ConfigError(slices.at(0).string(), "grey+alpha slices are not supported: use RGBA");
+  }
+
+  const LabelType type = table.max_id() > 255 ? LabelType::kUInt16 : LabelType::kUInt8;
+  auto volume = std::make_shared<VolumeData>(std::array<int, 3>{width, height, n}, spec.dimensions,
+                                             type, table);
+  visit_labels(type, volume->label_data(), [&](auto* labels) {
+    using T = std::remove_pointer_t<decltype(labels)>;
+    for (int k = 0; k < n; ++k) {
+      const cv::Mat& image = images[k];
+      for (int r = 0; r < height; ++r) {
+        const std::uint8_t* px = image.ptr<std::uint8_t>(r);
+        T* out = labels + volume->linear_index(0, height - 1 - r, k);
+        for (int c = 0; c < width; ++c, px += channels) {
+          if (channels == 1) {
+            out[c] = static_cast<T>(px[0]);
+            continue;
+          }
+          const bool solid =
+              channels == 4 ? px[3] >= spec.alpha_threshold : (px[0] | px[1] | px[2]) != 0;
+          if (!solid) {
+            out[c] = 0;
+            continue;
+          }
+          const std::uint32_t rgb = pack(px[2], px[1], px[0]);  // OpenCV reads BGR(A)
+          auto it = colour_to_label.find(rgb);
+          if (it == colour_to_label.end()) {
+            it = colour_to_label.emplace(rgb, table.nearest({px[2], px[1], px[0]})).first;
+          }
+          out[c] = static_cast<T>(it->second);
+        }
+      }
+    }
+  });
+  volume->commit();
+  volume->set_source(spec.folder);
+  return volume;
+}
+
+void save_slice_stack(const VolumeData& volume, const std::string& folder,
+                      const std::string& prefix, const std::string& format) {
+  std::error_code ec;
+  fs::create_directories(folder, ec);
+  if (!fs::is_directory(folder, ec)) throw ConfigError(folder, "cannot create the slice folder");
+  const auto& shape = volume.shape();
+  const int width = shape[0], height = shape[1];
+  std::vector<std::array<std::uint8_t, 3>> colours(65536, {255, 255, 255});
+  for (const Label& l : volume.label_table().labels()) colours[l.id] = l.color;
+  cv::Mat image(height, width, CV_8UC4);
+  visit_labels(volume.label_type(), volume.label_data(), [&](const auto* labels) {
+    for (int k = 0; k < shape[2]; ++k) {
+      for (int r = 0; r < height; ++r) {
+        std::uint8_t* px = image.ptr<std::uint8_t>(r);
+        const auto* in = labels + volume.linear_index(0, height - 1 - r, k);
+        for (int c = 0; c < width; ++c, px += 4) {
+          const auto l = in[c];
+          const auto& rgb = colours[l];
+          px[0] = l ? rgb[2] : 0;
+          px[1] = l ? rgb[1] : 0;
+          px[2] = l ? rgb[0] : 0;
+          px[3] = l ? 255 : 0;
+        }
+      }
+      const std::string path =
+          (fs::path(folder) / (prefix + std::to_string(k) + "." + format)).string();
+      bool ok = false;
+      try {
+        ok = cv::imwrite(path, image);
+      } catch (const cv::Exception&) {
+      }
+      if (!ok) throw ConfigError(path, "cannot write the slice image");
+    }
+  });
+}
+
+}  // namespace ambfplus

@@ -1,0 +1,468 @@
+#include "ambfplus/volume/volume_data.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <stdexcept>
+
+#include "volume/grid_access.h"
+
+namespace ambfplus {
+
+// ---------------------------------------------------------------------------------------------
+// VoxelBox
+
+bool VoxelBox::empty() const { return hi[0] <= lo[0] || hi[1] <= lo[1] || hi[2] <= lo[2]; }
+
+std::int64_t VoxelBox::count() const {
+  if (empty()) return 0;
+  return std::int64_t(hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]);
+}
+
+VoxelBox VoxelBox::united(const VoxelBox& o) const {
+  if (empty()) return o;
+  if (o.empty()) return *this;
+  VoxelBox b;
+  for (int a = 0; a < 3; ++a) {
+    b.lo[a] = std::min(lo[a], o.lo[a]);
+    b.hi[a] = std::max(hi[a], o.hi[a]);
+  }
+  return b;
+}
+
+VoxelBox VoxelBox::clipped(const std::array<int, 3>& shape) const {
+  VoxelBox b;
+  for (int a = 0; a < 3; ++a) {
+    b.lo[a] = std::clamp(lo[a], 0, shape[a]);
+    b.hi[a] = std::clamp(hi[a], 0, shape[a]);
+  }
+  return b;
+}
+
+VoxelBox VoxelBox::grown(int margin) const {
+  VoxelBox b = *this;
+  for (int a = 0; a < 3; ++a) {
+    b.lo[a] -= margin;
+    b.hi[a] += margin;
+  }
+  return b;
+}
+
+// ---------------------------------------------------------------------------------------------
+// VolumeData
+
+namespace {
+
+constexpr std::size_t kDirtyHistory = 4096;
+
+std::size_t label_bytes(LabelType t) { return t == LabelType::kUInt8 ? 1 : 2; }
+
+void check_table_fits(const LabelTable& table, LabelType type) {
+  if (type == LabelType::kUInt8 && table.max_id() > 255) {
+    throw std::invalid_argument("label id " + std::to_string(table.max_id()) +
+                                " does not fit a uint8 label grid (use uint16)");
+  }
+}
+
+}  // namespace
+
+VolumeData::VolumeData(const std::array<int, 3>& shape, const Eigen::Vector3d& dimensions,
+                       LabelType type, LabelTable table)
+    : shape_(shape), dimensions_(dimensions), label_type_(type), table_(std::move(table)) {
+  for (int a = 0; a < 3; ++a) {
+    if (shape_[a] <= 0 || shape_[a] > 8192) {
+      throw std::invalid_argument("volume shape must be 1..8192 voxels per axis, got " +
+                                  std::to_string(shape_[0]) + "x" + std::to_string(shape_[1]) +
+                                  "x" + std::to_string(shape_[2]));
+    }
+  }
+  set_dimensions(dimensions);
+  check_table_fits(table_, label_type_);
+  labels_.assign(static_cast<std::size_t>(voxel_count()) * label_bytes(label_type_), 0);
+  original_ = labels_;
+}
+
+void VolumeData::set_dimensions(const Eigen::Vector3d& dimensions) {
+  if (!(dimensions.minCoeff() > 0.0) || !dimensions.allFinite()) {
+    throw std::invalid_argument("volume dimensions must be positive metres");
+  }
+  dimensions_ = dimensions;
+}
+
+std::int64_t VolumeData::voxel_count() const {
+  return std::int64_t(shape_[0]) * shape_[1] * shape_[2];
+}
+
+Eigen::Vector3d VolumeData::voxel_size() const {
+  return dimensions_.cwiseQuotient(Eigen::Vector3d(shape_[0], shape_[1], shape_[2]));
+}
+
+void VolumeData::set_label_table(LabelTable table) {
+  check_table_fits(table, label_type_);
+  table_ = std::move(table);
+}
+
+std::uint16_t VolumeData::label(int i, int j, int k) const {
+  const std::size_t n = linear_index(i, j, k);
+  return label_type_ == LabelType::kUInt8
+             ? labels_[n]
+             : reinterpret_cast<const std::uint16_t*>(labels_.data())[n];
+}
+
+void VolumeData::set_intensity_type(IntensityType type) {
+  intensity_type_ = type;
+  const std::size_t bytes = type == IntensityType::kNone    ? 0
+                            : type == IntensityType::kInt16 ? 2
+                                                            : 4;
+  intensity_.assign(static_cast<std::size_t>(voxel_count()) * bytes, 0);
+  intensity_.shrink_to_fit();
+}
+
+Eigen::Vector3d VolumeData::voxel_center(int i, int j, int k) const {
+  return from_voxel_units(Eigen::Vector3d(i + 0.5, j + 0.5, k + 0.5));
+}
+
+Eigen::Vector3d VolumeData::to_voxel_units(const Eigen::Vector3d& p) const {
+  return (p + dimensions_ / 2).cwiseQuotient(voxel_size());
+}
+
+Eigen::Vector3d VolumeData::from_voxel_units(const Eigen::Vector3d& u) const {
+  return u.cwiseProduct(voxel_size()) - dimensions_ / 2;
+}
+
+std::vector<std::int64_t> VolumeData::label_counts() const {
+  std::vector<std::int64_t> counts(label_type_ == LabelType::kUInt8 ? 256 : 65536, 0);
+  visit_labels(label_type_, labels_.data(), [&](auto* p) {
+    const std::size_t n = static_cast<std::size_t>(voxel_count());
+    for (std::size_t v = 0; v < n; ++v) ++counts[p[v]];
+  });
+  std::size_t last = counts.size();
+  while (last > 1 && counts[last - 1] == 0) --last;
+  counts.resize(last);
+  return counts;
+}
+
+void VolumeData::record(VolumeEdit edit) {
+  edit.revision = ++revision_;
+  dirty_.emplace_back(edit.revision, edit.box);
+  if (dirty_.size() > kDirtyHistory) {
+    dirty_floor_ = dirty_.front().first;
+    dirty_.pop_front();
+  }
+  edit_log_.push_back(std::move(edit));
+}
+
+std::int64_t VolumeData::remove_sphere(const Eigen::Vector3d& center, double radius,
+                                       bool only_removable) {
+  if (!(radius >= 0.0) || !center.allFinite()) {
+    throw std::invalid_argument("remove_sphere needs a finite centre and a radius >= 0");
+  }
+  const Eigen::Vector3d s = voxel_size();
+  const Eigen::Vector3d u = to_voxel_units(center);
+  VoxelBox box;
+  for (int a = 0; a < 3; ++a) {
+    box.lo[a] = static_cast<int>(std::floor(u[a] - radius / s[a] - 0.5));
+    box.hi[a] = static_cast<int>(std::ceil(u[a] + radius / s[a] + 0.5)) + 1;
+  }
+  box = box.clipped(shape_);
+  std::vector<bool> keep(label_type_ == LabelType::kUInt8 ? 256 : 65536, false);
+  if (only_removable) {
+    for (const Label& l : table_.labels()) keep[l.id] = !l.removable;
+  }
+  VolumeEdit edit;
+  edit.kind = "remove_sphere";
+  const double r2 = radius * radius;
+  VoxelBox changed;
+  visit_labels(label_type_, labels_.data(), [&](auto* p) {
+    for (int k = box.lo[2]; k < box.hi[2]; ++k) {
+      for (int j = box.lo[1]; j < box.hi[1]; ++j) {
+        for (int i = box.lo[0]; i < box.hi[0]; ++i) {
+          auto& v = p[linear_index(i, j, k)];
+          if (v == 0 || keep[v]) continue;
+          if ((voxel_center(i, j, k) - center).squaredNorm() > r2) continue;
+          edit.voxels.push_back({i, j, k});
+          edit.old_labels.push_back(v);
+          v = 0;
+          changed = changed.united(VoxelBox{{i, j, k}, {i + 1, j + 1, k + 1}});
+        }
+      }
+    }
+  });
+  const auto count = static_cast<std::int64_t>(edit.voxels.size());
+  edit.changed = count;
+  edit.box = changed;
+  if (count > 0) record(std::move(edit));
+  return count;
+}
+
+std::int64_t VolumeData::set_region(const VoxelBox& region, std::uint16_t label) {
+  if (label_type_ == LabelType::kUInt8 && label > 255) {
+    throw std::invalid_argument("label " + std::to_string(label) + " does not fit a uint8 grid");
+  }
+  const VoxelBox box = region.clipped(shape_);
+  std::int64_t changed = 0;
+  visit_labels(label_type_, labels_.data(), [&](auto* p) {
+    using T = std::remove_pointer_t<decltype(p)>;
+    const T value = static_cast<T>(label);
+    for (int k = box.lo[2]; k < box.hi[2]; ++k) {
+      for (int j = box.lo[1]; j < box.hi[1]; ++j) {
+        T* row = p + linear_index(0, j, k);
+        for (int i = box.lo[0]; i < box.hi[0]; ++i) {
+          changed += row[i] != value;
+          row[i] = value;
+        }
+      }
+    }
+  });
+  VolumeEdit edit;
+  edit.kind = "set_region";
+  edit.box = box;
+  edit.changed = changed;
+  if (!box.empty()) record(std::move(edit));
+  return changed;
+}
+
+void VolumeData::mark_dirty(const VoxelBox& box) {
+  VolumeEdit edit;
+  edit.kind = "mark_dirty";
+  edit.box = box.clipped(shape_);
+  if (!edit.box.empty()) record(std::move(edit));
+}
+
+void VolumeData::reset() {
+  // Only the voxels that differ are rewritten, and only their box is marked.
+  VoxelBox changed;
+  std::int64_t count = 0;
+  const std::size_t bytes = label_bytes(label_type_);
+  for (int k = 0; k < shape_[2]; ++k) {
+    for (int j = 0; j < shape_[1]; ++j) {
+      const std::size_t row = linear_index(0, j, k) * bytes;
+      const std::size_t len = static_cast<std::size_t>(shape_[0]) * bytes;
+      if (std::memcmp(&labels_[row], &original_[row], len) == 0) continue;
+      int first = shape_[0], last = -1;
+      for (int i = 0; i < shape_[0]; ++i) {
+        if (std::memcmp(&labels_[row + i * bytes], &original_[row + i * bytes], bytes) != 0) {
+          first = std::min(first, i);
+          last = i;
+          ++count;
+        }
+      }
+      std::memcpy(&labels_[row], &original_[row], len);
+      changed = changed.united(VoxelBox{{first, j, k}, {last + 1, j + 1, k + 1}});
+    }
+  }
+  VolumeEdit edit;
+  edit.kind = "reset";
+  edit.box = changed;
+  edit.changed = count;
+  record(std::move(edit));
+}
+
+void VolumeData::commit() { original_ = labels_; }
+
+bool VolumeData::dirty_since(std::int64_t since, VoxelBox* box) const {
+  if (since >= revision_) return false;
+  if (since < dirty_floor_) {
+    *box = VoxelBox{{0, 0, 0}, shape_};
+    return true;
+  }
+  VoxelBox u;
+  for (auto it = dirty_.rbegin(); it != dirty_.rend() && it->first > since; ++it) {
+    u = u.united(it->second);
+  }
+  *box = u;
+  return true;
+}
+
+std::deque<VolumeEdit> VolumeData::take_edit_log() {
+  std::deque<VolumeEdit> out;
+  out.swap(edit_log_);
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Derived fields
+
+std::array<int, 3> VolumeData::brick_shape() const {
+  return {(shape_[0] + kBrickSize - 1) / kBrickSize, (shape_[1] + kBrickSize - 1) / kBrickSize,
+          (shape_[2] + kBrickSize - 1) / kBrickSize};
+}
+
+const std::vector<std::uint8_t>& VolumeData::smoothed_occupancy() {
+  update_derived();
+  return smoothed_;
+}
+
+const std::vector<std::uint8_t>& VolumeData::brick_max() {
+  update_derived();
+  return bricks_;
+}
+
+void VolumeData::update_derived() {
+  if (derived_revision_ == revision_) return;
+  VoxelBox box;
+  if (derived_revision_ < 0) {
+    smoothed_.assign(static_cast<std::size_t>(voxel_count()), 0);
+    const auto b = brick_shape();
+    bricks_.assign(static_cast<std::size_t>(b[0]) * b[1] * b[2], 0);
+    box = VoxelBox{{0, 0, 0}, shape_};
+  } else if (!dirty_since(derived_revision_, &box)) {
+    derived_revision_ = revision_;
+    return;
+  }
+  // A label change reaches the blurred field kSmoothRadius voxels around it.
+  const VoxelBox affected = box.grown(kSmoothRadius).clipped(shape_);
+  smooth_box(affected);
+  update_bricks(affected);
+  derived_revision_ = revision_;
+}
+
+void VolumeData::smooth_box(const VoxelBox& r) {
+  if (r.empty()) return;
+  constexpr int R = kSmoothRadius;
+  constexpr int kWeights[2 * R + 1] = {1, 4, 6, 4, 1};  // binomial: sums to 16 per axis
+  const int w = r.hi[0] - r.lo[0], h = r.hi[1] - r.lo[1];
+  // One k-slice of occupancy blurred along i and j, for (i, j) in r: rows of w, h rows.
+  std::vector<std::uint16_t> along_i(static_cast<std::size_t>(w) * (h + 2 * R));
+  auto blurred_slice = [&](int k, std::vector<std::uint16_t>& out) {
+    out.assign(static_cast<std::size_t>(w) * h, 0);
+    if (k < 0 || k >= shape_[2]) return;
+    std::fill(along_i.begin(), along_i.end(), 0);
+    visit_labels(label_type_, labels_.data(), [&](auto* p) {
+      for (int jj = 0; jj < h + 2 * R; ++jj) {
+        const int j = r.lo[1] - R + jj;
+        if (j < 0 || j >= shape_[1]) continue;
+        const auto* row = p + linear_index(0, j, k);
+        std::uint16_t* dst = &along_i[static_cast<std::size_t>(jj) * w];
+        for (int ii = 0; ii < w; ++ii) {
+          const int i = r.lo[0] + ii;
+          int sum = 0;
+          for (int t = -R; t <= R; ++t) {
+            const int x = i + t;
+            if (x >= 0 && x < shape_[0] && row[x] != 0) sum += kWeights[t + R];
+          }
+          dst[ii] = static_cast<std::uint16_t>(sum);
+        }
+      }
+    });
+    for (int jj = 0; jj < h; ++jj) {
+      std::uint16_t* dst = &out[static_cast<std::size_t>(jj) * w];
+      for (int t = 0; t <= 2 * R; ++t) {
+        const std::uint16_t* src = &along_i[static_cast<std::size_t>(jj + t) * w];
+        for (int ii = 0; ii < w; ++ii)
+          dst[ii] = static_cast<std::uint16_t>(dst[ii] + kWeights[t] * src[ii]);
+      }
+    }
+  };
+  // A window of 2R + 1 blurred slices around k.
+  std::vector<std::vector<std::uint16_t>> window(2 * R + 1);
+  for (int t = 0; t < 2 * R; ++t) blurred_slice(r.lo[2] - R + t, window[t + 1]);
+  for (int k = r.lo[2]; k < r.hi[2]; ++k) {
+    std::rotate(window.begin(), window.begin() + 1, window.end());
+    blurred_slice(k + R, window.back());
+    for (int jj = 0; jj < h; ++jj) {
+      std::uint8_t* dst = &smoothed_[linear_index(r.lo[0], r.lo[1] + jj, k)];
+      const std::size_t o = static_cast<std::size_t>(jj) * w;
+      for (int ii = 0; ii < w; ++ii) {
+        int sum = 0;  // 0..4096
+        for (int t = 0; t <= 2 * R; ++t) sum += kWeights[t] * window[t][o + ii];
+        dst[ii] = static_cast<std::uint8_t>((sum * 255 + 2048) / 4096);
+      }
+    }
+  }
+}
+
+void VolumeData::update_bricks(const VoxelBox& changed) {
+  const auto bs = brick_shape();
+  constexpr int B = kBrickSize;
+  // Bricks whose sampling footprint [b*B - 1, (b+1)*B + 1) meets the changed voxels.
+  std::array<int, 3> lo, hi;
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = std::max(0, (changed.lo[a] - 1) / B);
+    hi[a] = std::min(bs[a], (changed.hi[a] + 1) / B + 1);
+  }
+  for (int bk = lo[2]; bk < hi[2]; ++bk) {
+    for (int bj = lo[1]; bj < hi[1]; ++bj) {
+      for (int bi = lo[0]; bi < hi[0]; ++bi) {
+        const VoxelBox foot = VoxelBox{
+            {bi * B - 1, bj * B - 1, bk * B - 1},
+            {(bi + 1) * B + 1, (bj + 1) * B + 1,
+             (bk + 1) * B + 1}}.clipped(shape_);
+        std::uint8_t m = 0;
+        for (int k = foot.lo[2]; k < foot.hi[2] && m < 255; ++k) {
+          for (int j = foot.lo[1]; j < foot.hi[1]; ++j) {
+            const std::uint8_t* row = &smoothed_[linear_index(0, j, k)];
+            for (int i = foot.lo[0]; i < foot.hi[0]; ++i) m = std::max(m, row[i]);
+          }
+        }
+        bricks_[static_cast<std::size_t>(bi) +
+                static_cast<std::size_t>(bs[0]) * (bj + static_cast<std::size_t>(bs[1]) * bk)] = m;
+      }
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// CPU ray cast (the reference the GPU ray caster is tested against)
+
+VolumeHit VolumeData::raycast(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                              double iso, double max_distance) {
+  update_derived();
+  VolumeHit result;
+  const double norm = direction.norm();
+  if (!(norm > 0.0)) throw std::invalid_argument("raycast needs a non-zero direction");
+  const Eigen::Vector3d d = direction / norm;
+  const Eigen::Vector3d s = voxel_size();
+  const Eigen::Vector3d u0 = to_voxel_units(origin);
+  const Eigen::Vector3d du = d.cwiseQuotient(s);  // voxel units per metre along the ray
+  // Enter and leave the grid box [0, n].
+  double t0 = 0.0, t1 = max_distance;
+  for (int a = 0; a < 3; ++a) {
+    if (std::abs(du[a]) < 1e-300) {
+      if (u0[a] < 0 || u0[a] > shape_[a]) return result;
+      continue;
+    }
+    double ta = (0 - u0[a]) / du[a], tb = (shape_[a] - u0[a]) / du[a];
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+  }
+  if (t0 > t1) return result;
+  const VolumeField field{smoothed_.data(), shape_};
+  const double level = iso * 255.0;
+  // Samples on the lattice t0 + m * dt, half a voxel apart, as the GPU ray caster takes them.
+  const double dt = 0.5 / du.norm();
+  const std::int64_t last = static_cast<std::int64_t>(std::floor((t1 - t0) / dt));
+  for (std::int64_t m = 0; m <= last; ++m) {
+    const double t = t0 + static_cast<double>(m) * dt;
+    if (field.sample(u0 + t * du) < level) continue;
+    double lo = t0 + static_cast<double>(m - 1) * dt, hi = t;
+    for (int it = 0; it < 4 && m > 0; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      (field.sample(u0 + mid * du) >= level ? hi : lo) = mid;
+    }
+    const Eigen::Vector3d u = u0 + hi * du;
+    result.hit = true;
+    result.t = hi;
+    result.position = from_voxel_units(u);
+    const Eigen::Vector3d g = field.gradient(u, kNormalSpan);
+    const Eigen::Vector3d n = (-g).cwiseQuotient(s);
+    result.normal = n.norm() > 0 ? n.normalized() : Eigen::Vector3d(-d);
+    result.label = visit_labels(label_type_, labels_.data(), [&](auto* p) -> std::uint16_t {
+      // As the shader: the voxel a quarter voxel further in, else the dominant solid neighbour.
+      const Eigen::Vector3d in = u + 0.25 * du / du.norm();
+      const int i = static_cast<int>(std::floor(in.x())), j = static_cast<int>(std::floor(in.y())),
+                k = static_cast<int>(std::floor(in.z()));
+      if (i >= 0 && j >= 0 && k >= 0 && i < shape_[0] && j < shape_[1] && k < shape_[2]) {
+        const std::uint16_t l = p[linear_index(i, j, k)];
+        if (l != 0) return l;
+      }
+      return dominant_label(p, shape_, u);
+    });
+    return result;
+  }
+  return result;
+}
+
+}  // namespace ambfplus

@@ -1,0 +1,177 @@
+#version 450 core
+// Ray casting of a segmented volume's iso-surface, in voxel units (voxel (i, j, k) spans
+// [i, i+1) x [j, j+1) x [k, k+1), its centre at + 0.5).
+//
+// The surface is the iso level of the smoothed occupancy (trilinear). Rays skip bricks that
+// cannot reach the level (a distance map at brick resolution says how far), march every half
+// voxel inside the others, and refine a crossing by bisection. The label is that of the solid
+// voxel with the largest trilinear weight at the hit, the normal the field's negative gradient.
+// VolumeData::raycast on the CPU is the same algorithm without the skipping.
+
+#include "lighting.glsl"
+
+#ifndef NORMAL_SPAN
+#define NORMAL_SPAN 1.2  // VolumeData::kNormalSpan
+#endif
+#ifndef EMPTY_SPACE_SKIPPING
+#define EMPTY_SPACE_SKIPPING 1
+#endif
+
+in vec3 v_voxel;
+
+uniform vec3 u_shape;
+uniform vec3 u_eye;                // camera position, voxel units
+uniform mat4 u_clip_from_voxel;
+uniform mat4 u_camera_from_voxel;
+uniform mat3 u_normal_from_voxel;  // camera-frame normals from voxel-unit gradients
+uniform float u_level;             // iso level of the smoothed occupancy, 0..1
+uniform sampler3D u_occupancy;     // smoothed occupancy, linear filtering, zero border
+uniform usampler3D u_labels;       // label ids
+uniform usampler3D u_bricks;       // Chebyshev distance, in bricks, to the nearest brick that
+                                   // can reach the level (0 = this one can)
+uniform sampler2D u_colors;        // label id -> colour, 256 per row
+uniform int u_brick_size;
+
+layout(location = 0) out vec4 o_color;
+layout(location = 1) out float o_depth;
+layout(location = 2) out uint o_label;
+
+vec3 inv_shape;
+float field(vec3 u) { return texture(u_occupancy, u * inv_shape).r; }
+
+// Distance along the ray to leave the box [lo, hi] it is inside.
+float exit_distance(vec3 eye, vec3 inv_dir, vec3 lo, vec3 hi) {
+  vec3 a = (lo - eye) * inv_dir;
+  vec3 b = (hi - eye) * inv_dir;
+  vec3 far_t = max(a, b);
+  return min(min(far_t.x, far_t.y), far_t.z);
+}
+
+uint label_at(ivec3 v) {
+  if (any(lessThan(v, ivec3(0))) || any(greaterThanEqual(v, ivec3(u_shape)))) return 0u;
+  return texelFetch(u_labels, v, 0).r;
+}
+
+uint dominant_label(vec3 u) {
+  vec3 c = u - 0.5;
+  ivec3 base = ivec3(floor(c));
+  vec3 f = c - vec3(base);
+  uint best = 0u;
+  float best_w = -1.0;
+  for (int corner = 0; corner < 8; ++corner) {
+    ivec3 d = ivec3(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
+    uint l = label_at(base + d);
+    if (l == 0u) continue;
+    vec3 w3 = mix(1.0 - f, f, vec3(d));
+    float w = w3.x * w3.y * w3.z;
+    if (w > best_w) {
+      best_w = w;
+      best = l;
+    }
+  }
+  return best;
+}
+
+void main() {
+  inv_shape = 1.0 / u_shape;
+  vec3 dir = normalize(v_voxel - u_eye);
+  vec3 inv_dir = 1.0 / dir;
+  vec3 a = (vec3(0.0) - u_eye) * inv_dir;
+  vec3 b = (u_shape - u_eye) * inv_dir;
+  vec3 near_t = min(a, b);
+  vec3 far_t = max(a, b);
+  float t_enter = max(max(near_t.x, near_t.y), max(near_t.z, 0.0));
+  float t_exit = min(min(far_t.x, far_t.y), far_t.z);
+
+  // Samples sit on one lattice, t = t_enter + m * dt, with or without skipping.
+  const float dt = 0.5;
+  int m = 0;
+  int m_below = 0;  // the last sample known to be below the level
+  bool hit = false;
+  int budget = int(4.0 * (u_shape.x + u_shape.y + u_shape.z)) + 16;
+  float t = t_enter;
+#if EMPTY_SPACE_SKIPPING
+  ivec3 brick_shape = textureSize(u_bricks, 0);
+  float bs = float(u_brick_size);
+  while (!hit && t <= t_exit && budget > 0) {
+    vec3 p = u_eye + t * dir;
+    ivec3 brick = clamp(ivec3(floor(p / bs)), ivec3(0), brick_shape - 1);
+    uint dist = texelFetch(u_bricks, brick, 0).r;
+    --budget;
+    if (dist > 0u) {
+      // Every brick within dist - 1 of this one is empty: leave that cube in one jump.
+      vec3 lo = vec3(brick - ivec3(dist - 1u)) * bs;
+      vec3 hi = vec3(brick + ivec3(dist)) * bs;
+      float t_jump = exit_distance(u_eye, inv_dir, lo, hi);
+      m_below = max(m, int(floor((t_jump - t_enter) / dt)));
+      m = m_below + 1;
+      t = t_enter + float(m) * dt;
+      continue;
+    }
+    float t_brick = min(exit_distance(u_eye, inv_dir, vec3(brick) * bs, vec3(brick + 1) * bs),
+                        t_exit);
+    // At least one sample per visit, so rounding at a brick face cannot stall the ray.
+    do {
+      if (field(u_eye + t * dir) >= u_level) {
+        hit = true;
+        break;
+      }
+      m_below = m;
+      ++m;
+      t = t_enter + float(m) * dt;
+      --budget;
+    } while (t <= t_brick && budget > 0);
+  }
+#else
+  for (; t <= t_exit && budget > 0; --budget) {
+    if (field(u_eye + t * dir) >= u_level) {
+      hit = true;
+      break;
+    }
+    m_below = m;
+    ++m;
+    t = t_enter + float(m) * dt;
+  }
+#endif
+#ifdef DEBUG_STEPS
+  o_color = vec4(0.0);
+  o_depth = float(int(4.0 * (u_shape.x + u_shape.y + u_shape.z)) + 16 - budget);
+  gl_FragDepth = 0.5;
+  return;
+#endif
+  if (!hit) discard;
+
+  if (m > 0) {
+    float lo = t_enter + float(m_below) * dt, hi = t;
+    for (int i = 0; i < 4; ++i) {
+      float mid = 0.5 * (lo + hi);
+      if (field(u_eye + mid * dir) >= u_level) {
+        hi = mid;
+      } else {
+        lo = mid;
+      }
+    }
+    t = hi;
+  }
+  vec3 u = u_eye + t * dir;
+
+  // The gradient from the four corners of a tetrahedron around the hit.
+  const float h = NORMAL_SPAN;
+  float a0 = field(u + h * vec3(1, 1, 1)), a1 = field(u + h * vec3(1, -1, -1));
+  float a2 = field(u + h * vec3(-1, 1, -1)), a3 = field(u + h * vec3(-1, -1, 1));
+  vec3 g = vec3(a0 + a1 - a2 - a3, a0 - a1 + a2 - a3, a0 - a1 - a2 + a3);
+  vec3 n = normalize(u_normal_from_voxel * -g);
+  vec4 camera = u_camera_from_voxel * vec4(u, 1.0);
+  vec4 clip = u_clip_from_voxel * vec4(u, 1.0);
+  if (dot(n, camera.xyz) > 0.0) n = -n;  // grazing hits: light the side the camera sees
+
+  // The voxel half a step further in is solid almost always; thin features fall back to the
+  // solid neighbour with the largest trilinear weight.
+  uint label = label_at(ivec3(floor(u + 0.25 * dir)));
+  if (label == 0u) label = dominant_label(u);
+  vec3 base = texelFetch(u_colors, ivec2(int(label & 255u), int(label >> 8)), 0).rgb;
+  o_color = vec4(lit(base, n, camera.xyz), 1.0);
+  o_depth = camera.z;
+  o_label = label;
+  gl_FragDepth = clip.z / clip.w;
+}

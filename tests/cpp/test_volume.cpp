@@ -1,0 +1,103 @@
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "ambfplus/volume/volume_data.h"
+#include "render/volume_renderer.h"
+#include "volume/grid_access.h"
+
+namespace ambfplus {
+namespace {
+
+LabelTable bone() { return LabelTable({Label{1, "Bone", {200, 200, 200}, true, false}}); }
+
+TEST(VoxelBox, UnionClipGrow) {
+  const VoxelBox a{{0, 0, 0}, {2, 2, 2}}, b{{5, 1, 1}, {6, 3, 4}};
+  EXPECT_EQ(a.united(b), (VoxelBox{{0, 0, 0}, {6, 3, 4}}));
+  EXPECT_EQ(VoxelBox().united(b), b);
+  EXPECT_EQ(b.grown(2).clipped({6, 6, 6}), (VoxelBox{{3, 0, 0}, {6, 5, 6}}));
+  EXPECT_EQ(a.count(), 8);
+  EXPECT_TRUE((VoxelBox{{1, 1, 1}, {1, 5, 5}}).empty());
+}
+
+// A flat boundary between solid (i < 8) and empty voxels: the smoothed field crosses 0.5 exactly
+// on the boundary plane, and is symmetric about it.
+TEST(SmoothedOccupancy, FlatBoundarySitsOnTheVoxelFace) {
+  VolumeData v({16, 6, 6}, Eigen::Vector3d(0.016, 0.006, 0.006), LabelType::kUInt8, bone());
+  v.set_region(VoxelBox{{0, 0, 0}, {8, 6, 6}}, 1);
+  const VolumeField f{v.smoothed_occupancy().data(), v.shape()};
+  EXPECT_NEAR(f.sample(Eigen::Vector3d(8.0, 3.0, 3.0)), 127.5, 1.0);
+  for (double d : {0.3, 0.7, 1.2, 2.0}) {
+    const double in = f.sample(Eigen::Vector3d(8.0 - d, 3.0, 3.0));
+    const double out = f.sample(Eigen::Vector3d(8.0 + d, 3.0, 3.0));
+    EXPECT_NEAR(in + out, 255.0, 1.5) << d;
+    EXPECT_GT(in, out);
+  }
+}
+
+// Incremental updates of the derived fields equal recomputing them from scratch.
+TEST(SmoothedOccupancy, IncrementalEqualsFromScratch) {
+  std::mt19937 rng(3);
+  VolumeData v({24, 20, 18}, Eigen::Vector3d::Constant(0.02), LabelType::kUInt8, bone());
+  auto* labels = static_cast<std::uint8_t*>(v.label_data());
+  for (std::int64_t n = 0; n < v.voxel_count(); ++n) labels[n] = rng() % 3 == 0;
+  v.mark_dirty(VoxelBox{{0, 0, 0}, v.shape()});
+  (void)v.brick_max();
+  v.remove_sphere(Eigen::Vector3d(0.001, -0.002, 0.0), 0.004);
+  v.set_region(VoxelBox{{2, 3, 4}, {5, 9, 6}}, 1);
+  const auto smoothed = v.smoothed_occupancy();
+  const auto bricks = v.brick_max();
+  VolumeData fresh({24, 20, 18}, Eigen::Vector3d::Constant(0.02), LabelType::kUInt8, bone());
+  std::copy(labels, labels + v.voxel_count(), static_cast<std::uint8_t*>(fresh.label_data()));
+  EXPECT_EQ(fresh.smoothed_occupancy(), smoothed);
+  EXPECT_EQ(fresh.brick_max(), bricks);
+}
+
+TEST(VolumeData, DirtySinceUnitesLaterEdits) {
+  VolumeData v({10, 10, 10}, Eigen::Vector3d::Constant(0.01), LabelType::kUInt8, bone());
+  const std::int64_t r0 = v.revision();
+  VoxelBox box;
+  EXPECT_FALSE(v.dirty_since(r0, &box));
+  v.mark_dirty(VoxelBox{{1, 1, 1}, {2, 2, 2}});
+  const std::int64_t r1 = v.revision();
+  v.mark_dirty(VoxelBox{{5, 5, 5}, {7, 6, 6}});
+  ASSERT_TRUE(v.dirty_since(r0, &box));
+  EXPECT_EQ(box, (VoxelBox{{1, 1, 1}, {7, 6, 6}}));
+  ASSERT_TRUE(v.dirty_since(r1, &box));
+  EXPECT_EQ(box, (VoxelBox{{5, 5, 5}, {7, 6, 6}}));
+}
+
+// The two-pass distance map equals a brute-force Chebyshev distance to the nearest occupied brick.
+TEST(BrickDistances, MatchBruteForce) {
+  const std::array<int, 3> n = {9, 7, 11};
+  std::mt19937 rng(5);
+  std::vector<std::uint8_t> max(9 * 7 * 11, 0);
+  for (auto& m : max) m = rng() % 40 == 0 ? 200 : 10;
+  const auto d = render::brick_distances(max, n, 127);
+  for (int k = 0; k < n[2]; ++k)
+    for (int j = 0; j < n[1]; ++j)
+      for (int i = 0; i < n[0]; ++i) {
+        int best = 255;
+        for (int c = 0; c < n[2]; ++c)
+          for (int b = 0; b < n[1]; ++b)
+            for (int a = 0; a < n[0]; ++a) {
+              if (max[a + n[0] * (b + n[1] * c)] < 127) continue;
+              best = std::min(best, std::max({std::abs(a - i), std::abs(b - j), std::abs(c - k)}));
+            }
+        ASSERT_EQ(d[i + n[0] * (j + n[1] * k)], best) << i << "," << j << "," << k;
+      }
+}
+
+TEST(VolumeData, RaycastHitsAFlatFaceAtItsPlane) {
+  VolumeData v({20, 20, 20}, Eigen::Vector3d::Constant(0.02), LabelType::kUInt8, bone());
+  v.set_region(VoxelBox{{0, 0, 0}, {20, 20, 10}}, 1);  // solid below z = 0
+  const VolumeHit hit = v.raycast(Eigen::Vector3d(0.001, 0.002, 0.05), Eigen::Vector3d(0.1, 0, -1));
+  ASSERT_TRUE(hit.hit);
+  EXPECT_NEAR(hit.position.z(), 0.0, 0.0001);
+  EXPECT_TRUE(hit.normal.isApprox(Eigen::Vector3d::UnitZ(), 1e-3));
+  EXPECT_EQ(hit.label, 1);
+  EXPECT_FALSE(v.raycast(Eigen::Vector3d(0, 0, 0.05), Eigen::Vector3d(1, 0, 0)).hit);
+}
+
+}  // namespace
+}  // namespace ambfplus

@@ -15,10 +15,16 @@ void register_scene(pybind11::module_& m);
 }  // namespace ambfplus::bindings
 
 #include <array>
+#include <memory>
 #include <optional>
+#include <string>
 
 namespace ambfplus {
 class Camera;
+class Drill;
+class Model;
+class Object;
+class Volume;
 class VolumeData;
 struct VolumeHit;
 struct VoxelBox;
@@ -29,6 +35,13 @@ namespace ambfplus::bindings {
 /// Camera.capture(out=None): renders with the GIL released. out may be None (a new Frame), a Frame
 /// (refilled in place) or a dict of preallocated arrays {"rgb": ..., "depth": ...}.
 pybind11::object capture(Camera& camera, pybind11::object out);
+
+/// add_drill(name, volume, **options) for World and Model.
+Drill& add_drill(Model& model, const std::string& name, Volume& volume, const pybind11::kwargs& kw);
+
+/// The Drill class's methods (the class itself is declared with the scene's).
+void register_haptics(pybind11::module_& m,
+                      pybind11::class_<Drill, Object, std::shared_ptr<Drill>>& drill);
 
 /// A ray hit as dict(distance, position, normal, label), or None when it missed.
 pybind11::object hit_dict(const VolumeHit& hit);

@@ -38,6 +38,8 @@ py::object to_python(Object* o) {
       return py::cast(handle(static_cast<Light*>(o), w));
     case ObjectKind::kVolume:
       return py::cast(handle(static_cast<Volume*>(o), w));
+    case ObjectKind::kDrill:
+      return py::cast(handle(static_cast<Drill*>(o), w));
   }
   return py::cast(handle(o, w));
 }
@@ -250,7 +252,19 @@ void def_adders(Class& cls, GetModel get_model) {
           py::arg("name"), py::arg("data"), py::kw_only(), py::arg("pose") = py::none(),
           py::arg("iso") = 0.5, py::arg("quality") = 0.5, py::arg("optical_density") = 1.0,
           "Places volume data in the world; pose is world from the volume frame (centred on the "
-          "grid). Several volumes may share one VolumeData.");
+          "grid). Several volumes may share one VolumeData.")
+      .def(
+          "add_drill",
+          [get_model](typename Class::type& self, const std::string& name, Volume& volume,
+                      const py::kwargs& kw) {
+            Model& model = get_model(self);
+            return handle(&add_drill(model, name, volume, kw), model.world());
+          },
+          py::arg("name"), py::arg("volume"),
+          "Adds a drill working on `volume`. Options: burr_diameters (m), burr (index), cursors, "
+          "spacing, shaft_radii, stiffness (N/m), damping, max_force, soft_start, "
+          "static_friction, dynamic_friction, removal ('physical' or 'compatible'), "
+          "cutting_rate (m^3/(s N)), voxels_per_step, pose (initial goal, 4x4).");
 }
 
 std::string repr_object(const Object& o) {
@@ -278,6 +292,9 @@ void register_scene(py::module_& m) {
       m, "Light", "A directional, point or spot light shining along its +z axis.");
   py::class_<Volume, Object, std::shared_ptr<Volume>> volume(
       m, "Volume", "Segmented volume data placed in a world, rendered by ray casting.");
+  py::class_<Drill, Object, std::shared_ptr<Drill>> drill(
+      m, "Drill", "A burr and shaft of finger-proxy cursors that drills a volume.");
+  register_haptics(m, drill);
 
   simulator
       .def(py::init([](double time_step, const std::string& world_name) {
@@ -356,6 +373,8 @@ void register_scene(py::module_& m) {
                              [](World& w) { return to_python_list(w.objects_of_kind<Light>()); })
       .def_property_readonly("volumes",
                              [](World& w) { return to_python_list(w.objects_of_kind<Volume>()); })
+      .def_property_readonly("drills",
+                             [](World& w) { return to_python_list(w.objects_of_kind<Drill>()); })
       .def(
           "load_volumes",
           [](World& w, const std::filesystem::path& path,

@@ -188,6 +188,92 @@ def volume(args) -> Iterator[dict]:
     }
 
 
+def drilling_run(data, seconds: float, ticks: int):
+    """The 6 mm burr pressed 0.5 mm into the phantom's lateral face and swept 6 mm sideways in
+    `seconds`, drilling, with 8 cursors. Returns the world, the drill and the last ticks' CPU and
+    wall times (us)."""
+    world = ambfplus.World()
+    volume = world.add_volume("anatomy", data)
+    shaft = ambfplus.rotation_between((1, 0, 0), (0.2, 0.1, 1.0))  # shaft up, tilted
+    start = ambfplus.make_pose((0.0, 0.0, 0.02), rotation=shaft)
+    drill = world.add_drill("drill", volume, burr=3, cursors=8, pose=start)
+    surface = volume.raycast((0.0, 0.0, 0.03), (0.0, 0.0, -1.0))["position"]
+    depth = drill.burr_radius - 0.0005
+    drill.on = True
+    drill.set_waypoints(
+        [
+            {
+                "time": 0.05,
+                "pose": ambfplus.make_pose(surface + (0, 0, depth), rotation=shaft),
+                "on": True,
+            },
+            {
+                "time": 0.05 + seconds,
+                "pose": ambfplus.make_pose(surface + (0.006, 0.002, depth), rotation=shaft),
+                "on": True,
+            },
+        ]
+    )
+    world.step(60 + ticks)
+    cpu = np.asarray(drill.tick_cpu_seconds)[-ticks:] * 1e6
+    wall = np.asarray(drill.tick_seconds)[-ticks:] * 1e6
+    return world, drill, cpu, wall
+
+
+@benchmark
+def haptics(args) -> Iterator[dict]:
+    """The drill at 512^3 (the phantom, 0.094 mm voxels), 8 cursors, the 6 mm burr in contact and
+    drilling: tick time (the thread's CPU time, robust on a busy shared machine) at a moderate
+    (1.5 mm/s) and a fast (6 mm/s) sweep; the collision query against the original's full-cube
+    scan; how many voxels a tick can remove within 1 ms."""
+    data = ambfplus.phantom(512)
+    ticks = 400 if args.quick else 1500
+    for name, seconds in (("1.5mm_s", 4.0), ("6mm_s", 1.0)):
+        world, drill, cpu, wall = drilling_run(data, seconds, min(ticks, int(seconds * 1000)))
+        yield {
+            "bench": f"haptic_tick_512_{name}",
+            "value": round(float(np.median(cpu)), 1),
+            "unit": "us (thread CPU)",
+            "target": 250,
+            "p99_us": round(float(np.percentile(cpu, 99)), 1),
+            "p99_target": 500,
+            "max_us": round(float(cpu.max()), 1),
+            "wall_median_us": round(float(np.median(wall)), 1),
+            "wall_p99_us": round(float(np.percentile(wall, 99)), 1),
+            "voxels_removed": len(drill.removed["step"]),
+            "what": f"8 cursors, 6 mm burr pressed 0.5 mm, sweeping at {name.replace('_', '/')}",
+        }
+    query = _core._benchmark_collision(drill, 0, 20 if args.quick else 100)
+    yield {
+        "bench": "haptic_query_512_gather",
+        "value": round(query["gather_seconds"] * 1e6, 2),
+        "unit": "us",
+        "baseline": round(query["full_cube_seconds"] * 1e6, 2),
+        "ratio": round(query["gather_seconds"] / query["full_cube_seconds"], 4),
+        "speedup": round(query["full_cube_seconds"] / query["gather_seconds"], 1),
+        "target_speedup": 5,
+        "gather_voxels": query["gather_voxels"],
+        "full_cube_voxels": query["full_cube_voxels"],
+        "same_hit": query["same_hit"],
+        "what": "tip sweep: surface voxels of nearby bricks vs the full cube (original)",
+    }
+    # Removal capacity: what removing voxels costs (collider bitmaps, volume, edit log), and so
+    # how many fit in a 1 ms tick beside the median tick's other work.
+    removal = _core._benchmark_removal(drill, 2000)
+    per_voxel_us = removal["seconds"] * 1e6 / max(removal["voxels"], 1)
+    spare_us = 1000.0 - float(np.median(cpu))
+    yield {
+        "bench": "haptic_removal_capacity_512",
+        "value": round(spare_us / per_voxel_us),
+        "unit": "voxels/tick",
+        "target": 200,
+        "per_voxel_us": round(per_voxel_us, 3),
+        "measured_voxels": removal["voxels"],
+        "budget_us": 1000,
+        "what": "voxels a 1 ms tick can remove besides the median fast tick's cursor work",
+    }
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--only", choices=sorted(BENCHMARKS), help="run one benchmark")

@@ -48,4 +48,9 @@ Volume& Model::add_volume(const VolumeSpec& spec) {
   return adopt(std::unique_ptr<Volume>(new Volume(*this, spec, id)));
 }
 
+Drill& Model::add_drill(const DrillSpec& spec) {
+  const int id = world_->claim_name(spec.name, "drill");
+  return adopt(std::unique_ptr<Drill>(new Drill(*this, spec, id)));
+}
+
 }  // namespace ambfplus

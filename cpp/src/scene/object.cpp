@@ -18,6 +18,8 @@ const char* object_kind_name(ObjectKind kind) {
       return "light";
     case ObjectKind::kVolume:
       return "volume";
+    case ObjectKind::kDrill:
+      return "drill";
   }
   return "object";
 }

@@ -54,7 +54,15 @@ void World::register_object(Object* object) {
 
 void World::step(std::int64_t n) {
   if (n < 0) throw std::invalid_argument("step count must be >= 0, got " + std::to_string(n));
-  step_index_ += n;
+  const std::vector<Drill*> drills = objects_of_kind<Drill>();
+  if (drills.empty()) {
+    step_index_ += n;
+    return;
+  }
+  for (std::int64_t s = 0; s < n; ++s) {
+    ++step_index_;
+    for (Drill* d : drills) d->tick(time_step_, step_index_);
+  }
 }
 
 render::SceneRenderer& World::renderer() {

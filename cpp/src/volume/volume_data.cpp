@@ -103,13 +103,6 @@ void VolumeData::set_label_table(LabelTable table) {
   table_ = std::move(table);
 }
 
-std::uint16_t VolumeData::label(int i, int j, int k) const {
-  const std::size_t n = linear_index(i, j, k);
-  return label_type_ == LabelType::kUInt8
-             ? labels_[n]
-             : reinterpret_cast<const std::uint16_t*>(labels_.data())[n];
-}
-
 void VolumeData::set_intensity_type(IntensityType type) {
   intensity_type_ = type;
   const std::size_t bytes = type == IntensityType::kNone    ? 0
@@ -194,6 +187,32 @@ std::int64_t VolumeData::remove_sphere(const Eigen::Vector3d& center, double rad
   edit.box = changed;
   if (count > 0) record(std::move(edit));
   return count;
+}
+
+std::vector<std::uint16_t> VolumeData::remove_voxels(const std::vector<std::array<int, 3>>& voxels,
+                                                     const std::string& kind) {
+  std::vector<std::uint16_t> old(voxels.size(), 0);
+  VolumeEdit edit;
+  edit.kind = kind;
+  visit_labels(label_type_, labels_.data(), [&](auto* p) {
+    for (std::size_t n = 0; n < voxels.size(); ++n) {
+      const auto& v = voxels[n];
+      if (v[0] < 0 || v[1] < 0 || v[2] < 0 || v[0] >= shape_[0] || v[1] >= shape_[1] ||
+          v[2] >= shape_[2]) {
+        throw std::invalid_argument("remove_voxels: voxel outside the grid");
+      }
+      auto& l = p[linear_index(v[0], v[1], v[2])];
+      old[n] = l;
+      if (l == 0) continue;
+      edit.voxels.push_back(v);
+      edit.old_labels.push_back(l);
+      l = 0;
+      edit.box = edit.box.united(VoxelBox{v, {v[0] + 1, v[1] + 1, v[2] + 1}});
+    }
+  });
+  edit.changed = static_cast<std::int64_t>(edit.voxels.size());
+  if (edit.changed > 0) record(std::move(edit));
+  return old;
 }
 
 std::int64_t VolumeData::set_region(const VoxelBox& region, std::uint16_t label) {

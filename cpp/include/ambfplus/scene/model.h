@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "ambfplus/export.h"
+#include "ambfplus/haptics/drill.h"
 #include "ambfplus/scene/camera.h"
 #include "ambfplus/scene/light.h"
 #include "ambfplus/scene/rigid_body.h"
@@ -36,6 +37,8 @@ class AMBFPLUS_API Model {
   Light& add_light(const LightSpec& spec);
   /// Places a volume. Throws std::invalid_argument for a bad spec or a taken name.
   Volume& add_volume(const VolumeSpec& spec);
+  /// Creates a drill working on a volume of the same world.
+  Drill& add_drill(const DrillSpec& spec);
 
  private:
   friend class World;

@@ -87,7 +87,12 @@ class AMBFPLUS_API VolumeData {
   /// renderers until mark_dirty() names the changed box.
   void* label_data() { return labels_.data(); }
   const void* label_data() const { return labels_.data(); }
-  std::uint16_t label(int i, int j, int k) const;
+  std::uint16_t label(int i, int j, int k) const {
+    const std::size_t n = linear_index(i, j, k);
+    return label_type_ == LabelType::kUInt8
+               ? labels_[n]
+               : reinterpret_cast<const std::uint16_t*>(labels_.data())[n];
+  }
   std::size_t linear_index(int i, int j, int k) const {
     return static_cast<std::size_t>(i) +
            static_cast<std::size_t>(shape_[0]) *
@@ -123,6 +128,10 @@ class AMBFPLUS_API VolumeData {
   /// only_removable, voxels whose label is not removable stay. Returns how many were cleared.
   std::int64_t remove_sphere(const Eigen::Vector3d& center, double radius,
                              bool only_removable = true);
+  /// Clears the given voxels (one edit of `kind`, logging the voxels that were solid and their
+  /// labels). Returns the labels they had, 0 for those already empty.
+  std::vector<std::uint16_t> remove_voxels(const std::vector<std::array<int, 3>>& voxels,
+                                           const std::string& kind = "drill");
   /// Sets every voxel of the box to label (0 clears). Returns how many changed.
   std::int64_t set_region(const VoxelBox& box, std::uint16_t label);
   /// Declares that the labels in box were changed directly (through the NumPy view).

@@ -1,0 +1,174 @@
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "ambfplus/haptics/proxy.h"
+#include "ambfplus/haptics/voxel_collider.h"
+#include "ambfplus/scene/object.h"
+
+namespace ambfplus {
+
+class CriticalDistances;
+class RigidBody;
+class Volume;
+
+/// How the burr removes tissue.
+enum class RemovalMode {
+  /// Volume per second = cutting_rate x speed x normal force / label hardness, independent of
+  /// the step and the voxel size (whole voxels, the remainder carried to the next step).
+  kPhysical,
+  /// The original's rule: a fixed number of voxels per step for each burr (1, 3, 6, 10).
+  kCompatible,
+};
+
+/// Everything needed to create a drill.
+struct AMBFPLUS_API DrillSpec {
+  std::string name;
+  Volume* volume = nullptr;                                        ///< the anatomy it drills
+  std::vector<double> burr_diameters{0.001, 0.002, 0.004, 0.006};  ///< metres
+  int burr = 3;                                                    ///< index into burr_diameters
+  int cursors = 8;                                                 ///< tip + shaft cursors, 1..16
+  double spacing = 0.0015;          ///< metres between cursors along the shaft
+  std::vector<double> shaft_radii;  ///< metres; empty: 0.65 mm, 0.75 mm, ... (as the original)
+  double stiffness = 700.0;         ///< N/m of proxy-goal separation
+  double damping = 0.0;             ///< N s/m against the goal's velocity while in contact
+  double max_force = 10.0;          ///< N
+  double soft_start = 0.0;          ///< s over which forces ramp up after the drill is made
+  Friction friction;
+  RemovalMode removal = RemovalMode::kPhysical;
+  double cutting_rate = 30e-9;                    ///< m^3 / (s N) at full speed (physical mode)
+  std::vector<int> voxels_per_step{1, 3, 6, 10};  ///< per burr (compatible mode)
+  /// Initial goal: world from drill, the burr's centre at the origin and the shaft along +x.
+  Eigen::Matrix4d pose = Eigen::Matrix4d::Identity();
+};
+
+/// One voxel taken by the burr.
+struct AMBFPLUS_API RemovedVoxel {
+  std::int64_t step = 0;
+  std::array<int, 3> voxel{0, 0, 0};
+  std::uint16_t label = 0;
+};
+
+/// Something a training session should react to.
+struct AMBFPLUS_API DrillEvent {
+  std::int64_t step = 0;
+  std::string kind;  ///< "critical": a voxel of a critical label was removed
+  std::uint16_t label = 0;
+  std::array<int, 3> voxel{0, 0, 0};
+};
+
+/// A target pose for the drill at a time, reached by linear interpolation.
+struct AMBFPLUS_API DrillWaypoint {
+  double time = 0.0;  ///< seconds from when the waypoints are set
+  Eigen::Matrix4d pose = Eigen::Matrix4d::Identity();
+  bool on = false;
+  double speed = 1.0;
+};
+
+/// The paper's drill: a tip cursor of the burr's radius and shaft cursors along the axis, each
+/// a finger proxy against the volume. The cursor with the largest proxy-goal error drives the
+/// drill's pose and the force fed back; only the tip removes tissue, and only when it leads, the
+/// drill is on and it touches the volume. It cuts the voxels it touches (centres within 0.6 voxel
+/// of the burr's surface), those nearest the goal first. Stepped with its world; deterministic.
+class AMBFPLUS_API Drill : public Object {
+ public:
+  ~Drill() override;
+  ObjectKind kind() const override { return ObjectKind::kDrill; }
+  Volume& volume() const { return *volume_; }
+  const DrillSpec& spec() const { return spec_; }
+
+  // --- Commands
+  /// Where the device puts the drill (world from drill).
+  void set_goal(const Eigen::Isometry3d& goal);
+  const Eigen::Isometry3d& goal() const { return goal_; }
+  void set_on(bool on) { on_ = on; }
+  bool on() const { return on_; }
+  /// Burr speed, 0..1 of full speed.
+  void set_speed(double speed);
+  double speed() const { return speed_; }
+  /// Selects burr i of spec().burr_diameters.
+  void set_burr(int index);
+  int burr() const { return burr_; }
+  double burr_radius() const { return spec_.burr_diameters[burr_] / 2; }
+  void set_removal_mode(RemovalMode mode) { spec_.removal = mode; }
+  void set_stiffness(double k);
+  void set_cutting_rate(double rate);
+  /// Cutting energy of a label relative to bone (1): the physical rate divides by it.
+  void set_hardness(std::uint16_t label, double hardness);
+  /// Follows these from now on, then holds the last one; an empty list stops following.
+  void set_waypoints(const std::vector<DrillWaypoint>& waypoints);
+  /// Bodies that move with the drill (its meshes), at a fixed offset from the drill frame.
+  void attach(RigidBody& body, const Eigen::Isometry3d& offset = Eigen::Isometry3d::Identity());
+
+  /// One haptic step: cursors, force, removal. Called by World::step.
+  void tick(double dt, std::int64_t step);
+
+  // --- State after the last tick (world frame)
+  /// The force fed back to the device: the leading cursor's, N.
+  const Eigen::Vector3d& force() const { return force_; }
+  /// The sum over all cursors, N.
+  const Eigen::Vector3d& total_force() const { return total_force_; }
+  int cursor_count() const { return static_cast<int>(cursors_.size()); }
+  int leading_cursor() const { return leading_; }
+  Eigen::Vector3d cursor_proxy(int i) const;
+  Eigen::Vector3d cursor_goal(int i) const;
+  double cursor_radius(int i) const { return cursors_[i].radius(); }
+  int cursor_contacts(int i) const { return cursors_[i].contacts(); }
+  /// Surface normal at the tip's first contact (world), zero without contact.
+  Eigen::Vector3d tip_normal() const;
+  /// Distance from the burr's surface to each critical label of the volume (metres, 0 when
+  /// touching, infinity when none is left), in label order.
+  const std::vector<std::pair<std::uint16_t, double>>& critical_distances() const {
+    return critical_distances_;
+  }
+  /// Voxels removed so far and not yet taken; take_* hands them over.
+  const std::deque<RemovedVoxel>& removed() const { return removed_; }
+  std::deque<RemovedVoxel> take_removed();
+  const std::deque<DrillEvent>& events() const { return events_; }
+  std::deque<DrillEvent> take_events();
+  /// Wall time of the last ticks, seconds (up to 100 000).
+  const std::deque<double>& tick_seconds() const { return tick_seconds_; }
+  /// CPU time of the thread for the same ticks: what the tick costs, whatever else the machine
+  /// is doing.
+  const std::deque<double>& tick_cpu_seconds() const { return tick_cpu_seconds_; }
+  const VoxelCollider& collider() const { return *collider_; }
+
+ private:
+  friend class Model;
+  Drill(Model& model, const DrillSpec& spec, int id);
+  void follow_waypoints();
+
+  Volume* volume_;
+  DrillSpec spec_;
+  std::unique_ptr<VoxelCollider> collider_;
+  std::unique_ptr<CriticalDistances> critical_;
+  std::vector<ProxyCursor> cursors_;
+  Eigen::Isometry3d goal_ = Eigen::Isometry3d::Identity();
+  Eigen::Vector3d last_goal_position_ = Eigen::Vector3d::Zero();
+  bool on_ = false;
+  double speed_ = 1.0;
+  int burr_;
+  int leading_ = 0;
+  double budget_ = 0.0;  // m^3 of removal owed (physical mode)
+  double age_ = 0.0;     // seconds since creation (soft start)
+  Eigen::Vector3d force_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d total_force_ = Eigen::Vector3d::Zero();
+  std::vector<double> hardness_;
+  std::vector<std::pair<std::uint16_t, double>> critical_distances_;
+  std::deque<RemovedVoxel> removed_;
+  std::deque<DrillEvent> events_;
+  std::deque<double> tick_seconds_;
+  std::deque<double> tick_cpu_seconds_;
+  std::vector<std::pair<RigidBody*, Eigen::Isometry3d>> attached_;
+  std::vector<DrillWaypoint> waypoints_;
+  double waypoint_clock_ = 0.0;
+};
+
+}  // namespace ambfplus

@@ -1,0 +1,319 @@
+#include "ambfplus/haptics/drill.h"
+
+#include <time.h>
+#include <algorithm>
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "ambfplus/scene/rigid_body.h"
+#include "ambfplus/scene/volume.h"
+#include "ambfplus/scene/world.h"
+#include "haptics/critical_distances.h"
+
+namespace ambfplus {
+namespace {
+
+constexpr std::size_t kTickHistory = 100000;
+
+double thread_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+constexpr double kPi = 3.14159265358979323846;
+
+}  // namespace
+
+Drill::Drill(Model& model, const DrillSpec& spec, int id)
+    : Object(model, spec.name, id), volume_(spec.volume), spec_(spec), burr_(spec.burr) {
+  const std::string who = "drill '" + spec.name + "': ";
+  if (volume_ == nullptr) throw std::invalid_argument(who + "needs a volume to drill");
+  if (&volume_->world() != &model.world()) {
+    throw std::invalid_argument(who + "its volume must be in the same world");
+  }
+  if (spec_.burr_diameters.empty()) throw std::invalid_argument(who + "needs at least one burr");
+  for (double d : spec_.burr_diameters) {
+    if (!(d > 0)) throw std::invalid_argument(who + "burr diameters must be > 0");
+  }
+  if (spec_.cursors < 1 || spec_.cursors > 16) {
+    throw std::invalid_argument(who + "cursors must be 1..16, got " +
+                                std::to_string(spec_.cursors));
+  }
+  if (!(spec_.spacing > 0)) throw std::invalid_argument(who + "cursor spacing must be > 0");
+  if (spec_.shaft_radii.empty()) {
+    for (int i = 1; i < spec_.cursors; ++i) spec_.shaft_radii.push_back(0.00065 + 0.0001 * (i - 1));
+  }
+  if (static_cast<int>(spec_.shaft_radii.size()) != spec_.cursors - 1) {
+    throw std::invalid_argument(who + "needs " + std::to_string(spec_.cursors - 1) +
+                                " shaft radii, got " + std::to_string(spec_.shaft_radii.size()));
+  }
+  if (spec_.voxels_per_step.size() != spec_.burr_diameters.size()) {
+    throw std::invalid_argument(who + "voxels_per_step needs one count per burr");
+  }
+  if (!(spec_.max_force > 0) || spec_.damping < 0 || spec_.soft_start < 0) {
+    throw std::invalid_argument(who + "max_force must be > 0, damping and soft_start >= 0");
+  }
+  set_stiffness(spec_.stiffness);
+  set_cutting_rate(spec_.cutting_rate);
+  set_burr(spec_.burr);
+  collider_ = std::make_unique<VoxelCollider>(volume_->data());
+  std::vector<std::uint16_t> critical;
+  for (const Label& l : volume_->data()->label_table().labels()) {
+    if (l.critical) critical.push_back(l.id);
+  }
+  critical_ = std::make_unique<CriticalDistances>(*volume_->data(), critical);
+  hardness_.assign(65536, 1.0);
+  cursors_.resize(spec_.cursors);
+  set_goal(checked_pose(spec_.pose));
+  const Eigen::Isometry3d volume_from_world = volume_->pose().inverse();
+  const Eigen::Vector3d tip = volume_from_world * goal_.translation();
+  const Eigen::Vector3d axis = volume_from_world.linear() * goal_.linear().col(0);
+  for (int i = 0; i < spec_.cursors; ++i) {
+    cursors_[i].set_radius(i == 0 ? burr_radius() : spec_.shaft_radii[i - 1]);
+    cursors_[i].reset(tip + axis * (spec_.spacing * i));
+  }
+  last_goal_position_ = goal_.translation();
+  set_pose(goal_);
+}
+
+Drill::~Drill() = default;
+
+void Drill::set_goal(const Eigen::Isometry3d& goal) {
+  if (!goal.matrix().allFinite()) throw std::invalid_argument("drill goal must be finite");
+  goal_ = goal;
+}
+
+void Drill::set_speed(double speed) {
+  if (!(speed >= 0.0 && speed <= 1.0)) throw std::invalid_argument("drill speed must be in 0..1");
+  speed_ = speed;
+}
+
+void Drill::set_burr(int index) {
+  if (index < 0 || index >= static_cast<int>(spec_.burr_diameters.size())) {
+    throw std::invalid_argument("burr index must be 0.." +
+                                std::to_string(spec_.burr_diameters.size() - 1));
+  }
+  burr_ = index;
+  if (!cursors_.empty()) cursors_[0].set_radius(burr_radius());
+}
+
+void Drill::set_stiffness(double k) {
+  if (!(k > 0) || !std::isfinite(k)) throw std::invalid_argument("stiffness must be > 0 N/m");
+  spec_.stiffness = k;
+}
+
+void Drill::set_cutting_rate(double rate) {
+  if (!(rate >= 0) || !std::isfinite(rate))
+    throw std::invalid_argument("cutting rate must be >= 0");
+  spec_.cutting_rate = rate;
+}
+
+void Drill::set_hardness(std::uint16_t label, double hardness) {
+  if (!(hardness > 0) || !std::isfinite(hardness))
+    throw std::invalid_argument("hardness must be > 0");
+  hardness_[label] = hardness;
+}
+
+void Drill::set_waypoints(const std::vector<DrillWaypoint>& waypoints) {
+  double last = 0;
+  for (const DrillWaypoint& w : waypoints) {
+    if (!(w.time >= last)) throw std::invalid_argument("waypoint times must not decrease from 0");
+    if (!(w.speed >= 0 && w.speed <= 1)) throw std::invalid_argument("waypoint speed must be 0..1");
+    checked_pose(w.pose);
+    last = w.time;
+  }
+  waypoints_.clear();
+  if (waypoints.empty()) return;
+  // Start from where the goal is now.
+  waypoints_.push_back(DrillWaypoint{0.0, goal_.matrix(), on_, speed_});
+  waypoints_.insert(waypoints_.end(), waypoints.begin(), waypoints.end());
+  waypoint_clock_ = 0.0;
+}
+
+void Drill::attach(RigidBody& body, const Eigen::Isometry3d& offset) {
+  attached_.emplace_back(&body, offset);
+  body.set_pose(pose() * offset);
+}
+
+void Drill::follow_waypoints() {
+  if (waypoints_.empty()) return;
+  std::size_t n = 0;
+  while (n + 1 < waypoints_.size() && waypoints_[n + 1].time <= waypoint_clock_) ++n;
+  const DrillWaypoint& a = waypoints_[n];
+  Eigen::Isometry3d pose = checked_pose(a.pose);
+  on_ = a.on;
+  speed_ = a.speed;
+  if (n + 1 < waypoints_.size()) {
+    const DrillWaypoint& b = waypoints_[n + 1];
+    const double f = (waypoint_clock_ - a.time) / std::max(b.time - a.time, 1e-12);
+    const Eigen::Isometry3d pb = checked_pose(b.pose);
+    pose.translation() = (1 - f) * pose.translation() + f * pb.translation();
+    pose.linear() = Eigen::Quaterniond(pose.linear())
+                        .slerp(f, Eigen::Quaterniond(pb.linear()))
+                        .toRotationMatrix();
+  }
+  goal_ = pose;
+}
+
+void Drill::tick(double dt, std::int64_t step) {
+  const auto start = std::chrono::steady_clock::now();
+  const double cpu_start = thread_cpu_seconds();
+  follow_waypoints();
+  waypoint_clock_ += dt;
+  age_ += dt;
+  collider_->sync();
+
+  // Cursor goals along the shaft, in the volume frame.
+  const Eigen::Isometry3d volume_from_world = volume_->pose().inverse();
+  const Eigen::Matrix3d world_from_volume = volume_->pose().linear();
+  const Eigen::Vector3d tip_goal = volume_from_world * goal_.translation();
+  const Eigen::Vector3d axis = volume_from_world.linear() * goal_.linear().col(0);
+  double largest = -1;
+  for (int i = 0; i < cursor_count(); ++i) {
+    cursors_[i].update(*collider_, tip_goal + axis * (spec_.spacing * i), spec_.friction);
+    const double error = (cursors_[i].proxy() - cursors_[i].goal()).norm();
+    if (error > largest + 1e-12) {
+      largest = error;
+      leading_ = i;
+    }
+  }
+
+  // The drill sits where its leading cursor's proxy puts it.
+  const ProxyCursor& lead = cursors_[leading_];
+  const Eigen::Vector3d tip = lead.proxy() - axis * (spec_.spacing * leading_);
+  Eigen::Isometry3d pose = goal_;
+  pose.translation() = volume_->pose() * tip;
+  set_pose(pose);
+  for (auto& [body, offset] : attached_) body->set_pose(pose * offset);
+
+  // Forces: stiffness times proxy - goal, damped against the goal's motion while in contact,
+  // limited, and ramped in over the soft start.
+  const Eigen::Vector3d goal_velocity =
+      dt > 0 ? Eigen::Vector3d((goal_.translation() - last_goal_position_) / dt)
+             : Eigen::Vector3d::Zero();
+  last_goal_position_ = goal_.translation();
+  const double ramp = spec_.soft_start > 0 ? std::min(1.0, age_ / spec_.soft_start) : 1.0;
+  auto limited = [&](Eigen::Vector3d f) {
+    const double m = f.norm();
+    if (m > spec_.max_force) f *= spec_.max_force / m;
+    return f * ramp;
+  };
+  total_force_.setZero();
+  Eigen::Vector3d tip_force_volume = Eigen::Vector3d::Zero();
+  for (int i = 0; i < cursor_count(); ++i) {
+    Eigen::Vector3d f = Eigen::Vector3d::Zero();
+    if (cursors_[i].contacts() > 0) {
+      f = world_from_volume * (spec_.stiffness * (cursors_[i].proxy() - cursors_[i].goal())) -
+          spec_.damping * goal_velocity;
+    }
+    f = limited(f);
+    total_force_ += f;
+    if (i == leading_) force_ = f;
+    if (i == 0) tip_force_volume = world_from_volume.transpose() * f;
+  }
+  total_force_ = limited(total_force_);
+
+  // Removal: only the tip, only when it leads, touches and the drill runs.
+  const ProxyCursor& burr = cursors_[0];
+  const bool cutting = on_ && speed_ > 0 && leading_ == 0 && burr.contacts() > 0;
+  if (!cutting) budget_ = 0;
+  if (cutting) {
+    const std::shared_ptr<VolumeData>& data = volume_->data();
+    // The burr cuts what it touches: voxels whose centres are within a little more than half a
+    // voxel of its surface (where the proxy holds it, touching the voxel spheres), those nearest
+    // where the device pushes it first.
+    const double reach = burr.radius() + 0.6 * data->voxel_size().maxCoeff();
+    // The proxy does not overlap the solid, so what it touches is surface, which the proxy's
+    // last patch holds (it reaches at least the burr radius and four voxel radii beyond where the
+    // proxy started; the proxy moved towards the goal, inside that).
+    const SurfacePatch& patch = burr.patch();
+    const bool covered = (burr.proxy() - patch.centre).norm() + reach <= patch.radius;
+    const std::vector<std::array<int, 3>> gathered =
+        covered ? std::vector<std::array<int, 3>>()
+                : collider_->surface_within(burr.proxy(), reach);
+    const std::vector<std::array<int, 3>>& candidates = covered ? patch.voxels : gathered;
+    std::vector<std::pair<double, std::array<int, 3>>> order;
+    for (const auto& v : candidates) {
+      if (data->label(v[0], v[1], v[2]) == 0) continue;  // removed earlier this step
+      const Eigen::Vector3d c = data->voxel_center(v[0], v[1], v[2]);
+      if ((c - burr.proxy()).squaredNorm() > reach * reach) continue;
+      const Label* l = data->label_table().find(data->label(v[0], v[1], v[2]));
+      if (l != nullptr && !l->removable) continue;
+      order.push_back({(c - burr.goal()).squaredNorm(), v});
+    }
+    // Nearest the goal first; ties by index, so the order is the same every run.
+    std::sort(order.begin(), order.end());
+    std::vector<std::array<int, 3>> take;
+    if (spec_.removal == RemovalMode::kCompatible) {
+      const std::size_t n = std::min<std::size_t>(order.size(), spec_.voxels_per_step[burr_]);
+      for (std::size_t i = 0; i < n; ++i) take.push_back(order[i].second);
+    } else {
+      const double normal_force = std::abs(tip_force_volume.dot(burr.mean_normal()));
+      const double voxel_volume = data->voxel_size().prod();
+      const double cap = 4.0 / 3.0 * kPi * std::pow(burr.radius(), 3);
+      budget_ = std::min(cap, budget_ + spec_.cutting_rate * speed_ * normal_force * dt);
+      for (const auto& [d2, v] : order) {
+        const double cost = voxel_volume * hardness_[data->label(v[0], v[1], v[2])];
+        if (cost > budget_) break;
+        budget_ -= cost;
+        take.push_back(v);
+      }
+      if (order.empty()) budget_ = 0;
+    }
+    if (!take.empty()) {
+      const std::vector<std::uint16_t> old = collider_->remove(take);
+      for (std::size_t i = 0; i < take.size(); ++i) {
+        removed_.push_back(RemovedVoxel{step, take[i], old[i]});
+        const Label* l = data->label_table().find(old[i]);
+        if (l != nullptr && l->critical) {
+          events_.push_back(DrillEvent{step, "critical", old[i], take[i]});
+          critical_->removed(take[i], old[i]);
+        }
+      }
+    }
+  }
+
+  // Distances from the burr's surface to the critical structures.
+  critical_distances_.clear();
+  const double half_voxel = 0.5 * std::cbrt(volume_->data()->voxel_size().prod());
+  for (std::uint16_t label : critical_->labels()) {
+    const double d = critical_->distance(burr.proxy(), label);
+    critical_distances_.emplace_back(
+        label, std::isinf(d) ? d : std::max(0.0, d - burr.radius() - half_voxel));
+  }
+
+  tick_seconds_.push_back(
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  tick_cpu_seconds_.push_back(thread_cpu_seconds() - cpu_start);
+  if (tick_seconds_.size() > kTickHistory) {
+    tick_seconds_.pop_front();
+    tick_cpu_seconds_.pop_front();
+  }
+}
+
+Eigen::Vector3d Drill::cursor_proxy(int i) const {
+  return volume_->pose() * cursors_.at(i).proxy();
+}
+
+Eigen::Vector3d Drill::cursor_goal(int i) const { return volume_->pose() * cursors_.at(i).goal(); }
+
+Eigen::Vector3d Drill::tip_normal() const {
+  return volume_->pose().linear() * cursors_[0].mean_normal();
+}
+
+std::deque<RemovedVoxel> Drill::take_removed() {
+  std::deque<RemovedVoxel> out;
+  out.swap(removed_);
+  return out;
+}
+
+std::deque<DrillEvent> Drill::take_events() {
+  std::deque<DrillEvent> out;
+  out.swap(events_);
+  return out;
+}
+
+}  // namespace ambfplus

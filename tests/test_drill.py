@@ -1,0 +1,251 @@
+"""The drill: finger-proxy cursors on a volume, removal, forces, determinism."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import ambfplus
+
+UP = ambfplus.rotation_between((1, 0, 0), (0, 0, 1))  # shaft straight up, burr at the bottom
+
+
+def slab(n=100, voxel=0.0002, labels=None):
+    """A 20 mm cube (at 0.2 mm voxels) of bone below z = 0 (the cube is centred on the origin)."""
+    grid = np.zeros((n, n, n), np.uint8)
+    grid[:, :, : n // 2] = 1
+    table = labels or [ambfplus.Label(1, "Bone")]
+    return ambfplus.VolumeData(grid, voxel_size=(voxel,) * 3, label_table=table)
+
+
+def drill_world(data, **options):
+    world = ambfplus.World()
+    volume = world.add_volume("bone", data)
+    options.setdefault("pose", ambfplus.make_pose((0, 0, 0.01), rotation=UP))
+    drill = world.add_drill("drill", volume, **options)
+    return world, volume, drill
+
+
+def plunge(world, drill, top, bottom, seconds, hold=0.3):
+    drill.on = True
+    drill.set_waypoints(
+        [
+            {"time": 0.0, "pose": ambfplus.make_pose(top, rotation=UP), "on": True},
+            {"time": seconds, "pose": ambfplus.make_pose(bottom, rotation=UP), "on": True},
+            {"time": seconds + hold, "pose": ambfplus.make_pose(bottom, rotation=UP), "on": True},
+        ]
+    )
+    world.step(int(round((seconds + hold) / world.time_step)))
+
+
+def test_a_plunge_removes_the_voxels_the_burr_sweeps():
+    data = slab()
+    before = np.asarray(data.labels).copy()
+    world, volume, drill = drill_world(data, burr=2, cutting_rate=2e-6, stiffness=2000.0)
+    r = drill.burr_radius
+    top, bottom = (0.0003, -0.0001, r + 0.005), (0.0003, -0.0001, r - 0.010)
+    plunge(world, drill, top, bottom, seconds=1.5)
+    removed = drill.removed
+    assert len(removed["step"]) > 0
+    got = np.zeros(before.shape, bool)
+    i, j, k = removed["voxel"].T
+    got[i, j, k] = True
+    assert (removed["label"] == 1).all() and (before[i, j, k] == 1).all()
+    # An independent sweep: voxel centres within r of the burr centre's path.
+    c = (np.arange(100) + 0.5 - 50) * 0.0002
+    x, y, z = np.meshgrid(c, c, c, indexing="ij")
+    zc = np.clip(z, bottom[2], top[2])
+    dist = np.sqrt((x - top[0]) ** 2 + (y - top[1]) ** 2 + (z - zc) ** 2)
+    expected = (dist <= r) & (before == 1)
+    differ = got ^ expected
+    assert expected.sum() > 5000
+    # Differences only in the boundary layer, one voxel thick (the burr touches voxels whose
+    # centres are half a voxel beyond its radius).
+    assert np.abs(dist[differ] - r).max() <= 0.0002 * 1.01
+    assert differ.sum() < 3 * 0.0002 / r * expected.sum()
+    assert not np.asarray(data.labels)[got].any(), "the volume lost them too"
+
+
+def test_removal_rate_is_independent_of_step_and_voxel_size():
+    def removed_volume(voxel, dt):
+        n = int(round(0.02 / voxel))
+        world = ambfplus.World(time_step=dt)
+        volume = world.add_volume("bone", slab(n, voxel))
+        drill = world.add_drill(
+            "drill",
+            volume,
+            burr=3,
+            stiffness=1000.0,
+            pose=ambfplus.make_pose((0, 0, 0.004), rotation=UP),
+        )
+        drill.on = True
+        force = 1.0  # N pressed along the surface normal, whatever the surface does
+        for _ in range(int(round(0.3 / dt))):
+            goal = drill.goal
+            tip = drill.cursor_proxies[0]
+            normal = drill.tip_normal if drill.cursor_contacts[0] else np.array([0, 0, 1.0])
+            goal[:3, 3] = tip - normal * (force / drill.stiffness)
+            drill.goal = goal
+            world.step()
+        return len(drill.removed["step"]) * voxel**3
+
+    reference = removed_volume(0.0002, 0.001)
+    expected = 30e-9 * 1.0 * 0.3  # cutting rate x force x time
+    assert reference == pytest.approx(expected, rel=0.05)
+    assert removed_volume(0.0001, 0.001) == pytest.approx(reference, rel=0.05)
+    assert removed_volume(0.0002, 0.0005) == pytest.approx(reference, rel=0.05)
+
+
+def test_shaft_contact_blocks_removal_and_moves_the_drill():
+    grid = np.zeros((100, 100, 100), np.uint8)
+    grid[:, :, :50] = 1  # floor, z < 0
+    grid[:40, :, :] = 1  # wall, x < -2 mm
+    data = ambfplus.VolumeData(
+        grid, voxel_size=(0.0002,) * 3, label_table=[ambfplus.Label(1, "Bone")]
+    )
+    axis = np.array([-1.0, 0.0, 1.0]) / np.sqrt(2)
+    rotation = ambfplus.rotation_between((1, 0, 0), axis)
+    world = ambfplus.World()
+    volume = world.add_volume("bone", data)
+    start = ambfplus.make_pose((0.008, 0, 0.003), rotation=rotation)
+    drill = world.add_drill("drill", volume, burr=2, pose=start, cutting_rate=2e-6)
+    r = drill.burr_radius
+    drill.on = True
+    shaft_led = removed_while_shaft_led = 0
+    for step in range(400):
+        # The tip pressed 0.2 mm into the floor while the drill moves towards the wall.
+        x = 0.008 - step * 0.00002
+        drill.goal = ambfplus.make_pose((x, 0, r - 0.0002), rotation=rotation)
+        before = len(drill.removed["step"])
+        world.step()
+        if drill.leading_cursor > 0:
+            shaft_led += 1
+            removed_while_shaft_led += len(drill.removed["step"]) - before
+            lead = drill.leading_cursor
+            expected = drill.cursor_proxies[lead] - axis * 0.0015 * lead
+            assert np.allclose(drill.pose[:3, 3], expected, atol=1e-9)
+    assert shaft_led > 50
+    assert removed_while_shaft_led == 0
+    assert len(drill.removed["step"]) > 0, "before the shaft met the wall the tip cut the floor"
+
+
+def run_script(removal="physical"):
+    world, volume, drill = drill_world(
+        ambfplus.phantom(96, seed=5),
+        burr=3,
+        removal=removal,
+        cutting_rate=1e-6,
+        pose=ambfplus.make_pose((0.0, 0.0, 0.03), rotation=UP),
+    )
+    forces = []
+    drill.set_waypoints(
+        [
+            {
+                "time": 0.05,
+                "pose": ambfplus.make_pose((0.001, 0.002, 0.006), rotation=UP),
+                "on": True,
+            },
+            {
+                "time": 0.15,
+                "pose": ambfplus.make_pose((0.004, 0.0, 0.004), rotation=UP),
+                "on": True,
+            },
+        ]
+    )
+    for _ in range(150):
+        world.step()
+        forces.append(drill.force.copy())
+    return drill.removed, np.array(forces), drill
+
+
+def test_the_same_script_gives_the_same_removal_and_forces():
+    a_removed, a_forces, _ = run_script()
+    b_removed, b_forces, _ = run_script()
+    assert len(a_removed["step"]) > 100
+    for key in ("step", "voxel", "label"):
+        assert np.array_equal(a_removed[key], b_removed[key])
+    assert np.array_equal(a_forces, b_forces)
+    assert np.abs(a_forces).max() > 0.1
+
+
+def test_compatible_mode_removes_a_fixed_count_per_step():
+    removed, _, drill = run_script("compatible")
+    per_step = np.bincount(removed["step"])
+    assert per_step.max() == 10, "the 6 mm burr takes 10 voxels a step"
+    drill.burr = 0
+    assert drill.burr_radius == pytest.approx(0.0005)
+
+
+def test_critical_structures_raise_events_and_report_their_distance():
+    grid = np.zeros((100, 100, 100), np.uint8)
+    grid[:, :, :50] = 1
+    grid[45:55, 45:55, 30:40] = 2  # a nerve 2 to 4 mm below the surface
+    data = ambfplus.VolumeData(
+        grid,
+        voxel_size=(0.0002,) * 3,
+        label_table=[ambfplus.Label(1, "Bone"), ambfplus.Label(2, "Nerve", critical=True)],
+    )
+    world, volume, drill = drill_world(data, burr=1, cutting_rate=2e-6, stiffness=2000.0)
+    r = drill.burr_radius
+    world.step()
+    # Nerve voxel centres start 2.1 mm below the surface; the burr is 8 mm above it.
+    start = drill.critical_distances["Nerve"]
+    assert start == pytest.approx(0.010 - r + 0.0021 - 0.0001 - r, abs=0.0003) or start > 0.009
+    plunge(world, drill, (0, 0, 0.01), (0, 0, r - 0.0035), seconds=1.0)
+    events = drill.take_events()
+    assert events and all(e["kind"] == "critical" and e["label"] == 2 for e in events)
+    assert drill.critical_distances["Nerve"] < 0.0002, "the burr ends against the nerve"
+    assert drill.events == []
+
+
+def test_drill_moves_attached_bodies_and_reports_tick_times():
+    world, volume, drill = drill_world(slab())
+    burr = world.add_body("burr", "sphere", radius=drill.burr_radius)
+    drill.attach(burr)
+    drill.goal = ambfplus.make_pose((0.001, 0.002, 0.008), rotation=UP)
+    world.step(3)
+    assert np.allclose(burr.pose[:3, 3], (0.001, 0.002, 0.008))
+    assert len(drill.tick_seconds) == 3 and (drill.tick_seconds > 0).all()
+
+
+def test_bad_drill_arguments():
+    world, volume, drill = drill_world(slab(20))
+    with pytest.raises(ValueError, match="burr index"):
+        drill.burr = 9
+    with pytest.raises(ValueError, match="speed"):
+        drill.speed = 2.0
+    with pytest.raises(TypeError, match="unexpected keyword"):
+        world.add_drill("d2", volume, colour="red")
+    with pytest.raises(ValueError, match="cursors"):
+        world.add_drill("d3", volume, cursors=0)
+    with pytest.raises(ValueError, match="waypoint times"):
+        drill.set_waypoints([{"time": 1.0, "pose": np.eye(4)}, {"time": 0.5, "pose": np.eye(4)}])
+
+
+def test_force_limit_and_soft_start():
+    world, volume, drill = drill_world(slab(), stiffness=2000.0, max_force=1.5, soft_start=0.01)
+    r = drill.burr_radius
+    drill.goal = ambfplus.make_pose((0, 0, r - 0.002), rotation=UP)  # 2 mm deep: 4 N unlimited
+    forces = []
+    for _ in range(20):
+        world.step()
+        forces.append(np.linalg.norm(drill.force))
+    forces = np.array(forces)
+    # Ramped in over 10 ms (the ramp starts when the drill is made), then capped at 1.5 N.
+    assert forces[0] < 0.3 and np.all(np.diff(forces[:10]) > 0)
+    assert forces[-1] == pytest.approx(1.5, rel=1e-6)
+    assert np.allclose(drill.force / np.linalg.norm(drill.force), (0, 0, 1), atol=1e-3)
+
+
+def test_damping_opposes_the_goal_motion_in_contact():
+    world, volume, drill = drill_world(slab(), stiffness=1000.0, damping=2.0)
+    r = drill.burr_radius
+    drill.goal = ambfplus.make_pose((0, 0, r - 0.001), rotation=UP)
+    world.step(2)  # the second step has the goal at rest
+    still = drill.force.copy()
+    assert still[2] == pytest.approx(1.0, rel=0.02)
+    # The goal moving sideways at 1 m/s adds 2 N against the motion.
+    drill.goal = ambfplus.make_pose((0.001, 0, r - 0.001), rotation=UP)
+    world.step()
+    assert drill.force[0] == pytest.approx(-2.0, abs=0.05)
+    assert drill.force[2] == pytest.approx(still[2], rel=0.02)

@@ -388,7 +388,8 @@ void register_scene(py::module_& m) {
           },
           py::arg("path"), py::arg("labels") = py::none(),
           "Loads the volumes: of an AMBF model file (its bodies and joints come with ADF "
-          "loading) into a new model; labels (CSV/YAML) overrides their label tables.")
+          "loading) into a new model, then the drills: it declares on them (ambfplus "
+          "extension); labels (CSV/YAML) overrides their label tables. Returns the volumes.")
       .def("__repr__", [](World& w) {
         std::ostringstream s;
         s << "<World '" << w.name() << "' objects=" << w.objects().size()

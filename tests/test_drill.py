@@ -249,3 +249,135 @@ def test_damping_opposes_the_goal_motion_in_contact():
     world.step()
     assert drill.force[0] == pytest.approx(-2.0, abs=0.05)
     assert drill.force[2] == pytest.approx(still[2], rel=0.02)
+
+
+def test_rigid_bodies_stop_the_drill_at_their_faces():
+    # Bone below z = 0 and a steel plate (a static box body) whose top face is at z = 5 mm over
+    # part of it: pushed down onto the plate, the burr rests on its face, feels the spring force
+    # along its normal and cuts nothing; beside the plate it reaches the bone.
+    world, volume, drill = drill_world(slab(), stiffness=800.0)
+    world.add_body(
+        "plate", "box", size=(0.006, 0.02, 0.002), mass=0.0, pose=ambfplus.make_pose((0, 0, 0.004))
+    )
+    drill.on = True
+    r = drill.burr_radius
+    goal_z = 0.005 + r - 0.001  # 1 mm into the plate
+    drill.set_waypoints(
+        [
+            {"time": 0.2, "pose": ambfplus.make_pose((0, 0.001, goal_z), rotation=UP), "on": True},
+            {"time": 0.4, "pose": ambfplus.make_pose((0, 0.001, goal_z), rotation=UP), "on": True},
+        ]
+    )
+    world.step(400)
+    tip = drill.cursor_proxies[0]
+    assert tip[2] == pytest.approx(0.005 + r, abs=1e-5), "resting on the plate's top face"
+    assert np.allclose(drill.force, 800.0 * (tip - drill.cursor_goals[0]), atol=1e-9)
+    assert np.allclose(drill.force, (0, 0, 0.8), rtol=0.01, atol=1e-6), "1 mm deep at 800 N/m"
+    assert np.allclose(drill.tip_normal, (0, 0, 1), atol=1e-9)
+    assert len(drill.removed["voxel"]) == 0, "the plate is not bone"
+    # The plate moves away (as a body pushed by physics would): the drill falls to the bone.
+    world["plate"].pose = ambfplus.make_pose((0.05, 0, 0.004))
+    drill.set_waypoints(
+        [{"time": 0.1, "pose": ambfplus.make_pose((0, 0.001, r - 0.0005), rotation=UP), "on": True}]
+    )
+    world.step(200)
+    assert drill.cursor_proxies[0][2] < 0.001 + r, "reached the bone"
+    assert len(drill.take_removed()["voxel"]) > 0
+
+
+def test_a_body_across_the_shaft_stops_the_drill():
+    # A bar 6 mm up the shaft (cursor 4's height), 3 mm to the side: moving the drill sideways
+    # into it, the shaft cursor meets the bar, leads, and the force pushes back along -x.
+    world, volume, drill = drill_world(slab())
+    tip_z = 0.008
+    world.add_body(
+        "bar",
+        "box",
+        size=(0.002, 0.02, 0.002),
+        mass=0.0,
+        pose=ambfplus.make_pose((0.004, 0, tip_z + 4 * 0.0015)),
+    )
+    drill.set_waypoints(
+        [
+            {"time": 0.0, "pose": ambfplus.make_pose((0, 0, tip_z), rotation=UP)},
+            {"time": 0.3, "pose": ambfplus.make_pose((0.006, 0, tip_z), rotation=UP)},
+        ]
+    )
+    world.step(300)
+    lead = drill.leading_cursor
+    assert 3 <= lead <= 5, "a shaft cursor near the bar leads"
+    stop = 0.003 - drill.cursor_radii[lead]
+    assert drill.cursor_proxies[lead][0] == pytest.approx(stop, abs=1e-4), "held at the bar"
+    assert drill.force[0] < -0.5 and abs(drill.force[2]) < 0.2 * abs(drill.force[0])
+    assert drill.pose[0, 3] == pytest.approx(stop, abs=1e-4), "the drill is shown where it stops"
+
+
+def adf_with_drill(tmp_path, drill_block):
+    """A model file with a slab volume (a slice stack) and the given drill block."""
+    data = slab(20, voxel=0.001)
+    data.save_slice_stack(tmp_path / "slab")
+    ambfplus.write_label_table(tmp_path / "slab" / "labels.csv", data.label_table)
+    path = tmp_path / "model.yaml"
+    path.write_text(
+        "volumes: [VOLUME slab]\n"
+        "drills: [DRILL burr]\n"
+        "VOLUME slab:\n"
+        "  name: slab\n"
+        "  dimensions: {x: 0.02, y: 0.02, z: 0.02}\n"
+        "  images: {path: slab/, prefix: plane00, format: png, count: 20}\n"
+        "  labels: slab/labels.csv\n" + drill_block
+    )
+    return path
+
+
+def test_drills_declared_in_a_model_file(tmp_path, caplog):
+    path = adf_with_drill(
+        tmp_path,
+        "DRILL burr:\n"
+        "  name: mastoid drill\n"
+        "  volume: VOLUME slab\n"
+        "  location:\n"
+        "    position: {x: 0.0, y: 0.0, z: 0.02}\n"
+        "    orientation: {r: 0, p: -1.5707963, y: 0}\n"
+        "  burr diameters: [0.0015, 0.003, 0.005]\n"
+        "  burr: 1\n"
+        "  cursors: 4\n"
+        "  shaft radii: [0.0007, 0.0008, 0.0009]\n"
+        "  stiffness: 400\n"
+        "  removal: compatible\n"
+        "  voxels per step: [2, 4, 8]\n"
+        "  colour: red\n",
+    )
+    world = ambfplus.World()
+    with caplog.at_level("WARNING", logger="ambfplus"):
+        (volume,) = world.load_volumes(path)
+    assert "unknown key 'colour'" in caplog.text and "line 21" in caplog.text
+    (drill,) = world.drills
+    assert drill.name == "mastoiddrill" and drill.volume.name == "slab"
+    assert drill.burr_diameters == [0.0015, 0.003, 0.005] and drill.burr == 1
+    assert drill.burr_radius == 0.0015 and drill.cursor_radii == [0.0015, 0.0007, 0.0008, 0.0009]
+    assert drill.stiffness == 400 and drill.removal == "compatible"
+    # The shaft (+x of the drill) points up: the pitch of -90 degrees turns x onto +z.
+    assert np.allclose(drill.goal[:3, 0], (0, 0, 1), atol=1e-6)
+    assert np.allclose(drill.goal[:3, 3], (0, 0, 0.02))
+    drill.burr = 2
+    assert drill.cursor_radii[0] == 0.0025, "a burr change at run time resizes the tip"
+
+
+@pytest.mark.parametrize(
+    "block, message",
+    [
+        ("DRILL burr:\n  burr: 1\n", "needs 'volume'"),
+        ("DRILL burr:\n  volume: VOLUME other\n", "not one of the file's volumes"),
+        ("DRILL burr:\n  volume: slab\n  removal: fast\n", "line 10.*physical or compatible"),
+        ("DRILL burr:\n  volume: slab\n  burr: [1]\n", "line 10.*'burr' has the wrong type"),
+        ("DRILL burr:\n  volume: slab\n  burr diameters: [0.001, -1]\n", "must be > 0"),
+        ("", "lists 'DRILL burr' but the file has no block"),
+    ],
+)
+def test_bad_drill_blocks_name_the_file_and_key(tmp_path, block, message):
+    path = adf_with_drill(tmp_path, block)
+    world = ambfplus.World()
+    with pytest.raises(ambfplus.ConfigError, match=message) as error:
+        world.load_volumes(path)
+    assert error.value.filename == str(path)

@@ -136,6 +136,33 @@ void Drill::set_waypoints(const std::vector<DrillWaypoint>& waypoints) {
 void Drill::attach(RigidBody& body, const Eigen::Isometry3d& offset) {
   attached_.emplace_back(&body, offset);
   body.set_pose(pose() * offset);
+  objects_seen_ = 0;  // rebuild the mesh collider without it
+}
+
+void Drill::sync_meshes() {
+  const std::vector<Object*> objects = volume_->world().objects();
+  if (objects.size() != objects_seen_) {
+    objects_seen_ = objects.size();
+    meshes_.clear();
+    mesh_bodies_.clear();
+    for (Object* o : objects) {
+      auto* body = dynamic_cast<RigidBody*>(o);
+      if (body == nullptr || !body->visual_mesh()) continue;
+      const bool carried = std::any_of(attached_.begin(), attached_.end(),
+                                       [&](const auto& a) { return a.first == body; });
+      if (carried) continue;
+      if (body->shape().kind == Shape::Kind::kPlane) {
+        meshes_.add_plane();
+      } else {
+        meshes_.add_mesh(*body->visual_mesh());
+      }
+      mesh_bodies_.push_back(body);
+    }
+  }
+  const Eigen::Isometry3d volume_from_world = volume_->pose().inverse();
+  for (std::size_t i = 0; i < mesh_bodies_.size(); ++i) {
+    meshes_.set_pose(static_cast<int>(i), volume_from_world * mesh_bodies_[i]->pose());
+  }
 }
 
 void Drill::follow_waypoints() {
@@ -165,6 +192,7 @@ void Drill::tick(double dt, std::int64_t step) {
   waypoint_clock_ += dt;
   age_ += dt;
   collider_->sync();
+  sync_meshes();
 
   // Cursor goals along the shaft, in the volume frame.
   const Eigen::Isometry3d volume_from_world = volume_->pose().inverse();
@@ -173,7 +201,7 @@ void Drill::tick(double dt, std::int64_t step) {
   const Eigen::Vector3d axis = volume_from_world.linear() * goal_.linear().col(0);
   double largest = -1;
   for (int i = 0; i < cursor_count(); ++i) {
-    cursors_[i].update(*collider_, tip_goal + axis * (spec_.spacing * i), spec_.friction);
+    cursors_[i].update(*collider_, tip_goal + axis * (spec_.spacing * i), spec_.friction, &meshes_);
     const double error = (cursors_[i].proxy() - cursors_[i].goal()).norm();
     if (error > largest + 1e-12) {
       largest = error;
@@ -216,9 +244,11 @@ void Drill::tick(double dt, std::int64_t step) {
   }
   total_force_ = limited(total_force_);
 
-  // Removal: only the tip, only when it leads, touches and the drill runs.
+  // Removal: only the tip, only when it leads, touches the anatomy and the drill runs.
   const ProxyCursor& burr = cursors_[0];
-  const bool cutting = on_ && speed_ > 0 && leading_ == 0 && burr.contacts() > 0;
+  bool on_anatomy = false;  // a mesh contact alone cuts nothing
+  for (int i = 0; i < burr.contacts(); ++i) on_anatomy |= burr.contact_voxel(i)[0] >= 0;
+  const bool cutting = on_ && speed_ > 0 && leading_ == 0 && on_anatomy;
   if (!cutting) budget_ = 0;
   if (cutting) {
     const std::shared_ptr<VolumeData>& data = volume_->data();

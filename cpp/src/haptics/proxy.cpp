@@ -111,7 +111,7 @@ int ProxyCursor::same_surface(const Eigen::Vector3d& n) const {
 }
 
 void ProxyCursor::update(const VoxelCollider& collider, const Eigen::Vector3d& goal,
-                         const Friction& friction) {
+                         const Friction& friction, const MeshCollider* meshes) {
   goal_ = goal;
   push_out(collider);
   const Eigen::Vector3d last_normal = mean_normal();  // of the last update's contacts
@@ -156,6 +156,16 @@ void ProxyCursor::update(const VoxelCollider& collider, const Eigen::Vector3d& g
           hit = full;
           n = surface_normal(collider, hit, proxy_ + motion * hit.t);
         }
+      }
+    }
+    if (meshes != nullptr && meshes->parts() > 0) {
+      // A mesh met first wins (at the full radius: its triangles are exact, without bumps).
+      const MeshHit mesh = meshes->sweep(proxy_, target, radius_);
+      if (mesh.hit && (!hit.hit || mesh.t < hit.t)) {
+        hit.hit = true;
+        hit.t = mesh.t;
+        hit.voxel = {-1, -1, -1};
+        n = mesh.normal;
       }
     }
     if (!hit.hit) {

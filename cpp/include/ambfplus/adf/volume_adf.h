@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "ambfplus/export.h"
+#include "ambfplus/haptics/drill.h"
 #include "ambfplus/scene/volume.h"
 #include "ambfplus/volume/volume_io.h"
 
@@ -29,9 +30,24 @@ struct AMBFPLUS_API AdfVolumeBlock {
 /// absent, or a block without `images`.
 AMBFPLUS_API std::vector<AdfVolumeBlock> read_adf_volumes(const std::string& path);
 
+/// A `DRILL <identifier>` block of a model file (an ambfplus extension AMBF ignores), listed under
+/// `drills:`; read but not yet created. Keys, all optional but `volume`: name, volume (a VOLUME
+/// block's identifier or name), location, burr diameters (metres), burr, cursors, cursor spacing,
+/// shaft radii, stiffness, damping, max force, soft start, friction {static, dynamic}, removal
+/// (physical | compatible), cutting rate, voxels per step.
+struct AMBFPLUS_API AdfDrillBlock {
+  std::string identifier;
+  std::string volume;  ///< as written
+  DrillSpec spec;      ///< everything but the volume
+};
+
+/// Reads the drills a model file lists under `drills:`, with the same errors as
+/// read_adf_volumes; unknown keys are logged once each as warnings.
+AMBFPLUS_API std::vector<AdfDrillBlock> read_adf_drills(const std::string& path);
+
 /// Loads the volumes of an AMBF model file into a new model of the world (named after the file),
-/// each from its slice stack. A non-empty `labels` (CSV/YAML) overrides the blocks' tables.
-/// Returns them in file order.
+/// each from its slice stack, then the drills listed under `drills:` on them. A non-empty
+/// `labels` (CSV/YAML) overrides the blocks' tables. Returns the volumes in file order.
 AMBFPLUS_API std::vector<Volume*> load_adf_volumes(World& world, const std::string& path,
                                                    const std::string& labels = "");
 

@@ -9,6 +9,7 @@
 
 #include <Eigen/Geometry>
 
+#include "ambfplus/haptics/mesh_collider.h"
 #include "ambfplus/haptics/proxy.h"
 #include "ambfplus/haptics/voxel_collider.h"
 #include "ambfplus/scene/object.h"
@@ -76,7 +77,9 @@ struct AMBFPLUS_API DrillWaypoint {
 /// a finger proxy against the volume. The cursor with the largest proxy-goal error drives the
 /// drill's pose and the force fed back; only the tip removes tissue, and only when it leads, the
 /// drill is on and it touches the volume. It cuts the voxels it touches (centres within 0.6 voxel
-/// of the burr's surface), those nearest the goal first. Stepped with its world; deterministic.
+/// of the burr's surface), those nearest the goal first. The world's other rigid bodies (all but
+/// those attached to the drill) stop the cursors at their triangles, where they are at each tick.
+/// Stepped with its world; deterministic.
 class AMBFPLUS_API Drill : public Object {
  public:
   ~Drill() override;
@@ -139,11 +142,15 @@ class AMBFPLUS_API Drill : public Object {
   /// is doing.
   const std::deque<double>& tick_cpu_seconds() const { return tick_cpu_seconds_; }
   const VoxelCollider& collider() const { return *collider_; }
+  /// The rigid bodies the cursors collide with (volume frame), as of the last tick.
+  const MeshCollider& mesh_collider() const { return meshes_; }
 
  private:
   friend class Model;
   Drill(Model& model, const DrillSpec& spec, int id);
   void follow_waypoints();
+  // Brings the mesh collider up to date with the world's bodies and their poses.
+  void sync_meshes();
 
   Volume* volume_;
   DrillSpec spec_;
@@ -167,6 +174,9 @@ class AMBFPLUS_API Drill : public Object {
   std::deque<double> tick_seconds_;
   std::deque<double> tick_cpu_seconds_;
   std::vector<std::pair<RigidBody*, Eigen::Isometry3d>> attached_;
+  MeshCollider meshes_;
+  std::vector<RigidBody*> mesh_bodies_;  // part i of meshes_ is mesh_bodies_[i]
+  std::size_t objects_seen_ = 0;         // world objects when meshes_ was built
   std::vector<DrillWaypoint> waypoints_;
   double waypoint_clock_ = 0.0;
 };

@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 
 #include "ambfplus/export.h"
+#include "ambfplus/haptics/mesh_collider.h"
 #include "ambfplus/haptics/voxel_collider.h"
 
 namespace ambfplus {
@@ -20,7 +21,8 @@ struct AMBFPLUS_API Friction {
 /// on the first, slides in that plane, then along the crease of two, and stops in the corner of
 /// three. Planes are the smoothed occupancy's (the surface as rendered, so on a voxelised curve the
 /// proxy follows the curve, not its staircase), and sliding tolerates the micrometre bumps the
-/// voxel spheres leave between their centres. All positions are in the volume frame.
+/// voxel spheres leave between their centres. Rigid meshes and planes (a MeshCollider) stop it
+/// the same way, at their exact triangles. All positions are in the volume frame.
 class AMBFPLUS_API ProxyCursor {
  public:
   explicit ProxyCursor(double radius = 0.001);
@@ -31,9 +33,9 @@ class AMBFPLUS_API ProxyCursor {
   void reset(const Eigen::Vector3d& p);
 
   /// Moves the proxy towards goal, against the collider. Sweeps only, so a goal that moves
-  /// through a wall in one step cannot tunnel.
+  /// through a wall in one step cannot tunnel. meshes, if given, are in the volume frame too.
   void update(const VoxelCollider& collider, const Eigen::Vector3d& goal,
-              const Friction& friction = {});
+              const Friction& friction = {}, const MeshCollider* meshes = nullptr);
 
   const Eigen::Vector3d& proxy() const { return proxy_; }
   const Eigen::Vector3d& goal() const { return goal_; }
@@ -41,6 +43,7 @@ class AMBFPLUS_API ProxyCursor {
   /// occupancy, as the surface is rendered).
   int contacts() const { return contacts_; }
   const Eigen::Vector3d& normal(int i) const { return normals_[i]; }
+  /// The voxel touched by contact i, or {-1, -1, -1} for a mesh.
   const std::array<int, 3>& contact_voxel(int i) const { return voxels_[i]; }
   /// Sum of the contact normals, unit (zero without contact).
   Eigen::Vector3d mean_normal() const;

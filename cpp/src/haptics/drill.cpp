@@ -266,10 +266,13 @@ void Drill::tick(double dt, std::int64_t step) {
                 : collider_->surface_within(burr.proxy(), reach);
     const std::vector<std::array<int, 3>>& candidates = covered ? patch.voxels : gathered;
     std::vector<std::pair<double, std::array<int, 3>>> order;
-    for (const auto& v : candidates) {
-      if (data->label(v[0], v[1], v[2]) == 0) continue;  // removed earlier this step
-      const Eigen::Vector3d c = data->voxel_center(v[0], v[1], v[2]);
+    for (std::size_t n = 0; n < candidates.size(); ++n) {
+      const std::array<int, 3>& v = candidates[n];
+      // Distance first (the patch holds the centres), the grid only for voxels in reach.
+      const Eigen::Vector3d c = covered ? Eigen::Vector3d(patch.x[n], patch.y[n], patch.z[n])
+                                        : data->voxel_center(v[0], v[1], v[2]);
       if ((c - burr.proxy()).squaredNorm() > reach * reach) continue;
+      if (data->label(v[0], v[1], v[2]) == 0) continue;  // removed earlier this step
       const Label* l = data->label_table().find(data->label(v[0], v[1], v[2]));
       if (l != nullptr && !l->removable) continue;
       order.push_back({(c - burr.goal()).squaredNorm(), v});

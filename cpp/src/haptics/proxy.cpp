@@ -123,12 +123,14 @@ void ProxyCursor::update(const VoxelCollider& collider, const Eigen::Vector3d& g
   const double s = 2 * collider.voxel_radius();
   const double ripple = std::min(0.5 * radius_, 1.5 * s * s / (4 * (radius_ + 0.5 * s)));
   Eigen::Vector3d target = goal;
-  // Every target of this step is the goal projected onto planes or lines through the proxy, so
-  // no nearer to the proxy's start than the goal is: gather the surface within that reach once.
-  // (Sweeps that leave the patch fall back to the bricks.)
+  // The first target of this step is the goal, or its projection onto a plane through the proxy,
+  // which lies on the sphere whose diameter joins proxy and goal (the foot of a perpendicular
+  // sees that diameter at a right angle): gather the surface within the cursor's reach of that
+  // sphere once. (Sweeps that leave it, along creases, fall back to the bricks.)
   const Eigen::Vector3d offset = goal - proxy_;
   const bool pressing = previous_contacts_ > 0 && offset.dot(last_normal) < 0;
-  collider.gather(proxy_, offset.norm() + radius_ + 4 * collider.voxel_radius(), patch_);
+  collider.gather(proxy_ + 0.5 * offset,
+                  0.5 * offset.norm() + radius_ + 4 * collider.voxel_radius(), patch_);
   const SurfacePatch& patch = patch_;
   normal_cache_.clear();
   for (int sweep = 0; sweep < kMaxSweeps; ++sweep) {

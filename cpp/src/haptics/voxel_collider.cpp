@@ -17,16 +17,22 @@ __attribute__((target_clones("avx2", "default"))) void entry_fractions(
     const double* x, const double* y, const double* z, std::size_t n, double ax, double ay,
     double az, double dx, double dy, double dz, double length, double R, double* out) {
   const double R2 = R * R, inv_length = length > 0 ? 1.0 / length : 0.0;
-  const bool still = length <= 0;
+  // Still: touching blocks nothing. (One simple select per condition, so the loop has no branches
+  // and vectorises.)
+  const double blocked_touch = length <= 0 ? 2.0 : 0.0;
+  const double moves = length <= 0 ? 0.0 : 1.0;
   for (std::size_t i = 0; i < n; ++i) {
     const double mx = ax - x[i], my = ay - y[i], mz = az - z[i];
     const double c2 = mx * mx + my * my + mz * mz - R2;
     const double bd = mx * dx + my * dy + mz * dz;
     const double disc = bd * bd - c2;
-    const double enter_at = (-bd - std::sqrt(disc > 0 ? disc : 0.0)) * inv_length;
-    const double touching = (still || bd < 0) ? 0.0 : 2.0;
-    const double moving = (still || bd >= 0 || disc < 0 || enter_at > 1.0) ? 2.0 : enter_at;
-    out[i] = c2 <= 0 ? touching : moving;
+    const double enter_at = (-bd - std::sqrt(std::max(disc, 0.0))) * inv_length;
+    double moving = disc >= 0.0 ? enter_at : 2.0;
+    moving = moving <= 1.0 ? moving : 2.0;
+    moving = bd < 0.0 ? moving : 2.0;
+    moving = moves > 0.0 ? moving : 2.0;
+    const double touching = bd < 0.0 ? blocked_touch : 2.0;
+    out[i] = c2 <= 0.0 ? touching : moving;
   }
 }
 

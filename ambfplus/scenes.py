@@ -16,11 +16,19 @@ PAPER_FOV_Y = 2.0 * math.atan(240.0 / PAPER_FOCAL_PX)
 
 def add_drill(world: World, tip: tuple[float, float, float], direction, burr_radius: float = 0.003):
     """A drill built from primitives: a burr at `tip`, a shaft and a handle along `direction`
-    (from the tip towards the surgeon's hand). Returns the burr, shaft and handle bodies."""
+    (from the tip towards the surgeon's hand), kinematic (held by the hand, not by gravity).
+    Returns the burr, shaft and handle bodies."""
     tip_pose = make_pose(tip, rotation=rotation_between((0, 0, 1), direction))
     grey = (0.72, 0.74, 0.8)
     burr = world.add_body(
-        "burr", "sphere", radius=burr_radius, pose=tip_pose, mass=0.01, color=grey, specular=0.6
+        "burr",
+        "sphere",
+        radius=burr_radius,
+        pose=tip_pose,
+        mass=0.01,
+        kinematic=True,
+        color=grey,
+        specular=0.6,
     )
     shaft = world.add_body(
         "shaft",
@@ -28,6 +36,7 @@ def add_drill(world: World, tip: tuple[float, float, float], direction, burr_rad
         radius=0.0012,
         height=0.06,
         mass=0.02,
+        kinematic=True,
         pose=tip_pose @ make_pose((0, 0, 0.03)),
         color=grey,
         specular=0.6,
@@ -38,6 +47,7 @@ def add_drill(world: World, tip: tuple[float, float, float], direction, burr_rad
         radius=0.006,
         height=0.08,
         mass=0.2,
+        kinematic=True,
         pose=tip_pose @ make_pose((0, 0, 0.1)),
         color=(0.2, 0.45, 0.75),
     )

@@ -22,6 +22,9 @@ void register_scene(pybind11::module_& m);
 namespace ambfplus {
 class Camera;
 class Drill;
+class Joint;
+class RigidBody;
+struct RigidBodySpec;
 class Model;
 class Object;
 class Volume;
@@ -36,12 +39,24 @@ namespace ambfplus::bindings {
 /// (refilled in place) or a dict of preallocated arrays {"rgb": ..., "depth": ...}.
 pybind11::object capture(Camera& camera, pybind11::object out);
 
+/// add_body's physics keywords (inertia, friction, kinematic, collision_*, groups, axis, ...).
+void apply_body_options(RigidBodySpec& spec, const pybind11::kwargs& kw);
+
+/// add_joint(name, parent, child, type, **options) for World and Model.
+Joint& add_joint(Model& model, const std::string& name, RigidBody& parent, RigidBody& child,
+                 const std::string& type, const pybind11::kwargs& kw);
+
 /// add_drill(name, volume, **options) for World and Model.
 Drill& add_drill(Model& model, const std::string& name, Volume& volume, const pybind11::kwargs& kw);
 
 /// The Drill class's methods (the class itself is declared with the scene's).
 void register_haptics(pybind11::module_& m,
                       pybind11::class_<Drill, Object, std::shared_ptr<Drill>>& drill);
+
+/// The physics side of RigidBody and the Joint class's methods.
+void register_physics(pybind11::module_& m,
+                      pybind11::class_<RigidBody, Object, std::shared_ptr<RigidBody>>& body,
+                      pybind11::class_<Joint, Object, std::shared_ptr<Joint>>& joint);
 
 /// A ray hit as dict(distance, position, normal, label), or None when it missed.
 pybind11::object hit_dict(const VolumeHit& hit);

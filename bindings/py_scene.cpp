@@ -32,6 +32,8 @@ py::object to_python(Object* o) {
   switch (o->kind()) {
     case ObjectKind::kRigidBody:
       return py::cast(handle(static_cast<RigidBody*>(o), w));
+    case ObjectKind::kJoint:
+      return py::cast(handle(static_cast<Joint*>(o), w));
     case ObjectKind::kCamera:
       return py::cast(handle(static_cast<Camera*>(o), w));
     case ObjectKind::kLight:
@@ -83,7 +85,8 @@ RigidBody& add_body(Model& model, const std::string& name, const std::string& sh
                     std::optional<Vec3> size, std::optional<double> radius,
                     std::optional<double> height, std::optional<std::string> mesh, double scale,
                     std::optional<Mat4> pose, double mass, std::optional<std::vector<double>> color,
-                    std::optional<double> specular, std::optional<double> shininess) {
+                    std::optional<double> specular, std::optional<double> shininess,
+                    const py::kwargs& physics) {
   RigidBodySpec spec;
   spec.name = name;
   spec.shape.kind = parse_shape_kind(shape.empty() ? (mesh ? "mesh" : "box") : shape);
@@ -133,10 +136,11 @@ RigidBody& add_body(Model& model, const std::string& name, const std::string& sh
     if (scale != 1.0) throw py::value_error("scale applies to mesh bodies only");
   }
   if (pose) spec.pose = *pose;
-  spec.mass = mass;
+  spec.dynamics.mass = mass;
   if (color) spec.material.color = rgba(*color, "color");
   if (specular) spec.material.specular = static_cast<float>(*specular);
   if (shininess) spec.material.shininess = static_cast<float>(*shininess);
+  apply_body_options(spec, physics);
   RigidBody* body = nullptr;
   {
     py::gil_scoped_release release;  // mesh files can take a while to read
@@ -187,10 +191,10 @@ void def_adders(Class& cls, GetModel get_model) {
                      std::optional<double> height, std::optional<std::string> mesh, double scale,
                      std::optional<Mat4> pose, double mass,
                      std::optional<std::vector<double>> color, std::optional<double> specular,
-                     std::optional<double> shininess) {
+                     std::optional<double> shininess, const py::kwargs& physics) {
            Model& model = get_model(self);
            return handle(&add_body(model, name, shape, size, radius, height, mesh, scale, pose,
-                                   mass, color, specular, shininess),
+                                   mass, color, specular, shininess, physics),
                          model.world());
          },
          py::arg("name"), py::arg("shape") = "", py::kw_only(), py::arg("size") = py::none(),
@@ -199,8 +203,26 @@ void def_adders(Class& cls, GetModel get_model) {
          py::arg("mass") = 1.0, py::arg("color") = py::none(), py::arg("specular") = py::none(),
          py::arg("shininess") = py::none(),
          "Adds a rigid body: shape is box (size = full extents), sphere (radius), cylinder, "
-         "capsule or cone (radius, height along z; a capsule's height includes its caps), plane "
-         "(z = 0, infinite) or mesh (mesh = file, scale); pose is a 4x4 world-from-body matrix.")
+         "capsule or cone (radius, height along axis, z unless axis='x' or 'y'; a capsule's "
+         "height includes its caps), plane (z = 0, infinite) or mesh (mesh = file, scale); pose "
+         "is a 4x4 world-from-body matrix. Physics (mass > 0 moves under gravity; 0 is static): "
+         "inertia, inertial_offset (4x4), friction, rolling_friction, restitution, "
+         "linear_damping, angular_damping, kinematic, collision (False: none), collision_mesh, "
+         "collision_type (concave, convex_mesh, convex_hull, point_cloud), collision_shapes "
+         "([{shape, size/radius/height/axis, pose}]), margin, groups ([0..31]).")
+      .def(
+          "add_joint",
+          [get_model](typename Class::type& self, const std::string& name, RigidBody& parent,
+                      RigidBody& child, const std::string& type, const py::kwargs& kw) {
+            Model& model = get_model(self);
+            return handle(&add_joint(model, name, parent, child, type, kw), model.world());
+          },
+          py::arg("name"), py::arg("parent"), py::arg("child"), py::arg("type") = "revolute",
+          "Adds a joint (revolute/hinge/continuous, prismatic/slider, fixed, spring, torsion "
+          "spring, p2p, cone twist, six dof, six dof spring) between two bodies. Keywords: "
+          "parent_pivot, parent_axis, child_pivot, child_axis (each body's frame), offset, "
+          "child_offset, lower, upper, damping, stiffness, equilibrium, max_motor_impulse, erp, "
+          "cfm, controller ({p, i, d, output}), passive, ignore_inter_collision.")
       .def(
           "add_camera",
           [get_model](typename Class::type& self, const std::string& name, int width, int height,
@@ -286,6 +308,8 @@ void register_scene(py::module_& m) {
                                                      "Anything in a world with a unique name.");
   py::class_<RigidBody, Object, std::shared_ptr<RigidBody>> body(
       m, "RigidBody", "A rigid body: a shape with mass and a material.");
+  py::class_<Joint, Object, std::shared_ptr<Joint>> joint(
+      m, "Joint", "A joint between two bodies, with a controller and limits.");
   py::class_<Camera, Object, std::shared_ptr<Camera>> camera(
       m, "Camera", "A pinhole camera; pose is world from camera in the OpenCV frame.");
   py::class_<Light, Object, std::shared_ptr<Light>> light(
@@ -295,6 +319,7 @@ void register_scene(py::module_& m) {
   py::class_<Drill, Object, std::shared_ptr<Drill>> drill(
       m, "Drill", "A burr and shaft of finger-proxy cursors that drills a volume.");
   register_haptics(m, drill);
+  register_physics(m, body, joint);
 
   simulator
       .def(py::init([](double time_step, const std::string& world_name) {
@@ -373,6 +398,9 @@ void register_scene(py::module_& m) {
                              [](World& w) { return to_python_list(w.objects_of_kind<Light>()); })
       .def_property_readonly("volumes",
                              [](World& w) { return to_python_list(w.objects_of_kind<Volume>()); })
+      .def_property("gravity", &World::gravity, &World::set_gravity, "m/s^2, world frame")
+      .def_property_readonly("joints",
+                             [](World& w) { return to_python_list(w.objects_of_kind<Joint>()); })
       .def_property_readonly("drills",
                              [](World& w) { return to_python_list(w.objects_of_kind<Drill>()); })
       .def(

@@ -58,4 +58,33 @@ add_library(ambfplus_dep_zlib INTERFACE)
 target_link_libraries(ambfplus_dep_zlib INTERFACE ZLIB::ZLIB)
 add_library(ambfplus::dep_zlib ALIAS ambfplus_dep_zlib)
 
+# Bullet: rigid and soft body physics. Debian's BulletConfig.cmake carries relative paths, so
+# pkg-config it is (`bullet`: the single-precision build). Float and double builds mangle
+# differently, so a link test catches headers and libraries that disagree at configure time.
+pkg_check_modules(BULLET REQUIRED IMPORTED_TARGET bullet)
+add_library(ambfplus_dep_bullet INTERFACE)
+target_link_libraries(ambfplus_dep_bullet INTERFACE PkgConfig::BULLET)
+add_library(ambfplus::dep_bullet ALIAS ambfplus_dep_bullet)
+include(CheckCXXSourceCompiles)
+set(CMAKE_REQUIRED_INCLUDES ${BULLET_INCLUDE_DIRS})
+set(CMAKE_REQUIRED_LIBRARIES PkgConfig::BULLET)
+check_cxx_source_compiles([=[
+#include <btBulletDynamicsCommon.h>
+#include <BulletSoftBody/btSoftRigidDynamicsWorld.h>
+int main() {
+  btDefaultCollisionConfiguration config;
+  btCollisionDispatcher dispatcher(&config);
+  btDbvtBroadphase broadphase;
+  btSequentialImpulseConstraintSolver solver;
+  btDiscreteDynamicsWorld world(&dispatcher, &broadphase, &solver, &config);
+  world.setGravity(btVector3(0, 0, -9.8));
+  return world.stepSimulation(0.001, 1, 0.001) == 1 ? 0 : 1;
+}]=] AMBFPLUS_BULLET_LINKS)
+unset(CMAKE_REQUIRED_INCLUDES)
+unset(CMAKE_REQUIRED_LIBRARIES)
+if(NOT AMBFPLUS_BULLET_LINKS)
+  message(FATAL_ERROR "Bullet's headers and libraries do not link together (a double-precision "
+    "build where the single-precision one is expected?). Install libbullet-dev (Debian).")
+endif()
+
 find_package(Threads REQUIRED)

@@ -26,6 +26,7 @@ TEST(Render, FrontalFaceHasExactDepthAndFrameCarriesTime) {
   RigidBodySpec box;
   box.name = "box";
   box.shape.size = {0.4, 0.4, 0.2};
+  box.dynamics.mass = 0;  // static: it must not fall while the clock runs
   world.default_model().add_body(box);
   CameraSpec spec;
   spec.name = "cam";

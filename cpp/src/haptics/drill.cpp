@@ -134,6 +134,7 @@ void Drill::set_waypoints(const std::vector<DrillWaypoint>& waypoints) {
 }
 
 void Drill::attach(RigidBody& body, const Eigen::Isometry3d& offset) {
+  body.set_kinematic(true);  // the drill carries it
   attached_.emplace_back(&body, offset);
   body.set_pose(pose() * offset);
   objects_seen_ = 0;  // rebuild the mesh collider without it

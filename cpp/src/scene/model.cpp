@@ -1,6 +1,7 @@
 #include "ambfplus/scene/model.h"
 
 #include "ambfplus/scene/world.h"
+#include "physics/physics_world.h"
 
 #include <stdexcept>
 #include <string>
@@ -22,8 +23,18 @@ T& Model::adopt(std::unique_ptr<T> object) {
 
 RigidBody& Model::add_body(const RigidBodySpec& spec) {
   const int id = world_->claim_name(spec.name, "body");
-  // The constructor loads or builds geometry and may throw; nothing is registered before that.
-  return adopt(std::unique_ptr<RigidBody>(new RigidBody(*this, spec, id)));
+  // The constructor loads or builds geometry and may throw, as may physics; nothing is
+  // registered before both succeed.
+  std::unique_ptr<RigidBody> body(new RigidBody(*this, spec, id));
+  world_->physics().add(*body);
+  return adopt(std::move(body));
+}
+
+Joint& Model::add_joint(const JointSpec& spec) {
+  const int id = world_->claim_name(spec.name, "joint");
+  std::unique_ptr<Joint> joint(new Joint(*this, spec, id));
+  world_->physics().add(*joint);
+  return adopt(std::move(joint));
 }
 
 Camera& Model::add_camera(const CameraSpec& spec) {

@@ -12,6 +12,8 @@ const char* object_kind_name(ObjectKind kind) {
   switch (kind) {
     case ObjectKind::kRigidBody:
       return "body";
+    case ObjectKind::kJoint:
+      return "joint";
     case ObjectKind::kCamera:
       return "camera";
     case ObjectKind::kLight:

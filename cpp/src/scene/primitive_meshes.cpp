@@ -152,20 +152,39 @@ MeshData plane() {
   return m;
 }
 
+// Turns a mesh built along z onto axis 0 (x) or 1 (y): a cyclic permutation of the coordinates,
+// which is a rotation.
+MeshData along_axis(MeshData m, int axis) {
+  if (axis == 2) return m;
+  const int shift = axis == 0 ? 1 : 2;  // z -> x: (x, y, z) -> (z, x, y)
+  auto turn = [&](std::vector<float>& v, int stride) {
+    for (std::size_t i = 0; i + 2 < v.size(); i += stride) {
+      const float p[3] = {v[i], v[i + 1], v[i + 2]};
+      for (int a = 0; a < 3; ++a) v[i + a] = p[(a + 3 - shift) % 3];
+    }
+  };
+  turn(m.positions, m.position_size);
+  turn(m.normals, 3);
+  return m;
+}
+
 }  // namespace
 
 MeshData make_primitive_mesh(const Shape& shape) {
+  if (shape.axis < 0 || shape.axis > 2) {
+    throw std::invalid_argument("shape axis must be 0 (x), 1 (y) or 2 (z)");
+  }
   switch (shape.kind) {
     case Shape::Kind::kBox:
       return box(shape.size);
     case Shape::Kind::kSphere:
       return sphere(shape.radius);
     case Shape::Kind::kCylinder:
-      return cylinder(shape.radius, shape.height);
+      return along_axis(cylinder(shape.radius, shape.height), shape.axis);
     case Shape::Kind::kCapsule:
-      return capsule(shape.radius, shape.height);
+      return along_axis(capsule(shape.radius, shape.height), shape.axis);
     case Shape::Kind::kCone:
-      return cone(shape.radius, shape.height);
+      return along_axis(cone(shape.radius, shape.height), shape.axis);
     case Shape::Kind::kPlane:
       return plane();
     case Shape::Kind::kMesh:

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "physics/physics_world.h"  // (the Bullet body it may own on the way out)
 #include "scene/primitive_meshes.h"
 #include "util/strings.h"
 
@@ -13,6 +14,39 @@ void require_positive(double value, const char* what, const std::string& body) {
   if (!(value > 0.0) || !std::isfinite(value)) {
     throw std::invalid_argument("body '" + body + "': " + what + " must be > 0, got " +
                                 std::to_string(value));
+  }
+}
+
+// Throws unless the shape's dimensions make sense.
+void check_shape(const Shape& shape, const std::string& name) {
+  switch (shape.kind) {
+    case Shape::Kind::kBox:
+      for (int i = 0; i < 3; ++i) require_positive(shape.size[i], "every box size", name);
+      break;
+    case Shape::Kind::kSphere:
+      require_positive(shape.radius, "radius", name);
+      break;
+    case Shape::Kind::kCylinder:
+    case Shape::Kind::kCone:
+      require_positive(shape.radius, "radius", name);
+      require_positive(shape.height, "height", name);
+      break;
+    case Shape::Kind::kCapsule:
+      require_positive(shape.radius, "radius", name);
+      if (!(shape.height >= 2 * shape.radius)) {
+        throw std::invalid_argument("body '" + name +
+                                    "': a capsule's height includes its caps, so it must be >= "
+                                    "2 * radius");
+      }
+      break;
+    case Shape::Kind::kPlane:
+      break;
+    case Shape::Kind::kMesh:
+      if (shape.mesh.empty()) {
+        throw std::invalid_argument("body '" + name + "': a mesh shape needs a mesh file");
+      }
+      require_positive(shape.scale, "scale", name);
+      break;
   }
 }
 
@@ -51,41 +85,55 @@ const char* shape_kind_name(Shape::Kind kind) {
   return "?";
 }
 
+MeshCollision parse_mesh_collision(const std::string& name) {
+  const std::string n = to_lower(name);
+  if (n == "concave_mesh" || n == "trimesh" || n == "concave") return MeshCollision::kConcave;
+  if (n == "convex_mesh") return MeshCollision::kConvexMesh;
+  if (n == "convex_hull" || n == "hull") return MeshCollision::kConvexHull;
+  if (n == "point_cloud") return MeshCollision::kPointCloud;
+  throw std::invalid_argument("unknown collision mesh type '" + name +
+                              "': expected CONCAVE_MESH, TRIMESH, CONVEX_MESH, CONVEX_HULL, hull "
+                              "or POINT_CLOUD");
+}
+
 RigidBody::RigidBody(Model& model, const RigidBodySpec& spec, int id)
-    : Object(model, spec.name, id), shape_(spec.shape), mass_(spec.mass), material_(spec.material) {
+    : Object(model, spec.name, id),
+      shape_(spec.shape),
+      dynamics_(spec.dynamics),
+      collision_(spec.collision),
+      material_(spec.material) {
   const std::string& name = spec.name;
-  if (!(mass_ >= 0.0) || !std::isfinite(mass_)) {
+  const double mass = dynamics_.mass;
+  if (!(mass >= 0.0) || !std::isfinite(mass)) {
     throw std::invalid_argument("body '" + name + "': mass must be >= 0 kg, got " +
-                                std::to_string(mass_));
+                                std::to_string(mass));
   }
-  switch (shape_.kind) {
-    case Shape::Kind::kBox:
-      for (int i = 0; i < 3; ++i) require_positive(shape_.size[i], "every box size", name);
-      break;
-    case Shape::Kind::kSphere:
-      require_positive(shape_.radius, "radius", name);
-      break;
-    case Shape::Kind::kCylinder:
-    case Shape::Kind::kCone:
-      require_positive(shape_.radius, "radius", name);
-      require_positive(shape_.height, "height", name);
-      break;
-    case Shape::Kind::kCapsule:
-      require_positive(shape_.radius, "radius", name);
-      if (!(shape_.height >= 2 * shape_.radius)) {
-        throw std::invalid_argument("body '" + name +
-                                    "': a capsule's height includes its caps, so it must be >= "
-                                    "2 * radius");
-      }
-      break;
-    case Shape::Kind::kPlane:
-      break;
-    case Shape::Kind::kMesh:
-      if (shape_.mesh.empty()) {
-        throw std::invalid_argument("body '" + name + "': a mesh shape needs a mesh file");
-      }
-      require_positive(shape_.scale, "scale", name);
-      break;
+  const Dynamics& d = dynamics_;
+  for (double v : {d.static_friction, d.rolling_friction}) {
+    if (!(v >= 0) || !std::isfinite(v)) {
+      throw std::invalid_argument("body '" + name + "': friction must be >= 0");
+    }
+  }
+  if (!(d.restitution >= 0 && d.restitution <= 1)) {
+    throw std::invalid_argument("body '" + name + "': restitution must be in 0..1");
+  }
+  if (!(d.linear_damping >= 0 && d.linear_damping <= 1) ||
+      !(d.angular_damping >= 0 && d.angular_damping <= 1)) {
+    throw std::invalid_argument("body '" + name + "': damping must be in 0..1");
+  }
+  if (!(collision_.margin >= 0) || !std::isfinite(collision_.margin)) {
+    throw std::invalid_argument("body '" + name + "': collision margin must be >= 0");
+  }
+  if (shape_.axis < 0 || shape_.axis > 2) {
+    throw std::invalid_argument("body '" + name + "': axis must be 0 (x), 1 (y) or 2 (z)");
+  }
+  check_shape(shape_, name);
+  for (const auto& [part, pose] : collision_.shapes) {
+    if (part.kind == Shape::Kind::kMesh || part.kind == Shape::Kind::kPlane) {
+      throw std::invalid_argument("body '" + name + "': compound parts must be primitives");
+    }
+    check_shape(part, name);
+    checked_pose(pose);
   }
   set_pose(checked_pose(spec.pose));
   visual_mesh_ = std::make_shared<const MeshData>(shape_.kind == Shape::Kind::kMesh

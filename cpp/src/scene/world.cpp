@@ -1,5 +1,7 @@
 #include "ambfplus/scene/world.h"
 
+#include "physics/physics_world.h"
+
 #include <cmath>
 #include <stdexcept>
 
@@ -8,12 +10,24 @@
 namespace ambfplus {
 
 World::World(Simulator& simulator, std::string name, double time_step)
-    : simulator_(&simulator), name_(std::move(name)), time_step_(time_step) {
+    : simulator_(&simulator),
+      name_(std::move(name)),
+      time_step_(time_step),
+      physics_(std::make_unique<physics::PhysicsWorld>()) {
   models_.push_back(std::unique_ptr<Model>(new Model(*this, name_)));
 }
 
-// The renderer releases its GL objects before the objects it drew go away.
-World::~World() { renderer_.reset(); }
+// The renderer releases its GL objects before the objects it drew go away, and Bullet lets go
+// of bodies and joints before they are deleted.
+World::~World() {
+  renderer_.reset();
+  physics_->detach_all();
+  models_.clear();
+}
+
+void World::set_gravity(const Eigen::Vector3d& g) { physics_->set_gravity(g); }
+
+Eigen::Vector3d World::gravity() const { return physics_->gravity(); }
 
 Model& World::add_model(const std::string& name) {
   for (const auto& m : models_) {
@@ -55,12 +69,9 @@ void World::register_object(Object* object) {
 void World::step(std::int64_t n) {
   if (n < 0) throw std::invalid_argument("step count must be >= 0, got " + std::to_string(n));
   const std::vector<Drill*> drills = objects_of_kind<Drill>();
-  if (drills.empty()) {
-    step_index_ += n;
-    return;
-  }
   for (std::int64_t s = 0; s < n; ++s) {
     ++step_index_;
+    physics_->step(time_step_);
     for (Drill* d : drills) d->tick(time_step_, step_index_);
   }
 }

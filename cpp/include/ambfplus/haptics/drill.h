@@ -107,7 +107,8 @@ class AMBFPLUS_API Drill : public Object {
   void set_hardness(std::uint16_t label, double hardness);
   /// Follows these from now on, then holds the last one; an empty list stops following.
   void set_waypoints(const std::vector<DrillWaypoint>& waypoints);
-  /// Bodies that move with the drill (its meshes), at a fixed offset from the drill frame.
+  /// Bodies that move with the drill (its meshes), at a fixed offset from the drill frame; they
+  /// become kinematic.
   void attach(RigidBody& body, const Eigen::Isometry3d& offset = Eigen::Isometry3d::Identity());
 
   /// One haptic step: cursors, force, removal. Called by World::step.

@@ -7,6 +7,7 @@
 #include "ambfplus/export.h"
 #include "ambfplus/haptics/drill.h"
 #include "ambfplus/scene/camera.h"
+#include "ambfplus/scene/joint.h"
 #include "ambfplus/scene/light.h"
 #include "ambfplus/scene/rigid_body.h"
 #include "ambfplus/scene/volume.h"
@@ -31,6 +32,9 @@ class AMBFPLUS_API Model {
   /// Creates a body. Throws std::invalid_argument for a bad spec or a taken name, AssetNotFound
   /// or ConfigError for a mesh that cannot be read.
   RigidBody& add_body(const RigidBodySpec& spec);
+  /// Creates a joint between two bodies of the world. Throws std::invalid_argument for a bad spec
+  /// or a taken name.
+  Joint& add_joint(const JointSpec& spec);
   /// Creates a camera. Throws std::invalid_argument for a bad spec or a taken name.
   Camera& add_camera(const CameraSpec& spec);
   /// Creates a light. Throws std::invalid_argument for a bad spec or a taken name.

@@ -12,9 +12,9 @@ class Model;
 class World;
 
 /// What kind of object a scene object is.
-enum class ObjectKind { kRigidBody, kCamera, kLight, kVolume, kDrill };
+enum class ObjectKind { kRigidBody, kJoint, kCamera, kLight, kVolume, kDrill };
 
-/// Name of an ObjectKind as users see it ("body", "camera", "light", "volume", "drill").
+/// Name of an ObjectKind as users see it ("body", "joint", "camera", "light", "volume", "drill").
 AMBFPLUS_API const char* object_kind_name(ObjectKind kind);
 
 /// Anything that lives in a world under a name unique within that world.

@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
+
 #include "ambfplus/export.h"
 #include "ambfplus/scene/model.h"
 
@@ -14,6 +16,9 @@ namespace ambfplus {
 class Simulator;
 namespace render {
 class SceneRenderer;
+}
+namespace physics {
+class PhysicsWorld;
 }
 
 /// The scene: models and their objects, and the simulation clock.
@@ -48,8 +53,14 @@ class AMBFPLUS_API World {
   double time() const { return static_cast<double>(step_index_) * time_step_; }
   std::int64_t step_index() const { return step_index_; }
 
+  /// Gravity, m/s^2 (AMBF's default: 0, 0, -9.8).
+  void set_gravity(const Eigen::Vector3d& g);
+  Eigen::Vector3d gravity() const;
+
   /// The world's renderer (created on first use; internal to the engine).
   render::SceneRenderer& renderer();
+  /// The world's physics (internal to the engine).
+  physics::PhysicsWorld& physics() { return *physics_; }
 
  private:
   friend class Simulator;
@@ -63,6 +74,8 @@ class AMBFPLUS_API World {
   double time_step_;
   std::int64_t step_index_ = 0;
   int next_id_ = 1;
+  // Before the models: it outlives their bodies and joints.
+  std::unique_ptr<physics::PhysicsWorld> physics_;
   std::vector<std::unique_ptr<Model>> models_;
   std::map<std::string, Object*> by_name_;
   std::vector<Object*> objects_;

@@ -1,0 +1,115 @@
+// RigidBody's physics side: what it asks of Bullet.
+
+#include <stdexcept>
+
+#include "ambfplus/scene/rigid_body.h"
+#include "ambfplus/scene/world.h"
+#include "physics/physics_world.h"
+
+namespace ambfplus {
+namespace {
+
+void check_finite(const Eigen::Vector3d& v, const std::string& body, const char* what) {
+  if (!v.allFinite())
+    throw std::invalid_argument("body '" + body + "': " + what + " must be finite");
+}
+
+}  // namespace
+
+RigidBody::~RigidBody() = default;
+
+void RigidBody::set_pose(const Eigen::Isometry3d& pose) {
+  Object::set_pose(pose);
+  if (!physics_) return;
+  const btTransform t = physics::to_bullet(pose * physics_->offset);
+  btRigidBody& body = *physics_->body;
+  // Kinematic bodies move through their motion state, so Bullet sees their velocity.
+  physics_->motion->setWorldTransform(t);
+  if (!dynamics_.kinematic) {
+    body.setWorldTransform(t);
+    body.setInterpolationWorldTransform(t);
+    body.activate(true);
+  }
+}
+
+void RigidBody::set_kinematic(bool kinematic) {
+  if (kinematic == dynamics_.kinematic) return;
+  if (!kinematic && shape_.kind == Shape::Kind::kPlane && dynamics_.mass > 0) {
+    throw std::invalid_argument("body '" + name() + "': a plane cannot be dynamic");
+  }
+  dynamics_.kinematic = kinematic;
+  if (physics_) {
+    world().physics().refresh(*this);
+    set_pose(pose());
+  }
+}
+
+Eigen::Vector3d RigidBody::linear_velocity() const {
+  const btRigidBody& b = *physics_->body;
+  const Eigen::Vector3d r = pose().translation() - physics::to_eigen(b.getCenterOfMassPosition());
+  return physics::to_eigen(b.getVelocityInLocalPoint(physics::to_bullet(r)));
+}
+
+Eigen::Vector3d RigidBody::angular_velocity() const {
+  return physics::to_eigen(physics_->body->getAngularVelocity());
+}
+
+void RigidBody::set_linear_velocity(const Eigen::Vector3d& v) {
+  check_finite(v, name(), "velocity");
+  btRigidBody& b = *physics_->body;
+  // The centre of mass moves with v less the part the spin adds at the body origin.
+  const Eigen::Vector3d r = pose().translation() - physics::to_eigen(b.getCenterOfMassPosition());
+  const Eigen::Vector3d w = physics::to_eigen(b.getAngularVelocity());
+  b.setLinearVelocity(physics::to_bullet(Eigen::Vector3d(v - w.cross(r))));
+  b.activate(true);
+}
+
+void RigidBody::set_angular_velocity(const Eigen::Vector3d& w) {
+  check_finite(w, name(), "angular velocity");
+  const Eigen::Vector3d v = linear_velocity();
+  physics_->body->setAngularVelocity(physics::to_bullet(w));
+  set_linear_velocity(v);
+}
+
+void RigidBody::set_force(const Eigen::Vector3d& f) {
+  check_finite(f, name(), "force");
+  force_ = f;
+}
+
+void RigidBody::set_torque(const Eigen::Vector3d& t) {
+  check_finite(t, name(), "torque");
+  torque_ = t;
+}
+
+Eigen::Vector3d RigidBody::inertia() const { return physics_->inertia; }
+
+Eigen::Isometry3d RigidBody::inertial_offset() const { return physics_->offset; }
+
+void RigidBody::set_friction(double static_friction, double rolling_friction) {
+  if (!(static_friction >= 0) || !(rolling_friction >= 0)) {
+    throw std::invalid_argument("body '" + name() + "': friction must be >= 0");
+  }
+  dynamics_.static_friction = static_friction;
+  dynamics_.rolling_friction = rolling_friction;
+  physics_->body->setFriction(static_friction);
+  physics_->body->setRollingFriction(rolling_friction);
+}
+
+void RigidBody::set_restitution(double restitution) {
+  if (!(restitution >= 0 && restitution <= 1)) {
+    throw std::invalid_argument("body '" + name() + "': restitution must be in 0..1");
+  }
+  dynamics_.restitution = restitution;
+  physics_->body->setRestitution(restitution);
+}
+
+void RigidBody::set_damping(double linear, double angular) {
+  if (!(linear >= 0 && linear <= 1) || !(angular >= 0 && angular <= 1)) {
+    throw std::invalid_argument("body '" + name() + "': damping must be in 0..1");
+  }
+  dynamics_.linear_damping = linear;
+  dynamics_.angular_damping = angular;
+  physics_->body->setDamping(linear, angular);
+}
+
+}  // namespace ambfplus

@@ -11,6 +11,7 @@ void register_render(pybind11::module_& m);
 void register_capture(pybind11::module_& m);
 void register_volume(pybind11::module_& m);
 void register_scene(pybind11::module_& m);
+void register_adf(pybind11::module_& m);
 
 }  // namespace ambfplus::bindings
 
@@ -19,14 +20,19 @@ void register_scene(pybind11::module_& m);
 #include <optional>
 #include <string>
 
+#include "ambfplus/scene/simulator.h"
+
 namespace ambfplus {
 class Camera;
+class ConstraintActuator;
 class Drill;
 class Joint;
 class RigidBody;
 struct RigidBodySpec;
 class Model;
 class Object;
+class ProximitySensor;
+class SoftBody;
 class Volume;
 class VolumeData;
 struct VolumeHit;
@@ -34,6 +40,16 @@ struct VoxelBox;
 }  // namespace ambfplus
 
 namespace ambfplus::bindings {
+
+/// Every handle given to Python shares ownership of the simulator, so no handle outlives the
+/// objects it points into, whatever order Python drops them in.
+template <typename T>
+std::shared_ptr<T> handle(T* p, World& world) {
+  return std::shared_ptr<T>(world.simulator().shared_from_this(), p);
+}
+
+/// An object as its most derived Python class (None for nullptr).
+pybind11::object to_python(Object* o);
 
 /// Camera.capture(out=None): renders with the GIL released. out may be None (a new Frame), a Frame
 /// (refilled in place) or a dict of preallocated arrays {"rgb": ..., "depth": ...}.
@@ -57,6 +73,21 @@ void register_haptics(pybind11::module_& m,
 void register_physics(pybind11::module_& m,
                       pybind11::class_<RigidBody, Object, std::shared_ptr<RigidBody>>& body,
                       pybind11::class_<Joint, Object, std::shared_ptr<Joint>>& joint);
+
+/// add_soft_body(name, mesh, **options), add_sensor(name, parent, **options) and
+/// add_actuator(name, parent, **options) for World and Model.
+SoftBody& add_soft_body(Model& model, const std::string& name, const std::string& mesh,
+                        const pybind11::kwargs& kw);
+ProximitySensor& add_sensor(Model& model, const std::string& name, RigidBody& parent,
+                            const pybind11::kwargs& kw);
+ConstraintActuator& add_actuator(Model& model, const std::string& name, RigidBody& parent,
+                                 const pybind11::kwargs& kw);
+
+/// The SoftBody, ProximitySensor and ConstraintActuator classes' methods.
+void register_soft(
+    pybind11::module_& m, pybind11::class_<SoftBody, Object, std::shared_ptr<SoftBody>>& soft,
+    pybind11::class_<ProximitySensor, Object, std::shared_ptr<ProximitySensor>>& sensor,
+    pybind11::class_<ConstraintActuator, Object, std::shared_ptr<ConstraintActuator>>& actuator);
 
 /// A ray hit as dict(distance, position, normal, label), or None when it missed.
 pybind11::object hit_dict(const VolumeHit& hit);

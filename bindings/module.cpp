@@ -35,6 +35,7 @@ PYBIND11_MODULE(_core, m) {
   ambfplus::bindings::register_capture(m);
   ambfplus::bindings::register_volume(m);
   ambfplus::bindings::register_scene(m);
+  ambfplus::bindings::register_adf(m);
 
   // Info and above go to Python, whose logging decides what to show (debug only on request, by
   // AMBFPLUS_LOG_LEVEL=debug, since every message takes the GIL).

@@ -1,7 +1,7 @@
 // The engine's typed errors, translated to Python exceptions in this one place:
 //   ambfplus.Error          base of all (an Exception)
 //   ambfplus.ConfigError    (Error, ValueError)        bad scene or data file; .filename
-//   ambfplus.AssetNotFound  (Error, FileNotFoundError) missing file; .filename, .errno
+//   ambfplus.AssetNotFound  (Error, FileNotFoundError) missing file; .filename, .errno, .tried
 //   ambfplus.RenderError    (Error, RuntimeError)
 //   ambfplus.PluginError    (Error, RuntimeError)
 // std::invalid_argument becomes ValueError (pybind11's default).
@@ -10,6 +10,8 @@
 
 #include "ambfplus/errors.h"
 #include "bindings.h"
+
+#include <pybind11/stl.h>
 
 namespace ambfplus::bindings {
 namespace {
@@ -29,12 +31,21 @@ PyObject* g_render_error = nullptr;
 PyObject* g_plugin_error = nullptr;
 
 // Raises type(message) with extra attributes set on the instance.
-void raise_with(PyObject* type, const std::string& message, const char* filename = nullptr,
-                int error_number = 0) {
+pybind11::object with(PyObject* type, const std::string& message, const char* filename = nullptr,
+                      int error_number = 0) {
   pybind11::object instance = pybind11::reinterpret_borrow<pybind11::object>(type)(message);
   if (filename != nullptr) instance.attr("filename") = filename;
-  if (error_number != 0) instance.attr("errno") = error_number;
-  PyErr_SetObject(type, instance.ptr());
+  if (error_number != 0) {
+    // OSError's str() is "[Errno n] strerror: 'filename'": the message goes in strerror.
+    instance.attr("errno") = error_number;
+    instance.attr("strerror") = message;
+  }
+  return instance;
+}
+
+void raise_with(PyObject* type, const std::string& message, const char* filename = nullptr,
+                int error_number = 0) {
+  PyErr_SetObject(type, with(type, message, filename, error_number).ptr());
 }
 
 }  // namespace
@@ -54,7 +65,9 @@ void register_errors(pybind11::module_& m) {
     try {
       if (p) std::rethrow_exception(p);
     } catch (const AssetNotFound& e) {
-      raise_with(g_asset_not_found, e.what(), e.path().c_str(), ENOENT);
+      pybind11::object error = with(g_asset_not_found, e.what(), e.path().c_str(), ENOENT);
+      error.attr("tried") = pybind11::cast(e.tried());
+      PyErr_SetObject(g_asset_not_found, error.ptr());
     } catch (const ConfigError& e) {
       raise_with(g_config_error, e.what(), e.file().empty() ? nullptr : e.file().c_str());
     } catch (const RenderError& e) {

@@ -14,17 +14,6 @@
 namespace py = pybind11;
 
 namespace ambfplus::bindings {
-namespace {
-
-using Vec3 = Eigen::Vector3d;
-using Mat4 = Eigen::Matrix4d;
-
-// Every handle given to Python shares ownership of the simulator, so no handle outlives the
-// objects it points into, whatever order Python drops them in.
-template <typename T>
-std::shared_ptr<T> handle(T* p, World& world) {
-  return std::shared_ptr<T>(world.simulator().shared_from_this(), p);
-}
 
 py::object to_python(Object* o) {
   if (o == nullptr) return py::none();
@@ -42,9 +31,20 @@ py::object to_python(Object* o) {
       return py::cast(handle(static_cast<Volume*>(o), w));
     case ObjectKind::kDrill:
       return py::cast(handle(static_cast<Drill*>(o), w));
+    case ObjectKind::kSoftBody:
+      return py::cast(handle(static_cast<SoftBody*>(o), w));
+    case ObjectKind::kSensor:
+      return py::cast(handle(static_cast<ProximitySensor*>(o), w));
+    case ObjectKind::kActuator:
+      return py::cast(handle(static_cast<ConstraintActuator*>(o), w));
   }
   return py::cast(handle(o, w));
 }
+
+namespace {
+
+using Vec3 = Eigen::Vector3d;
+using Mat4 = Eigen::Matrix4d;
 
 template <typename T>
 py::list to_python_list(const std::vector<T*>& objects) {
@@ -118,6 +118,11 @@ RigidBody& add_body(Model& model, const std::string& name, const std::string& sh
       spec.shape.height = *height;
       break;
     case Shape::Kind::kPlane:
+      reject(size.has_value(), "size", kind);
+      reject(radius.has_value(), "radius", kind);
+      reject(height.has_value(), "height", kind);
+      break;
+    case Shape::Kind::kNone:
       reject(size.has_value(), "size", kind);
       reject(radius.has_value(), "radius", kind);
       reject(height.has_value(), "height", kind);
@@ -286,7 +291,48 @@ void def_adders(Class& cls, GetModel get_model) {
           "Adds a drill working on `volume`. Options: burr_diameters (m), burr (index), cursors, "
           "spacing, shaft_radii, stiffness (N/m), damping, max_force, soft_start, "
           "static_friction, dynamic_friction, removal ('physical' or 'compatible'), "
-          "cutting_rate (m^3/(s N)), voxels_per_step, pose (initial goal, 4x4).");
+          "cutting_rate (m^3/(s N)), voxels_per_step, pose (initial goal, 4x4).")
+      .def(
+          "add_soft_body",
+          [get_model](typename Class::type& self, const std::string& name,
+                      const std::filesystem::path& mesh, const py::kwargs& kw) {
+            Model& model = get_model(self);
+            return handle(&add_soft_body(model, name, mesh.string(), kw), model.world());
+          },
+          py::arg("name"), py::arg("mesh"),
+          "Adds a soft body made from a mesh file (STL, OBJ, ...): nodes at its distinct "
+          "vertices, links along its triangle edges. Keywords: scale, pose (4x4 world from the "
+          "mesh frame), mass (kg, shared evenly), margin (collision margin, m), config (AMBF's "
+          "config block as a dict: kLST, kAST, kVST, kVCF, kDP, kDG, kLF, kPR, kVC, kDF, kMT, "
+          "kCHR, kKHR, kSHR, kAHR, cluster keys, viterations, piterations, diterations, "
+          "citerations, flags, 'bending constraint', clusters, 'fixed nodes'), fixed_nodes, "
+          "randomize_constraints, color, specular, shininess.")
+      .def(
+          "add_sensor",
+          [get_model](typename Class::type& self, const std::string& name, RigidBody& parent,
+                      const py::kwargs& kw) {
+            Model& model = get_model(self);
+            return handle(&add_sensor(model, name, parent, kw), model.world());
+          },
+          py::arg("name"), py::arg("parent"),
+          "Adds a proximity sensor fixed to parent, updated after every physics step. Keywords: "
+          "location (4x4 in the parent's frame) or pose (4x4 world, now), range (m, 0.5), one "
+          "ray by offset and direction (sensor frame, default +x from the origin), or rays "
+          "([{offset, direction}]) or parametric ({resolution, horizontal angle, vertical "
+          "angle, start offset}); a ray reaches offset + direction * range. visible, "
+          "visible_size.")
+      .def(
+          "add_actuator",
+          [get_model](typename Class::type& self, const std::string& name, RigidBody& parent,
+                      const py::kwargs& kw) {
+            Model& model = get_model(self);
+            return handle(&add_actuator(model, name, parent, kw), model.world());
+          },
+          py::arg("name"), py::arg("parent"),
+          "Adds a constraint actuator on parent that holds bodies on request. Keywords: "
+          "location (4x4 in the parent's frame) or pose (4x4 world, now), hold ('fixed': the "
+          "body keeps its pose relative to the actuator, or 'point': only the point is held), "
+          "max_impulse (N s per step, point hold), tau (point hold), visible, visible_size.");
 }
 
 std::string repr_object(const Object& o) {
@@ -320,6 +366,14 @@ void register_scene(py::module_& m) {
       m, "Drill", "A burr and shaft of finger-proxy cursors that drills a volume.");
   register_haptics(m, drill);
   register_physics(m, body, joint);
+  py::class_<SoftBody, Object, std::shared_ptr<SoftBody>> soft_body(
+      m, "SoftBody",
+      "A deformable body: Bullet nodes at a mesh's vertices, links along its edges.");
+  py::class_<ProximitySensor, Object, std::shared_ptr<ProximitySensor>> sensor(
+      m, "ProximitySensor", "Rays fixed to a body reporting the nearest body along each.");
+  py::class_<ConstraintActuator, Object, std::shared_ptr<ConstraintActuator>> actuator(
+      m, "ConstraintActuator", "Holds a body to its parent body on request (a grasp).");
+  register_soft(m, soft_body, sensor, actuator);
 
   simulator
       .def(py::init([](double time_step, const std::string& world_name) {

@@ -370,7 +370,7 @@ def test_drills_declared_in_a_model_file(tmp_path, caplog):
         ("DRILL burr:\n  burr: 1\n", "needs 'volume'"),
         ("DRILL burr:\n  volume: VOLUME other\n", "not one of the file's volumes"),
         ("DRILL burr:\n  volume: slab\n  removal: fast\n", "line 10.*physical or compatible"),
-        ("DRILL burr:\n  volume: slab\n  burr: [1]\n", "line 10.*'burr' has the wrong type"),
+        ("DRILL burr:\n  volume: slab\n  burr: [1]\n", "line 10.*'burr' must be an integer"),
         ("DRILL burr:\n  volume: slab\n  burr diameters: [0.001, -1]\n", "must be > 0"),
         ("", "lists 'DRILL burr' but the file has no block"),
     ],

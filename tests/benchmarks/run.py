@@ -274,6 +274,49 @@ def haptics(args) -> Iterator[dict]:
     }
 
 
+LAUNCH = FIXTURES / "ambf" / "ambf_models" / "descriptions" / "launch.yaml"
+
+
+@benchmark
+def adf(args) -> Iterator[dict]:
+    if not LAUNCH.is_file():
+        print(f"adf: skipped, fixtures not found at {LAUNCH}", file=sys.stderr)
+        return
+    present = [i for i, f in enumerate(ambfplus.read_launch(LAUNCH)["models"]) if Path(f).is_file()]
+    walls, cpus = [], []
+    for _ in range(3 if args.quick else 7):
+        w0, c0 = time.perf_counter(), time.process_time()
+        sim = ambfplus.Simulator.from_launch(LAUNCH, models=present, strict=True)
+        cpus.append(time.process_time() - c0)
+        walls.append(time.perf_counter() - w0)
+        del sim  # meshes are shared only while a loaded scene holds them
+    yield {
+        "bench": "adf_launch_load",
+        "value": round(statistics.median(walls), 4),
+        "unit": "s",
+        "target": 2.0,
+        "cpu_s": round(statistics.median(cpus), 4),
+        "models": present,
+        "what": "fixture launch.yaml: world, environment and every present model, from files",
+    }
+    # Physics of puzzle2 on its floor, one core: simulated seconds per CPU second. The first
+    # 2 s have every piece falling and settling; over 10 s settled pieces sleep.
+    for seconds in (2, 10):
+        sim = ambfplus.Simulator.from_launch(LAUNCH, models=[12], strict=True)
+        c0 = time.process_time()
+        sim.step(seconds * 1000)
+        cpu = time.process_time() - c0
+        yield {
+            "bench": f"adf_puzzle2_realtime_factor_{seconds}s",
+            "value": round(seconds / cpu, 1),
+            "unit": "x real time",
+            "target": 10,
+            "cpu_s": round(cpu, 3),
+            "steps_per_cpu_s": round(seconds * 1000 / cpu),
+            "what": f"puzzle2 + floor, 1 ms steps, first {seconds} s after loading",
+        }
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--only", choices=sorted(BENCHMARKS), help="run one benchmark")

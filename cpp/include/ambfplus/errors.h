@@ -2,6 +2,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "ambfplus/export.h"
 
@@ -31,12 +32,26 @@ class AMBFPLUS_API AssetNotFound : public Error {
  public:
   explicit AssetNotFound(const std::string& path, const std::string& context = "")
       : Error((context.empty() ? std::string() : context + ": ") + "file not found: " + path),
-        path_(path) {}
-  /// The path that was looked for.
+        path_(path),
+        tried_{path} {}
+  /// None of the places a file was looked for holds it; the message lists them all.
+  AssetNotFound(const std::vector<std::string>& tried, const std::string& context)
+      : Error(context + ": file not found; tried " + join(tried)),
+        path_(tried.empty() ? std::string() : tried.front()),
+        tried_(tried) {}
+  /// The path that was looked for (the first, when several were).
   const std::string& path() const { return path_; }
+  /// Every path that was looked for, in order.
+  const std::vector<std::string>& tried() const { return tried_; }
 
  private:
+  static std::string join(const std::vector<std::string>& paths) {
+    std::string out;
+    for (const std::string& p : paths) out += (out.empty() ? "" : ", ") + p;
+    return out;
+  }
   std::string path_;
+  std::vector<std::string> tried_;
 };
 
 /// The renderer cannot do what was asked (no usable EGL device, shader errors, GL errors).

@@ -4,6 +4,8 @@
 
 #include <cmath>
 #include <filesystem>
+#include <map>
+#include <mutex>
 #include <system_error>
 
 #include "ambfplus/errors.h"
@@ -53,6 +55,37 @@ MeshData load_mesh(const std::string& path, double scale) {
   if (mesh.indices.empty()) {
     throw ConfigError(path, "mesh file holds no triangles");
   }
+  return mesh;
+}
+
+std::shared_ptr<const MeshData> load_mesh_shared(const std::string& path, double scale) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path canonical = fs::weakly_canonical(path, ec);
+  const auto stamp = fs::last_write_time(path, ec);
+  const auto bytes = fs::file_size(path, ec);
+  if (ec) return std::make_shared<const MeshData>(load_mesh(path, scale));  // it says why
+  struct Entry {
+    fs::file_time_type stamp;
+    std::uintmax_t bytes;
+    std::weak_ptr<const MeshData> mesh;
+  };
+  static std::mutex mutex;
+  static std::map<std::pair<std::string, double>, Entry> cache;
+  const auto key = std::make_pair(canonical.string(), scale);
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    const auto it = cache.find(key);
+    if (it != cache.end() && it->second.stamp == stamp && it->second.bytes == bytes) {
+      if (auto mesh = it->second.mesh.lock()) return mesh;
+    }
+  }
+  auto mesh = std::make_shared<const MeshData>(load_mesh(path, scale));
+  std::lock_guard<std::mutex> lock(mutex);
+  for (auto it = cache.begin(); it != cache.end();) {
+    it = it->second.mesh.expired() ? cache.erase(it) : std::next(it);
+  }
+  cache[key] = Entry{stamp, bytes, mesh};
   return mesh;
 }
 

@@ -29,6 +29,8 @@ void RigidBody::set_pose(const Eigen::Isometry3d& pose) {
     body.setWorldTransform(t);
     body.setInterpolationWorldTransform(t);
     body.activate(true);
+    // Ray tests see the body's new place before the next step.
+    if (physics_->world != nullptr) physics_->world->updateSingleAabb(&body);
   }
 }
 
@@ -110,6 +112,12 @@ void RigidBody::set_damping(double linear, double angular) {
   dynamics_.linear_damping = linear;
   dynamics_.angular_damping = angular;
   physics_->body->setDamping(linear, angular);
+}
+
+void RigidBody::ignore_collisions_with(RigidBody& other) {
+  if (!physics_ || !other.physics_ || &other == this) return;
+  physics_->body->setIgnoreCollisionCheck(other.physics_->body.get(), true);
+  other.physics_->body->setIgnoreCollisionCheck(physics_->body.get(), true);
 }
 
 }  // namespace ambfplus

@@ -6,8 +6,10 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "ambfplus/scene/constraint_actuator.h"
 #include "ambfplus/scene/joint.h"
 #include "ambfplus/scene/rigid_body.h"
+#include "ambfplus/scene/soft_body.h"
 #include "physics/shapes.h"
 
 namespace ambfplus {
@@ -26,8 +28,13 @@ struct GroupFilter : btOverlapFilterCallback {
     }
     const auto* oa = static_cast<const btCollisionObject*>(a->m_clientObject);
     const auto* ob = static_cast<const btCollisionObject*>(b->m_clientObject);
-    const auto* ba = oa ? static_cast<const Body*>(oa->getUserPointer()) : nullptr;
-    const auto* bb = ob ? static_cast<const Body*>(ob->getUserPointer()) : nullptr;
+    // Only rigid bodies carry a Body (soft bodies are in no group).
+    const auto* ba = oa && oa->getInternalType() == btCollisionObject::CO_RIGID_BODY
+                         ? static_cast<const Body*>(oa->getUserPointer())
+                         : nullptr;
+    const auto* bb = ob && ob->getInternalType() == btCollisionObject::CO_RIGID_BODY
+                         ? static_cast<const Body*>(ob->getUserPointer())
+                         : nullptr;
     if (ba == nullptr || bb == nullptr || ba->groups == 0 || bb->groups == 0) return true;
     return (ba->groups & bb->groups) != 0;
   }
@@ -125,6 +132,21 @@ void PhysicsWorld::detach_all() {
       b->world = nullptr;
     }
   }
+  // What is left are actuators' holds; then the soft bodies.
+  for (int i = world_->getNumConstraints() - 1; i >= 0; --i) {
+    btTypedConstraint* t = world_->getConstraint(i);
+    if (t->getUserConstraintPtr() != reinterpret_cast<void*>(-1) &&
+        t->getUserConstraintPtr() != nullptr) {
+      static_cast<Constraint*>(t->getUserConstraintPtr())->world = nullptr;
+    }
+    world_->removeConstraint(t);
+  }
+  btSoftBodyArray& softs = world_->getSoftBodyArray();
+  while (softs.size() > 0) {
+    btSoftBody* sb = softs[softs.size() - 1];
+    static_cast<SoftBody*>(sb->getUserPointer())->physics_soft()->world = nullptr;
+    world_->removeSoftBody(sb);
+  }
   joints_.clear();
   bodies_.clear();
 }
@@ -137,22 +159,50 @@ void PhysicsWorld::set_gravity(const Eigen::Vector3d& g) {
 
 Eigen::Vector3d PhysicsWorld::gravity() const { return to_eigen(world_->getGravity()); }
 
+void PhysicsWorld::remove(RigidBody& rb) {
+  bodies_.erase(std::remove(bodies_.begin(), bodies_.end(), &rb), bodies_.end());
+  // Actuators let go of it (or of the body their parent holds) while it still exists.
+  const btRigidBody* bullet_body = rb.physics_body() ? rb.physics_body()->body.get() : nullptr;
+  for (int i = world_->getNumConstraints() - 1; i >= 0; --i) {
+    btTypedConstraint* t = world_->getConstraint(i);
+    void* user = t->getUserConstraintPtr();
+    if (user == reinterpret_cast<void*>(-1) || user == nullptr) continue;
+    ConstraintActuator* a = static_cast<Constraint*>(user)->actuator;
+    if (a != nullptr &&
+        (&t->getRigidBodyA() == bullet_body || &t->getRigidBodyB() == bullet_body)) {
+      a->deactuate();
+    }
+  }
+}
+
+void PhysicsWorld::remove(Joint& joint) {
+  joints_.erase(std::remove(joints_.begin(), joints_.end(), &joint), joints_.end());
+  // Its constraint leaves Bullet now, while both bodies still exist.
+  if (physics::Constraint* c = joint.constraint()) {
+    if (c->world != nullptr && c->constraint) c->world->removeConstraint(c->constraint.get());
+    c->world = nullptr;
+  }
+}
+
 void PhysicsWorld::add(RigidBody& rb) {
   const Dynamics& d = rb.dynamics();
-  if (rb.shape().kind == Shape::Kind::kPlane && rb.is_dynamic()) {
+  const bool plane = rb.shape().kind == Shape::Kind::kPlane ||
+                     (rb.collision().shapes.size() == 1 &&
+                      rb.collision().shapes.front().first.kind == Shape::Kind::kPlane);
+  if (plane && rb.is_dynamic()) {
     throw std::invalid_argument("body '" + rb.name() +
                                 "': a plane is infinite, so it must be static (mass 0) or "
                                 "kinematic");
   }
   auto b = std::make_unique<Body>();
   // The collision mesh of a mesh shape: a separate file, or the visual triangles.
-  MeshData separate;
+  std::shared_ptr<const MeshData> separate;
   const MeshData* mesh = nullptr;
   const Collision& c = rb.collision();
   if (rb.shape().kind == Shape::Kind::kMesh && c.enabled && c.shapes.empty()) {
     if (!c.mesh.empty()) {
-      separate = load_mesh(c.mesh, rb.shape().scale);
-      mesh = &separate;
+      separate = load_mesh_shared(c.mesh, rb.shape().scale);
+      mesh = separate.get();
     } else {
       mesh = rb.visual_mesh().get();
     }
@@ -207,6 +257,7 @@ void PhysicsWorld::add(RigidBody& rb) {
                                btCollisionObject::CF_NO_CONTACT_RESPONSE);
   }
   b->groups = c.groups;
+  b->owner = &rb;
   world_->addRigidBody(b->body.get());
   b->world = world_.get();
   rb.physics_ = std::move(b);
@@ -241,7 +292,8 @@ void PhysicsWorld::add(Joint& joint) {
   auto c = std::make_unique<Constraint>();
   const Eigen::Vector3d axis0 = default_axis(s.type);
   c->frame_a = joint_frame(s.parent_pivot, s.parent_axis, s.offset, axis0, pa.offset);
-  c->frame_b = joint_frame(s.child_pivot, s.child_axis, s.child_offset, axis0, pb.offset);
+  // The child's offset turns its frame back, so bodies placed as exported sit at position 0.
+  c->frame_b = joint_frame(s.child_pivot, s.child_axis, -s.child_offset, axis0, pb.offset);
   btRigidBody& a = *pa.body;
   btRigidBody& b = *pb.body;
   switch (s.type) {
@@ -429,9 +481,24 @@ void PhysicsWorld::step(double dt) {
       body.activate();
     }
   }
-  if (!moving) return;  // static and kinematic bodies only: nothing for Bullet to do
+  if (!moving) moving = soft_bodies_move();
+  if (!moving) {
+    // Static and kinematic bodies only: nothing for Bullet to simulate, but kinematic bodies
+    // take their new poses (for ray tests) without a step.
+    for (RigidBody* rb : bodies_) {
+      if (!rb->dynamics().kinematic) continue;
+      btRigidBody& body = *rb->physics_body()->body;
+      btTransform t;
+      rb->physics_body()->motion->getWorldTransform(t);
+      body.setWorldTransform(t);
+      body.setInterpolationWorldTransform(t);
+      world_->updateSingleAabb(&body);
+    }
+    return;
+  }
   for (Joint* j : joints_) apply_joint(*j, dt);
   world_->stepSimulation(dt, 1, dt);
+  sync_soft_bodies();
   for (RigidBody* rb : bodies_) {
     if (!rb->is_dynamic()) continue;
     const Body& b = *rb->physics_body();

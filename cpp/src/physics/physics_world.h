@@ -12,8 +12,10 @@
 
 namespace ambfplus {
 
+class ConstraintActuator;
 class Joint;
 class RigidBody;
+class SoftBody;
 
 namespace physics {
 
@@ -35,6 +37,26 @@ struct Body {
   Eigen::Vector3d inertia = Eigen::Vector3d::Zero();
   std::uint32_t groups = 0;
   btDynamicsWorld* world = nullptr;  // while in one
+  RigidBody* owner = nullptr;        // the scene body (ray hits name it)
+};
+
+/// A soft body's Bullet side (its user pointer is the scene SoftBody).
+struct Soft {
+  ~Soft();
+  std::unique_ptr<btSoftBody> body;
+  btSoftRigidDynamicsWorld* world = nullptr;  // while in one
+  double node_mass = 0.0;                     // of each free node, kg
+};
+
+/// The nearest thing a ray segment met.
+struct RayHit {
+  bool hit = false;
+  double fraction = 1.0;  // along the segment
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  RigidBody* body = nullptr;
+  SoftBody* soft_body = nullptr;
+  int soft_body_node = -1;
 };
 
 /// A joint's Bullet constraint and its frames (in each body's centre-of-mass frame).
@@ -44,6 +66,7 @@ struct Constraint {
   btTransform frame_a, frame_b;
   btDynamicsWorld* world = nullptr;
   double last_position = 0.0;
+  ConstraintActuator* actuator = nullptr;  // an actuator's hold (its user pointer is this)
 };
 
 /// One Bullet world per scene world: bodies, joints, their controllers, a fixed step.
@@ -58,8 +81,17 @@ class PhysicsWorld {
   /// cannot simulate (a dynamic plane).
   void add(RigidBody& body);
   void add(Joint& joint);
+  /// Builds the soft body's nodes, links and faces in Bullet and adds it.
+  void add(SoftBody& body);
+  /// The nearest body along the segment from -> to, skipping `ignore` and bodies without
+  /// collision.
+  RayHit ray_test(const Eigen::Vector3d& from, const Eigen::Vector3d& to,
+                  const RigidBody* ignore) const;
   /// Re-adds a body whose kind (static, kinematic, dynamic) changed.
   void refresh(RigidBody& body);
+  /// Forgets a body or joint about to be deleted (its own destructor takes it out of Bullet).
+  void remove(RigidBody& body);
+  void remove(Joint& joint);
 
   /// Controllers and commands, one Bullet step of dt, then poses back into the scene.
   void step(double dt);
@@ -77,6 +109,10 @@ class PhysicsWorld {
 
  private:
   void apply_joint(Joint& joint, double dt);
+  /// Whether a soft body has a node physics moves.
+  bool soft_bodies_move() const;
+  /// Soft-body nodes back into the scene, and the soft bodies' distance cache trimmed.
+  void sync_soft_bodies();
 
   std::unique_ptr<btSoftBodyRigidBodyCollisionConfiguration> config_;
   std::unique_ptr<btCollisionDispatcher> dispatcher_;

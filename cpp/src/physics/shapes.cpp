@@ -32,6 +32,8 @@ std::unique_ptr<btCollisionShape> primitive(const Shape& s, const std::string& b
       return std::make_unique<btConeShapeZ>(s.radius, s.height);
     case Shape::Kind::kPlane:
       return std::make_unique<btStaticPlaneShape>(btVector3(0, 0, 1), 0);
+    case Shape::Kind::kNone:
+      return std::make_unique<btEmptyShape>();
     case Shape::Kind::kMesh:
       break;
   }
@@ -59,6 +61,13 @@ btCollisionShape* build_shape(Body& out, const RigidBody& rb, const MeshData* me
     return out.shapes.back().get();
   };
   if (!c.enabled) return keep(std::make_unique<btEmptyShape>());
+  if (c.shapes.size() == 1 && c.shapes.front().first.kind == Shape::Kind::kPlane) {
+    // A plane is infinite, so it cannot sit in a compound: its normal and offset take the pose.
+    const Eigen::Matrix4d& pose = c.shapes.front().second;
+    const Eigen::Vector3d normal = pose.topLeftCorner<3, 3>().col(2);
+    const double constant = normal.dot(pose.topRightCorner<3, 1>());
+    return keep(std::make_unique<btStaticPlaneShape>(to_bullet(normal), constant));
+  }
   if (!c.shapes.empty()) {
     auto compound = std::make_unique<btCompoundShape>();
     for (const auto& [part, pose] : c.shapes) {

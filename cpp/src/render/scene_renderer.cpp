@@ -22,11 +22,18 @@ Eigen::Matrix4f to_float(const Eigen::Matrix4d& m) { return m.cast<float>(); }
 SceneRenderer::SceneRenderer(World& world) : world_(world) {}
 
 SceneRenderer::~SceneRenderer() {
-  if ((meshes_.empty() && targets_.empty() && volumes_.empty()) || !Context::exists()) return;
+  if ((meshes_.empty() && soft_meshes_.empty() && targets_.empty() && volumes_.empty()) ||
+      !Context::exists()) {
+    return;
+  }
   try {
     Context::Scope scope;
     volumes_.clear();
     for (auto& [key, m] : meshes_) {
+      glDeleteVertexArrays(1, &m.vao);
+      glDeleteBuffers(3, m.buffers);
+    }
+    for (auto& [key, m] : soft_meshes_) {
       glDeleteVertexArrays(1, &m.vao);
       glDeleteBuffers(3, m.buffers);
     }
@@ -69,6 +76,60 @@ GpuMesh& SceneRenderer::mesh_for(const MeshData* mesh) {
   g.index_count = static_cast<GLsizei>(mesh->indices.size());
   check_gl("uploading a mesh");
   return meshes_.emplace(mesh, g).first->second;
+}
+
+GpuMesh& SceneRenderer::soft_mesh_for(const SoftBody& body) {
+  const std::vector<double>& x = body.node_positions();
+  const std::vector<std::uint32_t>& tri = body.triangles();
+  const std::size_t n = x.size() / 3;
+  // Smooth normals: each node's triangles' normals weighted by their area.
+  soft_scratch_.assign(6 * n, 0.0f);
+  float* positions = soft_scratch_.data();
+  float* normals = positions + 3 * n;
+  for (std::size_t i = 0; i < 3 * n; ++i) positions[i] = static_cast<float>(x[i]);
+  for (std::size_t t = 0; t < tri.size(); t += 3) {
+    const Eigen::Vector3d a(x.data() + 3 * tri[t]), b(x.data() + 3 * tri[t + 1]),
+        c(x.data() + 3 * tri[t + 2]);
+    const Eigen::Vector3f area_normal = (b - a).cross(c - a).cast<float>();
+    for (int k = 0; k < 3; ++k) {
+      Eigen::Map<Eigen::Vector3f>(normals + 3 * tri[t + k]) += area_normal;
+    }
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    Eigen::Map<Eigen::Vector3f> v(normals + 3 * i);
+    const float length = v.norm();
+    if (length > 0) v /= length;
+  }
+
+  auto it = soft_meshes_.find(body.id());
+  if (it == soft_meshes_.end()) {
+    GpuMesh g;
+    glGenVertexArrays(1, &g.vao);
+    glGenBuffers(3, g.buffers);
+    glBindVertexArray(g.vao);
+    glBindBuffer(GL_ARRAY_BUFFER, g.buffers[0]);
+    glBufferData(GL_ARRAY_BUFFER, 3 * n * sizeof(float), nullptr, GL_DYNAMIC_DRAW);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
+    glEnableVertexAttribArray(0);
+    glBindBuffer(GL_ARRAY_BUFFER, g.buffers[1]);
+    glBufferData(GL_ARRAY_BUFFER, 3 * n * sizeof(float), nullptr, GL_DYNAMIC_DRAW);
+    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
+    glEnableVertexAttribArray(1);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g.buffers[2]);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, tri.size() * sizeof(std::uint32_t), tri.data(),
+                 GL_STATIC_DRAW);
+    glBindVertexArray(0);
+    g.index_count = static_cast<GLsizei>(tri.size());
+    it = soft_meshes_.emplace(body.id(), g).first;
+  }
+  const GpuMesh& g = it->second;
+  glBindBuffer(GL_ARRAY_BUFFER, g.buffers[0]);
+  glBufferSubData(GL_ARRAY_BUFFER, 0, 3 * n * sizeof(float), positions);
+  glBindBuffer(GL_ARRAY_BUFFER, g.buffers[1]);
+  glBufferSubData(GL_ARRAY_BUFFER, 0, 3 * n * sizeof(float), normals);
+  glBindBuffer(GL_ARRAY_BUFFER, 0);
+  check_gl("uploading a soft body's nodes");
+  return it->second;
 }
 
 RenderTarget& SceneRenderer::target_for(const Camera& camera) {
@@ -146,20 +207,25 @@ void SceneRenderer::draw(const Camera& camera) {
   const GLint u_specular = program.uniform("u_specular");
   const GLint u_shininess = program.uniform("u_shininess");
 
-  for (const RigidBody* body : world_.objects_of_kind<RigidBody>()) {
-    const GpuMesh& mesh = mesh_for(body->visual_mesh().get());
-    // Composed in double, then rounded once, to keep depth exact far from the origin.
-    const Eigen::Isometry3d model_view = camera_from_world * body->pose();
+  auto draw = [&](const GpuMesh& mesh, const Eigen::Isometry3d& model_view, const Material& m) {
+    if (mesh.index_count == 0) return;  // an anchor without geometry
     const Eigen::Matrix4f mv = to_float(model_view.matrix());
     const Eigen::Matrix3f normal = model_view.linear().cast<float>();
     glUniformMatrix4fv(u_model_view, 1, GL_FALSE, mv.data());
     glUniformMatrix3fv(u_normal_matrix, 1, GL_FALSE, normal.data());
-    const Material& m = body->material();
     glUniform4fv(u_color, 1, m.color.data());
     glUniform1f(u_specular, m.specular);
     glUniform1f(u_shininess, m.shininess);
     glBindVertexArray(mesh.vao);
     glDrawElements(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr);
+  };
+  for (const RigidBody* body : world_.objects_of_kind<RigidBody>()) {
+    // Composed in double, then rounded once, to keep depth exact far from the origin.
+    draw(mesh_for(body->visual_mesh().get()), camera_from_world * body->pose(), body->material());
+  }
+  // Soft bodies: their nodes are in the world frame.
+  for (const SoftBody* body : world_.objects_of_kind<SoftBody>()) {
+    draw(soft_mesh_for(*body), camera_from_world, body->material());
   }
   glBindVertexArray(0);
   // Volumes after the meshes: their rays write depth, so each pixel keeps the nearer surface.

@@ -4,10 +4,12 @@
 
 #include <map>
 #include <memory>
+#include <vector>
 
 #include "ambfplus/scene/camera.h"
 
 namespace ambfplus {
+class SoftBody;
 class World;
 class VolumeData;
 struct MeshData;
@@ -54,10 +56,14 @@ class SceneRenderer {
 
  private:
   GpuMesh& mesh_for(const MeshData* mesh);
+  /// The soft body's GPU mesh, its vertices refreshed from the nodes (normals recomputed).
+  GpuMesh& soft_mesh_for(const SoftBody& body);
   RenderTarget& target_for(const Camera& camera);
 
   World& world_;
   std::map<const MeshData*, GpuMesh> meshes_;
+  std::map<int, GpuMesh> soft_meshes_;   // by soft body id; vertices change every frame
+  std::vector<float> soft_scratch_;      // positions then normals of one soft body
   std::map<int, RenderTarget> targets_;  // by camera id
   std::map<const VolumeData*, std::unique_ptr<GpuVolume>> volumes_;
 };

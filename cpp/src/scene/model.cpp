@@ -64,4 +64,24 @@ Drill& Model::add_drill(const DrillSpec& spec) {
   return adopt(std::unique_ptr<Drill>(new Drill(*this, spec, id)));
 }
 
+SoftBody& Model::add_soft_body(const SoftBodySpec& spec) {
+  const int id = world_->claim_name(spec.name, "soft body");
+  // The constructor reads the mesh and may throw; nothing is registered before physics succeeds.
+  std::unique_ptr<SoftBody> body(new SoftBody(*this, spec, id));
+  world_->physics().add(*body);
+  return adopt(std::move(body));
+}
+
+ProximitySensor& Model::add_sensor(const ProximitySensorSpec& spec) {
+  const int id = world_->claim_name(spec.name, "sensor");
+  std::unique_ptr<ProximitySensor> sensor(new ProximitySensor(*this, spec, id));
+  sensor->update();
+  return adopt(std::move(sensor));
+}
+
+ConstraintActuator& Model::add_actuator(const ConstraintActuatorSpec& spec) {
+  const int id = world_->claim_name(spec.name, "actuator");
+  return adopt(std::unique_ptr<ConstraintActuator>(new ConstraintActuator(*this, spec, id)));
+}
+
 }  // namespace ambfplus

@@ -22,6 +22,12 @@ const char* object_kind_name(ObjectKind kind) {
       return "volume";
     case ObjectKind::kDrill:
       return "drill";
+    case ObjectKind::kSoftBody:
+      return "soft body";
+    case ObjectKind::kSensor:
+      return "sensor";
+    case ObjectKind::kActuator:
+      return "actuator";
   }
   return "object";
 }
@@ -32,6 +38,19 @@ Object::Object(Model& model, std::string name, int id)
 Object::~Object() = default;
 
 World& Object::world() const { return model_->world(); }
+
+void Object::attach_to(const Object* parent, const Eigen::Isometry3d& local) {
+  for (const Object* p = parent; p != nullptr; p = p->attached_to_) {
+    if (p == this) throw std::invalid_argument("'" + name_ + "' cannot ride on itself");
+  }
+  attached_to_ = parent;
+  local_ = local;
+  follow_parent();
+}
+
+void Object::follow_parent() {
+  if (attached_to_ != nullptr) set_pose(attached_to_->pose() * local_);
+}
 
 Eigen::Isometry3d checked_pose(const Eigen::Matrix4d& m, double tol) {
   if (!m.allFinite()) throw std::invalid_argument("pose has non-finite entries");

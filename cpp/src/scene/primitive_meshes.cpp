@@ -187,6 +187,8 @@ MeshData make_primitive_mesh(const Shape& shape) {
       return along_axis(cone(shape.radius, shape.height), shape.axis);
     case Shape::Kind::kPlane:
       return plane();
+    case Shape::Kind::kNone:
+      return MeshData{};
     case Shape::Kind::kMesh:
       break;
   }

@@ -40,6 +40,7 @@ void check_shape(const Shape& shape, const std::string& name) {
       }
       break;
     case Shape::Kind::kPlane:
+    case Shape::Kind::kNone:
       break;
     case Shape::Kind::kMesh:
       if (shape.mesh.empty()) {
@@ -61,8 +62,10 @@ Shape::Kind parse_shape_kind(const std::string& name) {
   if (n == "cone") return Shape::Kind::kCone;
   if (n == "plane") return Shape::Kind::kPlane;
   if (n == "mesh") return Shape::Kind::kMesh;
-  throw std::invalid_argument("unknown shape '" + name +
-                              "': expected box, sphere, cylinder, capsule, cone, plane or mesh");
+  if (n == "none") return Shape::Kind::kNone;
+  throw std::invalid_argument(
+      "unknown shape '" + name +
+      "': expected box, sphere, cylinder, capsule, cone, plane, mesh or none");
 }
 
 const char* shape_kind_name(Shape::Kind kind) {
@@ -81,6 +84,8 @@ const char* shape_kind_name(Shape::Kind kind) {
       return "plane";
     case Shape::Kind::kMesh:
       return "mesh";
+    case Shape::Kind::kNone:
+      return "none";
   }
   return "?";
 }
@@ -121,6 +126,7 @@ RigidBody::RigidBody(Model& model, const RigidBodySpec& spec, int id)
       !(d.angular_damping >= 0 && d.angular_damping <= 1)) {
     throw std::invalid_argument("body '" + name + "': damping must be in 0..1");
   }
+  if (shape_.kind == Shape::Kind::kNone && collision_.shapes.empty()) collision_.enabled = false;
   if (!(collision_.margin >= 0) || !std::isfinite(collision_.margin)) {
     throw std::invalid_argument("body '" + name + "': collision margin must be >= 0");
   }
@@ -129,16 +135,18 @@ RigidBody::RigidBody(Model& model, const RigidBodySpec& spec, int id)
   }
   check_shape(shape_, name);
   for (const auto& [part, pose] : collision_.shapes) {
-    if (part.kind == Shape::Kind::kMesh || part.kind == Shape::Kind::kPlane) {
-      throw std::invalid_argument("body '" + name + "': compound parts must be primitives");
+    if (part.kind == Shape::Kind::kMesh || part.kind == Shape::Kind::kNone ||
+        (part.kind == Shape::Kind::kPlane && collision_.shapes.size() > 1)) {
+      throw std::invalid_argument("body '" + name +
+                                  "': compound parts must be primitives (a plane only alone)");
     }
     check_shape(part, name);
     checked_pose(pose);
   }
   set_pose(checked_pose(spec.pose));
-  visual_mesh_ = std::make_shared<const MeshData>(shape_.kind == Shape::Kind::kMesh
-                                                      ? load_mesh(shape_.mesh, shape_.scale)
-                                                      : make_primitive_mesh(shape_));
+  visual_mesh_ = shape_.kind == Shape::Kind::kMesh
+                     ? load_mesh_shared(shape_.mesh, shape_.scale)
+                     : std::make_shared<const MeshData>(make_primitive_mesh(shape_));
 }
 
 }  // namespace ambfplus

@@ -1,5 +1,7 @@
 #include "ambfplus/scene/world.h"
 
+#include <algorithm>
+
 #include "physics/physics_world.h"
 
 #include <cmath>
@@ -50,6 +52,71 @@ Object* World::find(const std::string& name) const {
 
 std::vector<Object*> World::objects() const { return objects_; }
 
+std::vector<Object*> World::lookup(const std::string& query, std::optional<ObjectKind> kind) const {
+  std::vector<Object*> exact, partial;
+  if (query.empty()) return exact;
+  for (Object* o : objects_) {
+    if (kind && o->kind() != *kind) continue;
+    const std::string qualified = o->qualified_name();
+    const std::string& id = o->identifier();
+    if (o->name() == query || qualified == query ||
+        (!id.empty() && (id == query || o->name_space() + id == query))) {
+      exact.push_back(o);
+    } else if (qualified.find(query) != std::string::npos ||
+               (!id.empty() && (o->name_space() + id).find(query) != std::string::npos)) {
+      partial.push_back(o);
+    }
+  }
+  return exact.empty() ? partial : exact;
+}
+
+std::vector<Joint*> World::descendant_joints(const RigidBody& root) const {
+  const std::vector<Joint*> joints = objects_of_kind<Joint>();
+  std::vector<const RigidBody*> reached{&root};
+  std::vector<bool> taken(joints.size(), false);
+  // Grow the set of reached bodies until no joint adds one (closed loops end it too).
+  for (bool grew = true; grew;) {
+    grew = false;
+    for (std::size_t i = 0; i < joints.size(); ++i) {
+      if (taken[i] ||
+          std::find(reached.begin(), reached.end(), &joints[i]->parent()) == reached.end()) {
+        continue;
+      }
+      taken[i] = true;
+      grew = true;
+      if (std::find(reached.begin(), reached.end(), &joints[i]->child()) == reached.end()) {
+        reached.push_back(&joints[i]->child());
+      }
+    }
+  }
+  std::vector<Joint*> out;
+  for (std::size_t i = 0; i < joints.size(); ++i) {
+    if (taken[i] && !joints[i]->spec().passive) out.push_back(joints[i]);
+  }
+  return out;
+}
+
+void World::remove_model(Model& model) {
+  if (&model == models_.front().get()) {
+    throw std::invalid_argument("the world's default model cannot be removed");
+  }
+  const auto it = std::find_if(models_.begin(), models_.end(),
+                               [&](const auto& m) { return m.get() == &model; });
+  if (it == models_.end()) throw std::invalid_argument("the model is not in this world");
+  // Newest first: joints go before the bodies they hold.
+  for (auto o = model.owned_.rbegin(); o != model.owned_.rend(); ++o) {
+    Object* object = o->get();
+    if (auto* joint = dynamic_cast<Joint*>(object)) physics_->remove(*joint);
+    if (auto* body = dynamic_cast<RigidBody*>(object)) physics_->remove(*body);
+    by_name_.erase(object->name());
+    objects_.erase(std::find(objects_.begin(), objects_.end(), object));
+  }
+  while (!model.owned_.empty()) model.owned_.pop_back();
+  // Its GPU copies are keyed by addresses that may be reused.
+  renderer_.reset();
+  models_.erase(it);
+}
+
 int World::claim_name(const std::string& name, const char* what) {
   if (name.empty()) throw std::invalid_argument(std::string("a ") + what + " needs a name");
   if (Object* existing = find(name)) {
@@ -69,10 +136,16 @@ void World::register_object(Object* object) {
 void World::step(std::int64_t n) {
   if (n < 0) throw std::invalid_argument("step count must be >= 0, got " + std::to_string(n));
   const std::vector<Drill*> drills = objects_of_kind<Drill>();
+  const std::vector<ProximitySensor*> sensors = objects_of_kind<ProximitySensor>();
+  const std::vector<ConstraintActuator*> actuators = objects_of_kind<ConstraintActuator>();
   for (std::int64_t s = 0; s < n; ++s) {
     ++step_index_;
     physics_->step(time_step_);
     for (Drill* d : drills) d->tick(time_step_, step_index_);
+    for (Object* o : objects_) o->follow_parent();
+    // Sensors see where everything ended up.
+    for (ConstraintActuator* a : actuators) a->update();
+    for (ProximitySensor* p : sensors) p->update();
   }
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -27,5 +28,10 @@ struct AMBFPLUS_API MeshData {
 /// file does not exist and ConfigError (naming the file and assimp's reason) when it cannot be
 /// read.
 AMBFPLUS_API MeshData load_mesh(const std::string& path, double scale = 1.0);
+
+/// load_mesh, shared: while any holder keeps the result, loading the same file (unchanged on
+/// disk) at the same scale returns it again instead of reading the file. Thread-safe.
+AMBFPLUS_API std::shared_ptr<const MeshData> load_mesh_shared(const std::string& path,
+                                                              double scale = 1.0);
 
 }  // namespace ambfplus

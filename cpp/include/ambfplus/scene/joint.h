@@ -60,8 +60,11 @@ struct AMBFPLUS_API JointSpec {
   Eigen::Vector3d parent_axis = Eigen::Vector3d::UnitZ();
   Eigen::Vector3d child_pivot = Eigen::Vector3d::Zero();
   Eigen::Vector3d child_axis = Eigen::Vector3d::UnitZ();
-  double offset = 0.0;                 ///< the parent frame's turn about the axis (rad)
-  double child_offset = 0.0;           ///< the child frame's turn about its axis (rad)
+  double offset = 0.0;  ///< the parent frame's turn about the axis (rad)
+  /// AMBF's `offset` (or `child offset`): the child's joint frame is turned by -child_offset about
+  /// its axis, so a child exported at joint angle `child_offset` from the parent's frame sits at
+  /// position 0 (rad).
+  double child_offset = 0.0;
   std::optional<double> lower, upper;  ///< limits, rad or m
   double damping = 0.0;                ///< N m s/rad or N s/m
   double stiffness = 0.0;              ///< springs: N m/rad or N/m

@@ -7,9 +7,12 @@
 #include "ambfplus/export.h"
 #include "ambfplus/haptics/drill.h"
 #include "ambfplus/scene/camera.h"
+#include "ambfplus/scene/constraint_actuator.h"
 #include "ambfplus/scene/joint.h"
 #include "ambfplus/scene/light.h"
+#include "ambfplus/scene/proximity_sensor.h"
 #include "ambfplus/scene/rigid_body.h"
+#include "ambfplus/scene/soft_body.h"
 #include "ambfplus/scene/volume.h"
 
 namespace ambfplus {
@@ -43,6 +46,15 @@ class AMBFPLUS_API Model {
   Volume& add_volume(const VolumeSpec& spec);
   /// Creates a drill working on a volume of the same world.
   Drill& add_drill(const DrillSpec& spec);
+  /// Creates a soft body from a mesh file. Throws std::invalid_argument for a bad spec or a taken
+  /// name, AssetNotFound or ConfigError for a mesh that cannot be read.
+  SoftBody& add_soft_body(const SoftBodySpec& spec);
+  /// Creates a proximity sensor on a rigid body of the world. Throws std::invalid_argument for a
+  /// bad spec or a taken name.
+  ProximitySensor& add_sensor(const ProximitySensorSpec& spec);
+  /// Creates a constraint actuator on a rigid body of the world. Throws std::invalid_argument for
+  /// a bad spec or a taken name.
+  ConstraintActuator& add_actuator(const ConstraintActuatorSpec& spec);
 
  private:
   friend class World;

@@ -12,9 +12,20 @@ class Model;
 class World;
 
 /// What kind of object a scene object is.
-enum class ObjectKind { kRigidBody, kJoint, kCamera, kLight, kVolume, kDrill };
+enum class ObjectKind {
+  kRigidBody,
+  kJoint,
+  kCamera,
+  kLight,
+  kVolume,
+  kDrill,
+  kSoftBody,
+  kSensor,
+  kActuator,
+};
 
-/// Name of an ObjectKind as users see it ("body", "joint", "camera", "light", "volume", "drill").
+/// Name of an ObjectKind as users see it ("body", "joint", "camera", "light", "volume", "drill",
+/// "soft body", "sensor", "actuator").
 AMBFPLUS_API const char* object_kind_name(ObjectKind kind);
 
 /// Anything that lives in a world under a name unique within that world.
@@ -39,6 +50,22 @@ class AMBFPLUS_API Object {
   const Eigen::Isometry3d& pose() const { return pose_; }
   virtual void set_pose(const Eigen::Isometry3d& pose) { pose_ = pose; }
 
+  /// AMBF namespace ("/ambf/env/"), "" for objects built from Python without one.
+  const std::string& name_space() const { return name_space_; }
+  void set_name_space(std::string ns) { name_space_ = std::move(ns); }
+  /// namespace + name, as AMBF publishes it ("/ambf/env/l1").
+  std::string qualified_name() const { return name_space_ + name_; }
+  /// The ADF block it came from ("BODY l1"), "" when not loaded from a file.
+  const std::string& identifier() const { return identifier_; }
+  void set_identifier(std::string identifier) { identifier_ = std::move(identifier); }
+
+  /// Rides on a rigid body: after every step the pose becomes parent pose * local (cameras and
+  /// lights with an ADF `parent`). nullptr detaches (the pose stays where it is).
+  void attach_to(const Object* parent, const Eigen::Isometry3d& local);
+  const Object* attached_to() const { return attached_to_; }
+  /// Moves an attached object to its parent's pose * local (the world calls it every step).
+  void follow_parent();
+
  protected:
   Object(Model& model, std::string name, int id);
 
@@ -47,6 +74,10 @@ class AMBFPLUS_API Object {
   std::string name_;
   int id_;
   Eigen::Isometry3d pose_ = Eigen::Isometry3d::Identity();
+  std::string name_space_;
+  std::string identifier_;
+  const Object* attached_to_ = nullptr;
+  Eigen::Isometry3d local_ = Eigen::Isometry3d::Identity();
 };
 
 /// Throws std::invalid_argument unless m is a rigid transform (orthonormal rotation with det +1,

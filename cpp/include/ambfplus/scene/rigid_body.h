@@ -17,7 +17,8 @@ namespace ambfplus {
 
 /// Geometry of a body, in the body frame.
 struct AMBFPLUS_API Shape {
-  enum class Kind { kBox, kSphere, kCylinder, kCapsule, kCone, kPlane, kMesh };
+  /// kNone: no geometry, an invisible anchor that collides with nothing (AMBF's `mesh: ''`).
+  enum class Kind { kBox, kSphere, kCylinder, kCapsule, kCone, kPlane, kMesh, kNone };
   Kind kind = Kind::kBox;
   /// Box: full extents along x, y, z.
   Eigen::Vector3d size = Eigen::Vector3d::Ones();
@@ -27,7 +28,8 @@ struct AMBFPLUS_API Shape {
   double height = 1.0;
   /// Cylinder, capsule, cone: the body axis they run along (0 = x, 1 = y, 2 = z).
   int axis = 2;
-  /// Mesh: file path, and a uniform scale applied to its vertices.
+  /// Mesh: file path, and a uniform scale applied to its vertices. Other shapes only record the
+  /// scale their dimensions were given with (AMBF's `scale`, which also scales joint pivots).
   std::string mesh;
   double scale = 1.0;
   // Planes are z = 0 in the body frame, normal +z, infinite.
@@ -48,7 +50,8 @@ AMBFPLUS_API MeshCollision parse_mesh_collision(const std::string& name);
 struct AMBFPLUS_API Collision {
   bool enabled = true;  ///< false: the body collides with nothing (an anchor)
   /// Primitives making a compound shape, each placed in the body frame. Empty: the body's own
-  /// shape (or, for a mesh, `mesh` or the visual mesh).
+  /// shape (or, for a mesh, `mesh` or the visual mesh). A plane may be the only part (of a body
+  /// that does not move): its z = 0 plane, placed by the part's pose.
   std::vector<std::pair<Shape, Eigen::Matrix4d>> shapes;
   std::string mesh;  ///< a separate collision mesh file (same scale as the shape), or ""
   MeshCollision mesh_type = MeshCollision::kConcave;
@@ -75,7 +78,7 @@ struct AMBFPLUS_API Dynamics {
   bool kinematic = false;
 };
 
-/// Parses "box", "sphere", "cylinder", "capsule", "cone", "plane", "mesh" (any case).
+/// Parses "box", "sphere", "cylinder", "capsule", "cone", "plane", "mesh", "none" (any case).
 AMBFPLUS_API Shape::Kind parse_shape_kind(const std::string& name);
 AMBFPLUS_API const char* shape_kind_name(Shape::Kind kind);
 
@@ -142,6 +145,8 @@ class AMBFPLUS_API RigidBody : public Object {
   void set_friction(double static_friction, double rolling_friction);
   void set_restitution(double restitution);
   void set_damping(double linear, double angular);
+  /// This body and other pass through each other (AMBF's model-wide `ignore inter-collision`).
+  void ignore_collisions_with(RigidBody& other);
 
   /// Physics internals (for the engine).
   physics::Body* physics_body() const { return physics_.get(); }

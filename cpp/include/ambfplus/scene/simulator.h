@@ -9,6 +9,8 @@
 
 namespace ambfplus {
 
+struct AdfReport;
+
 /// Options fixed when a simulator is created.
 struct AMBFPLUS_API SimulatorOptions {
   double time_step = 0.001;  ///< seconds per fixed step
@@ -29,9 +31,16 @@ class AMBFPLUS_API Simulator : public std::enable_shared_from_this<Simulator> {
   /// Advances the world by n fixed steps.
   void step(std::int64_t n = 1) { world_->step(n); }
 
+  /// What loading a launch file into it loaded and reported (null if it was not loaded so).
+  const std::shared_ptr<const AdfReport>& load_report() const { return load_report_; }
+  void set_load_report(std::shared_ptr<const AdfReport> report) {
+    load_report_ = std::move(report);
+  }
+
  private:
   explicit Simulator(const SimulatorOptions& options);
   std::unique_ptr<World> world_;
+  std::shared_ptr<const AdfReport> load_report_;
 };
 
 }  // namespace ambfplus

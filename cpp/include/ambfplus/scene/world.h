@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -40,6 +41,18 @@ class AMBFPLUS_API World {
 
   /// The object with exactly this name, or nullptr.
   Object* find(const std::string& name) const;
+  /// Objects a name refers to, the way AMBF finds them: those whose name, qualified name
+  /// ("/ambf/env/l1"), identifier ("BODY l1") or namespace + identifier equals the query; if
+  /// none does, every object whose qualified name or identifier contains it. Optionally of one
+  /// kind only. One result is a match; none or several are for the caller to report.
+  std::vector<Object*> lookup(const std::string& query,
+                              std::optional<ObjectKind> kind = std::nullopt) const;
+  /// The joints below a body, as AMBF lists a root body's joints: every joint reachable through
+  /// parent-to-child links, passive ones left out, in creation order.
+  std::vector<Joint*> descendant_joints(const RigidBody& root) const;
+  /// Removes a model and its objects (a loader undoing a model it could not finish). Nothing may
+  /// hold a handle to them, and no other model's joint may use its bodies.
+  void remove_model(Model& model);
   /// All objects in creation order.
   std::vector<Object*> objects() const;
   template <typename T>
@@ -52,6 +65,11 @@ class AMBFPLUS_API World {
   /// Simulation time, seconds (step_index * time_step, without accumulated rounding).
   double time() const { return static_cast<double>(step_index_) * time_step_; }
   std::int64_t step_index() const { return step_index_; }
+
+  /// The namespace models loaded into this world use when their files name none (AMBF's
+  /// "/ambf/env/"; a world file's `namespace` sets it).
+  const std::string& name_space() const { return name_space_; }
+  void set_name_space(std::string ns) { name_space_ = std::move(ns); }
 
   /// Gravity, m/s^2 (AMBF's default: 0, 0, -9.8).
   void set_gravity(const Eigen::Vector3d& g);
@@ -73,6 +91,7 @@ class AMBFPLUS_API World {
   std::string name_;
   double time_step_;
   std::int64_t step_index_ = 0;
+  std::string name_space_ = "/ambf/env/";
   int next_id_ = 1;
   // Before the models: it outlives their bodies and joints.
   std::unique_ptr<physics::PhysicsWorld> physics_;

@@ -1,0 +1,160 @@
+#include "adf/adf_yaml.h"
+
+#include <algorithm>
+#include <set>
+#include <system_error>
+
+#include <Eigen/Geometry>
+
+#include "ambfplus/log.h"
+
+namespace ambfplus::adf {
+
+Doc load(const std::string& path, const std::string& what) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) throw AssetNotFound(path, what);
+  Doc doc{path, fs::absolute(fs::path(path)).parent_path().lexically_normal(), {}};
+  try {
+    doc.root = YAML::LoadFile(path);
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(path, "line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
+  }
+  if (!doc.root.IsMap()) throw ConfigError(path, what + ": expected a mapping of keys at the top");
+  if (const YAML::Node version = doc.root["adf version"]) {
+    const std::string v = as<std::string>(doc, version, what, "adf version", "a string");
+    if (v != "1.0" && v != "1") {
+      fail(doc, version, what, "'adf version' " + v + " is not supported (only 1.0)");
+    }
+  }
+  return doc;
+}
+
+std::string at(const YAML::Node& node) {
+  const YAML::Mark mark = node.Mark();
+  return mark.is_null() ? std::string() : "line " + std::to_string(mark.line + 1) + ": ";
+}
+
+void fail(const Doc& doc, const YAML::Node& node, const std::string& where,
+          const std::string& message) {
+  throw ConfigError(doc.path, at(node) + (where.empty() ? "" : where + ": ") + message);
+}
+
+double number(const Doc& doc, const YAML::Node& node, const std::string& where,
+              const std::string& key) {
+  return as<double>(doc, node, where, key, "a number");
+}
+
+int integer(const Doc& doc, const YAML::Node& node, const std::string& where,
+            const std::string& key) {
+  return as<int>(doc, node, where, key, "an integer");
+}
+
+bool boolean(const Doc& doc, const YAML::Node& node, const std::string& where,
+             const std::string& key) {
+  return as<bool>(doc, node, where, key, "true or false");
+}
+
+std::string text(const Doc& doc, const YAML::Node& node, const std::string& where,
+                 const std::string& key) {
+  if (!node.IsScalar()) fail(doc, node, where, "'" + key + "' must be a string");
+  return node.as<std::string>();
+}
+
+double number_or(const Doc& doc, const YAML::Node& parent, const char* key,
+                 const std::string& where, double fallback) {
+  const YAML::Node n = parent[key];
+  return n ? number(doc, n, where, key) : fallback;
+}
+
+Eigen::Vector3d xyz(const Doc& doc, const YAML::Node& node, const std::string& where,
+                    const std::string& key, const Eigen::Vector3d& fallback) {
+  if (!node) return fallback;
+  if (!node.IsMap()) fail(doc, node, where, "'" + key + "' must be {x, y, z}");
+  Eigen::Vector3d v = fallback;
+  const char* axes[3] = {"x", "y", "z"};
+  for (int a = 0; a < 3; ++a) {
+    if (node[axes[a]]) v[a] = number(doc, node[axes[a]], where, key + "." + axes[a]);
+  }
+  return v;
+}
+
+Eigen::Matrix3d rpy(double r, double p, double y) {
+  return (Eigen::AngleAxisd(y, Eigen::Vector3d::UnitZ()) *
+          Eigen::AngleAxisd(p, Eigen::Vector3d::UnitY()) *
+          Eigen::AngleAxisd(r, Eigen::Vector3d::UnitX()))
+      .toRotationMatrix();
+}
+
+Eigen::Matrix4d frame(const Doc& doc, const YAML::Node& node, const std::string& where,
+                      const std::string& key, double scale) {
+  Eigen::Matrix4d pose = Eigen::Matrix4d::Identity();
+  if (!node) return pose;
+  if (!node.IsMap()) fail(doc, node, where, "'" + key + "' must be {position, orientation}");
+  pose.topRightCorner<3, 1>() =
+      xyz(doc, node["position"], where, key + ".position", Eigen::Vector3d::Zero()) * scale;
+  if (const YAML::Node o = node["orientation"]) {
+    if (!o.IsMap()) fail(doc, o, where, "'" + key + ".orientation' must be {r, p, y}");
+    pose.topLeftCorner<3, 3>() =
+        rpy(number_or(doc, o, "r", where, 0.0), number_or(doc, o, "p", where, 0.0),
+            number_or(doc, o, "y", where, 0.0));
+  }
+  return pose;
+}
+
+std::vector<std::pair<std::string, YAML::Node>> listed(const Doc& doc,
+                                                       const std::string& list_key) {
+  std::vector<std::pair<std::string, YAML::Node>> out;
+  const YAML::Node list = doc.root[list_key];
+  if (!list || list.IsNull()) return out;
+  if (!list.IsSequence()) fail(doc, list, "", "'" + list_key + "' must be a list of block names");
+  for (const YAML::Node& entry : list) {
+    const std::string id = text(doc, entry, list_key, list_key);
+    const YAML::Node block = doc.root[id];
+    if (!block || !block.IsMap()) {
+      fail(doc, entry, "",
+           "'" + list_key + "' lists '" + id + "' but the file has no block of that name");
+    }
+    out.emplace_back(id, block);
+  }
+  return out;
+}
+
+std::string remove_spaces(std::string s) {
+  s.erase(std::remove(s.begin(), s.end(), ' '), s.end());
+  return s;
+}
+
+std::string block_name(const Doc& doc, const std::string& id, const YAML::Node& block) {
+  if (const YAML::Node n = block["name"]) return remove_spaces(text(doc, n, id, "name"));
+  return remove_spaces(id.substr(id.find(' ') == std::string::npos ? 0 : id.find(' ') + 1));
+}
+
+std::string resolve(const fs::path& dir, const std::string& path) {
+  const fs::path p(path);
+  return (p.is_absolute() ? p : dir / p).lexically_normal().string();
+}
+
+void Diagnostics::warn(const std::string& file, const std::string& message) {
+  log(LogLevel::kWarning, file.empty() ? message : file + ": " + message);
+  warnings_.push_back({file, message});
+}
+
+void Diagnostics::error(const std::string& file, const std::string& message) {
+  log(LogLevel::kError, file.empty() ? message : file + ": " + message);
+  errors_.push_back({file, message});
+}
+
+void Diagnostics::unknown_keys(const Doc& doc, const std::string& where, const YAML::Node& block,
+                               std::initializer_list<const char*> known) {
+  const std::set<std::string> names(known.begin(), known.end());
+  std::set<std::string> seen;
+  for (const auto& entry : block) {
+    if (!entry.first.IsScalar()) continue;
+    const std::string key = entry.first.as<std::string>();
+    if (names.count(key) == 0 && seen.insert(key).second) {
+      warn(doc.path, at(entry.first) + where + ": unknown key '" + key + "' ignored");
+    }
+  }
+}
+
+}  // namespace ambfplus::adf

@@ -1,0 +1,105 @@
+#pragma once
+
+// Reading ADF (YAML) files: typed values whose errors name the file, line and key, AMBF's
+// vectors and poses, identifier indirection, paths, and warnings that are both logged and kept.
+
+#include <yaml-cpp/yaml.h>
+
+#include <filesystem>
+#include <initializer_list>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "ambfplus/adf/adf.h"
+#include "ambfplus/errors.h"
+
+namespace ambfplus::adf {
+
+namespace fs = std::filesystem;
+
+/// One parsed ADF file.
+struct Doc {
+  std::string path;  ///< as given
+  fs::path dir;      ///< its folder, absolute
+  YAML::Node root;   ///< a mapping
+};
+
+/// Reads a YAML file whose top level is a mapping (`what` names it in errors: "model file").
+/// Throws AssetNotFound when absent, ConfigError with the line for YAML syntax errors, a
+/// non-mapping top level, or an `adf version` other than 1.0.
+Doc load(const std::string& path, const std::string& what);
+
+/// "line N: " for a node (1-based), "" for a node without a position.
+std::string at(const YAML::Node& node);
+
+/// Throws ConfigError(doc.path, "line N: <where>: <message>").
+[[noreturn]] void fail(const Doc& doc, const YAML::Node& node, const std::string& where,
+                       const std::string& message);
+
+/// node as T, or ConfigError naming the file, line, object and key and the type expected.
+template <typename T>
+T as(const Doc& doc, const YAML::Node& node, const std::string& where, const std::string& key,
+     const char* expected) {
+  try {
+    return node.as<T>();
+  } catch (const YAML::Exception&) {
+    fail(doc, node, where, "'" + key + "' must be " + expected);
+  }
+}
+
+double number(const Doc& doc, const YAML::Node& node, const std::string& where,
+              const std::string& key);
+int integer(const Doc& doc, const YAML::Node& node, const std::string& where,
+            const std::string& key);
+bool boolean(const Doc& doc, const YAML::Node& node, const std::string& where,
+             const std::string& key);
+std::string text(const Doc& doc, const YAML::Node& node, const std::string& where,
+                 const std::string& key);
+
+/// parent[key] as a number when present, else fallback.
+double number_or(const Doc& doc, const YAML::Node& parent, const char* key,
+                 const std::string& where, double fallback);
+
+/// `{x, y, z}`: absent components keep the fallback's.
+Eigen::Vector3d xyz(const Doc& doc, const YAML::Node& node, const std::string& where,
+                    const std::string& key, const Eigen::Vector3d& fallback);
+
+/// Fixed-axis roll, pitch, yaw (AMBF's `{r, p, y}`): R = Rz(y) Ry(p) Rx(r).
+Eigen::Matrix3d rpy(double r, double p, double y);
+
+/// `{position: {x,y,z}, orientation: {r,p,y}}` as a pose; the position is multiplied by scale.
+Eigen::Matrix4d frame(const Doc& doc, const YAML::Node& node, const std::string& where,
+                      const std::string& key, double scale = 1.0);
+
+/// The blocks the list under root[list_key] names, in order. ConfigError for a list that is not
+/// a list, or names a block the file does not have.
+std::vector<std::pair<std::string, YAML::Node>> listed(const Doc& doc, const std::string& list_key);
+
+/// A block's `name` with spaces removed (AMBF), or the identifier's last word when absent.
+std::string block_name(const Doc& doc, const std::string& id, const YAML::Node& block);
+
+std::string remove_spaces(std::string s);
+
+/// A path from a file, made absolute against dir (absolute paths are kept).
+std::string resolve(const fs::path& dir, const std::string& path);
+
+/// Warnings of a load, logged as they come and kept for the report.
+class Diagnostics {
+ public:
+  void warn(const std::string& file, const std::string& message);
+  void error(const std::string& file, const std::string& message);
+  /// One warning per key of block that is not in known ("unknown key 'x' ignored").
+  void unknown_keys(const Doc& doc, const std::string& where, const YAML::Node& block,
+                    std::initializer_list<const char*> known);
+  std::vector<AdfProblem>& warnings() { return warnings_; }
+  std::vector<AdfProblem>& errors() { return errors_; }
+
+ private:
+  std::vector<AdfProblem> warnings_;
+  std::vector<AdfProblem> errors_;
+};
+
+}  // namespace ambfplus::adf

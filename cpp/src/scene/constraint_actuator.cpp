@@ -1,0 +1,57 @@
+// ConstraintActuator's scene side: checking the spec, following the parent.
+
+#include "ambfplus/scene/constraint_actuator.h"
+
+#include <cmath>
+#include <stdexcept>
+
+#include "ambfplus/scene/rigid_body.h"
+#include "ambfplus/scene/world.h"
+#include "physics/physics_world.h"  // (the Bullet side it may own on the way out)
+
+namespace ambfplus {
+
+ConstraintActuator::ConstraintActuator(Model& model, const ConstraintActuatorSpec& spec, int id)
+    : Object(model, spec.name, id), spec_(spec) {
+  const std::string& name = spec.name;
+  if (spec_.parent == nullptr) {
+    throw std::invalid_argument("actuator '" + name + "' needs a parent body");
+  }
+  if (&spec_.parent->world() != &model.world()) {
+    throw std::invalid_argument("actuator '" + name + "': its parent '" + spec_.parent->name() +
+                                "' is in another world");
+  }
+  checked_pose(spec_.location);
+  if (!(spec_.max_impulse > 0) || !std::isfinite(spec_.max_impulse)) {
+    throw std::invalid_argument("actuator '" + name + "': max impulse must be > 0 N s, got " +
+                                std::to_string(spec_.max_impulse));
+  }
+  if (!(spec_.tau > 0 && spec_.tau <= 1)) {
+    throw std::invalid_argument("actuator '" + name + "': tau must be in (0, 1], got " +
+                                std::to_string(spec_.tau));
+  }
+  if (!(spec_.visible_size >= 0) || !std::isfinite(spec_.visible_size)) {
+    throw std::invalid_argument("actuator '" + name + "': visible size must be >= 0");
+  }
+  update();
+}
+
+Eigen::Isometry3d ConstraintActuator::location() const { return checked_pose(spec_.location); }
+
+void ConstraintActuator::set_pose(const Eigen::Isometry3d& pose) {
+  if (is_actuated()) {
+    throw std::logic_error("actuator '" + name() +
+                           "' holds a body: deactuate it before moving the actuator");
+  }
+  spec_.location = (parent().pose().inverse() * pose).matrix();
+  Object::set_pose(pose);
+}
+
+void ConstraintActuator::actuate(RigidBody& body) {
+  // Where the actuator frame is on the body now: the body is held as it is.
+  actuate(body, body.pose().inverse() * parent().pose() * location());
+}
+
+void ConstraintActuator::update() { Object::set_pose(parent().pose() * location()); }
+
+}  // namespace ambfplus

@@ -505,3 +505,27 @@ def test_loaded_models_render(fixtures):
     heights = backproject(frame)[:, 2]
     assert heights.min() == pytest.approx(world.get("Plane").pose[2, 3], abs=0.01)
     assert heights.max() > -1.0
+
+
+def test_enclosure_when_no_environment(fixtures, tmp_path):
+    world_file = write(
+        tmp_path, "world.yaml", "enclosure: {length: 2.0, width: 3.0, height: 2.0}\n"
+    )
+    ball = write(
+        tmp_path,
+        "ball.yaml",
+        """
+        bodies: [BODY ball]
+        BODY ball: {name: ball, mass: 0.1, shape: SPHERE, geometry: {radius: 0.05},
+                    location: {position: {x: 0.9, y: 0, z: 0}}, restitution: 0}
+        """,
+    )
+    colors = fixtures / DESCRIPTIONS / "color" / "colors.yaml"
+    launch = small_launch(tmp_path, fixtures, str(world_file), str(colors))
+    sim = ambfplus.Simulator.from_launch(launch, models=[], extra=[ball], strict=True)
+    assert [m.name for m in sim.load_report.models] == ["enclosure", "ball"]
+    sim.get("ball").linear_velocity = (1.0, 0.0, 0.0)  # into the wall at x = 1
+    sim.step(1500)
+    p = sim.get("ball").pose[:3, 3]
+    assert p[2] == pytest.approx(-1.0 + 0.05, abs=2e-3)  # on the floor, height / 2 down
+    assert p[0] < 1.0 - 0.05 + 2e-3  # not through the wall

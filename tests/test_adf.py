@@ -529,3 +529,26 @@ def test_enclosure_when_no_environment(fixtures, tmp_path):
     p = sim.get("ball").pose[:3, 3]
     assert p[2] == pytest.approx(-1.0 + 0.05, abs=2e-3)  # on the floor, height / 2 down
     assert p[0] < 1.0 - 0.05 + 2e-3  # not through the wall
+
+
+def test_drilling_fixture_cameras_ride_on_the_main_camera(fixtures):
+    # The original drilling scene: its stereo pair and its headlight are children of a camera,
+    # placed in that camera's AMBF frame (x back from the view, y right, z up).
+    launch = fixtures / "volumetric_drilling" / "launch.yaml"
+    sim = ambfplus.Simulator.from_launch(launch, models=[0, 2, 5], strict=True)
+    assert sim.load_report.errors == []
+    assert not [w for w in sim.load_report.warnings if "not found" in w[1] and "parent" in w[1]]
+    main, left, right = (sim.get(n) for n in ("main_camera", "stereoL", "stereoR"))
+    assert left.attached_to.name == "main_camera" and right.attached_to.name == "main_camera"
+    assert left.pose == pytest.approx(main.pose)
+    right_in_left = np.linalg.inv(left.pose) @ right.pose
+    assert right_in_left[:3, :3] == pytest.approx(np.eye(3))
+    assert right_in_left[:3, 3] == pytest.approx([0.025, 0, 0])  # 25 mm to the right
+    light = sim.get("light1")
+    assert light.pose[:3, 3] == pytest.approx(main.pose[:3, :3] @ [0, -0.025, 0])  # 25 mm up
+    assert light.direction == pytest.approx(main.pose[:3, 2])  # along the view
+    sim.get("main_camera").look_at((0.1, 0.2, 0.3), (0, 0, 0))
+    sim.step(1)
+    assert np.linalg.inv(sim.get("stereoL").pose) @ sim.get("stereoR").pose == pytest.approx(
+        right_in_left
+    )

@@ -3,6 +3,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <functional>
@@ -335,7 +336,7 @@ BodyPlan plan_body(const Doc& doc, const std::string& model_hr, const std::strin
         fail(doc, type, id, e.what());
       }
     }
-  } else if (b["collision mesh"]) {
+  } else if (b["collision mesh"] && !text(doc, b["collision mesh"], id, "collision mesh").empty()) {
     ctx.diag->warn(doc.path, at(b["collision mesh"]) + id +
                                  ": a collision mesh needs a visual mesh in ambfplus; ignored");
   }
@@ -723,28 +724,52 @@ std::optional<SensorPlan> plan_sensor(const Doc& doc, const std::string& model_n
   return p;
 }
 
-// The one body a reference names: this file's blocks first (identifier or name), then the world
-// (exact, else a unique substring, also under the model's namespace). nullptr when none or
-// several match; why is in `why`.
-RigidBody* find_body(World& world, const std::string& ref, const std::string& ns,
-                     const std::vector<std::pair<std::string, RigidBody*>>& own, std::string& why) {
+// The one object a reference names: this file's bodies first (identifier or name), then the
+// world (exact, else a unique substring, also under the model's namespace), of one kind or, for
+// parents, any kind but joints. nullptr when none or several match; why is in `why`.
+Object* find_object(World& world, const std::string& ref, const std::string& ns,
+                    const std::vector<std::pair<std::string, RigidBody*>>& own,
+                    std::optional<ObjectKind> kind, std::string& why) {
   for (const auto& [id, body] : own) {
     if (id == ref || ns + id == ref) return body;
   }
   for (const auto& [id, body] : own) {
     if (body->name() == remove_spaces(ref)) return body;
   }
-  std::vector<Object*> found = world.lookup(ref, ObjectKind::kRigidBody);
-  if (found.empty()) found = world.lookup(ns + ref, ObjectKind::kRigidBody);
-  if (found.size() == 1) return static_cast<RigidBody*>(found.front());
+  std::vector<Object*> found = world.lookup(ref, kind);
+  if (found.empty()) found = world.lookup(ns + ref, kind);
+  if (!kind) {
+    found.erase(std::remove_if(found.begin(), found.end(),
+                               [](Object* o) { return o->kind() == ObjectKind::kJoint; }),
+                found.end());
+  }
+  if (found.size() == 1) return found.front();
+  const std::string what = kind ? "body" : "object";
   if (found.empty()) {
-    why = "no body '" + ref + "' in the file or the world";
+    why = "no " + what + " '" + ref + "' in the file or the world";
   } else {
-    why = "'" + ref + "' matches " + std::to_string(found.size()) + " bodies (" +
+    why = "'" + ref + "' matches " + std::to_string(found.size()) + " " + what + "s (" +
           found[0]->qualified_name() + ", " + found[1]->qualified_name() +
           (found.size() > 2 ? ", ..." : "") + ")";
   }
   return nullptr;
+}
+
+RigidBody* find_body(World& world, const std::string& ref, const std::string& ns,
+                     const std::vector<std::pair<std::string, RigidBody*>>& own, std::string& why) {
+  return static_cast<RigidBody*>(find_object(world, ref, ns, own, ObjectKind::kRigidBody, why));
+}
+
+// AMBF gives a child's location in its parent's frame; a camera's frame there is AMBF's (x back
+// from the view direction, y right, z up), ours is OpenCV's (x right, y down, z forward).
+Eigen::Isometry3d parent_frame(const Object& parent) {
+  Eigen::Isometry3d frame = Eigen::Isometry3d::Identity();
+  if (parent.kind() == ObjectKind::kCamera) {
+    frame.linear() << 0, 1, 0,  //
+        0, 0, -1,               //
+        -1, 0, 0;
+  }
+  return frame;
 }
 
 }  // namespace
@@ -785,15 +810,15 @@ void add_cameras_and_lights(Model& model, const Doc& doc, const std::string& bas
   }
   // A parent that is not there leaves the object in the world frame, with a warning.
   auto parent_of = [&](const std::string& id, const std::string& parent,
-                       const std::string& ns) -> RigidBody* {
+                       const std::string& ns) -> Object* {
     if (parent.empty()) return nullptr;
     std::string why;
-    RigidBody* body = find_body(world, parent, ns, own, why);
-    if (body == nullptr) {
+    Object* found = find_object(world, parent, ns, own, std::nullopt, why);
+    if (found == nullptr) {
       ctx.diag->warn(doc.path, id + ": parent '" + parent + "' not found (" + why +
                                    "); placed in the world frame instead");
     }
-    return body;
+    return found;
   };
   for (CameraPlan& c : cameras) {
     c.spec.name = unique_name(world, c.spec.name);
@@ -801,15 +826,18 @@ void add_cameras_and_lights(Model& model, const Doc& doc, const std::string& bas
     camera.set_identifier(c.id);
     camera.set_name_space(c.ns);
     camera.look_at(c.eye, c.target, c.up);
-    if (RigidBody* parent = parent_of(c.id, c.parent, c.ns))
-      camera.attach_to(parent, camera.pose());
+    if (Object* parent = parent_of(c.id, c.parent, c.ns)) {
+      camera.attach_to(parent, parent_frame(*parent) * camera.pose());
+    }
   }
   for (LightPlan& l : lights) {
     l.spec.name = unique_name(world, l.spec.name);
     Light& light = model.add_light(l.spec);
     light.set_identifier(l.id);
     light.set_name_space(l.ns);
-    if (RigidBody* parent = parent_of(l.id, l.parent, l.ns)) light.attach_to(parent, light.pose());
+    if (Object* parent = parent_of(l.id, l.parent, l.ns)) {
+      light.attach_to(parent, parent_frame(*parent) * light.pose());
+    }
   }
 }
 

@@ -39,6 +39,7 @@ from ._core import (
     Model,
     Object,
     PluginError,
+    PluginInfo,
     ProximitySensor,
     RenderError,
     RigidBody,
@@ -59,6 +60,7 @@ from ._core import (
     write_image,
     write_label_table,
 )
+from .plugins import Plugin, cmake_dir, plugin_dir
 from .transforms import make_pose, rotation_between, rpy_matrix
 from .volumes import convert_volume, load_volume
 
@@ -66,6 +68,7 @@ __all__ = [
     "__version__",
     "AssetNotFound",
     "Camera",
+    "cmake_dir",
     "ConfigError",
     "ConstraintActuator",
     "convert_volume",
@@ -84,7 +87,10 @@ __all__ = [
     "Model",
     "Object",
     "phantom",
+    "Plugin",
+    "plugin_dir",
     "PluginError",
+    "PluginInfo",
     "ProximitySensor",
     "read_colors",
     "read_input_devices",

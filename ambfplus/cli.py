@@ -1,4 +1,5 @@
-"""The ``ambfplus`` command line: ``demo``, ``convert``, ``launch``, ``info``."""
+"""The ``ambfplus`` command line: ``demo``, ``convert``, ``launch``, ``info`` (and
+``--cmake-dir``, the folder of the CMake package C++ plugins build against)."""
 
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from . import Simulator, __version__, gl_info, write_image
+from .plugins import cmake_dir
 from .scenes import demo_scene
 from .volumes import convert_volume
 
@@ -109,6 +111,7 @@ def indices(text: str) -> list[int]:
 def run_launch(args: argparse.Namespace) -> int:
     """Loads an AMBF launch file headless like AMBF's -l/-a, steps it, prints what loaded."""
     extra = [Path(p) for p in args.a.split(",") if p] if args.a else []
+    plugins = [p for p in args.plugins.split(",") if p] if args.plugins else []
     sim = Simulator.from_launch(
         args.launch_file,
         models=args.l,
@@ -116,6 +119,7 @@ def run_launch(args: argparse.Namespace) -> int:
         devices=args.i or [],
         strict=args.strict,
         namespace_prefix=args.ns,
+        plugins=plugins,
     )
     sim.step(args.steps)
     report = sim.load_report
@@ -125,6 +129,7 @@ def run_launch(args: argparse.Namespace) -> int:
             kind: sum(o.kind == kind for o in sim.world.objects)
             for kind in ("body", "joint", "camera", "light", "volume")
         },
+        "plugins": [f"{p.name} ({p.language}, {p.scope})" for p in sim.world.plugins],
         "errors": [f"{f}: {m}" for f, m in report.errors],
         "warnings": len(report.warnings),
         "time": sim.world.time,
@@ -133,9 +138,25 @@ def run_launch(args: argparse.Namespace) -> int:
     return 1 if report.errors else 0
 
 
+class _PrintCmakeDir(argparse.Action):
+    """--cmake-dir: prints the folder and exits, as --version does."""
+
+    def __init__(self, option_strings, dest, **kwargs):
+        super().__init__(option_strings, dest, nargs=0, default=argparse.SUPPRESS, **kwargs)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        print(cmake_dir())
+        parser.exit()
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="ambfplus", description=__doc__)
     parser.add_argument("--version", action="version", version=f"ambfplus {__version__}")
+    parser.add_argument(
+        "--cmake-dir",
+        action=_PrintCmakeDir,
+        help="print the folder of ambfplusConfig.cmake (for -Dambfplus_DIR=...) and exit",
+    )
     commands = parser.add_subparsers(dest="command", required=True)
     demo = commands.add_parser("demo", help="render the built-in scene headless to PNG files")
     demo.add_argument("--out", type=Path, default=Path("demo_out"), help="output folder")
@@ -182,7 +203,14 @@ def main(argv: list[str] | None = None) -> int:
     launch.add_argument("-i", type=indices, help="input devices to set up, e.g. 0,1")
     launch.add_argument("--ns", default="", help="namespace prefix")
     launch.add_argument("--steps", type=int, default=1000, help="1 ms steps to take")
-    launch.add_argument("--strict", action="store_true", help="a model that fails is fatal")
+    launch.add_argument(
+        "--strict", action="store_true", help="a model or plugin that fails is fatal"
+    )
+    launch.add_argument(
+        "--plugins",
+        help="simulator plugins to load after the launch file's, comma separated "
+        "(libx.so, x.py, a path, or a name searched in AMBFPLUS_PLUGIN_PATH)",
+    )
     commands.add_parser("info", help="print the version and the OpenGL device")
     args = parser.parse_args(argv)
     if args.command == "launch":

@@ -12,6 +12,7 @@ void register_capture(pybind11::module_& m);
 void register_volume(pybind11::module_& m);
 void register_scene(pybind11::module_& m);
 void register_adf(pybind11::module_& m);
+void register_plugin(pybind11::module_& m);
 
 }  // namespace ambfplus::bindings
 
@@ -53,7 +54,13 @@ pybind11::object to_python(Object* o);
 
 /// Camera.capture(out=None): renders with the GIL released. out may be None (a new Frame), a Frame
 /// (refilled in place) or a dict of preallocated arrays {"rgb": ..., "depth": ...}.
-pybind11::object capture(Camera& camera, pybind11::object out);
+pybind11::object capture(Camera& camera, pybind11::object out, pybind11::object passes,
+                         pybind11::object poses);
+
+/// CapturePass bits from pass names ("rgb", "depth", "label", "instance", "voxel").
+unsigned parse_passes(const pybind11::handle& names);
+/// The names of CapturePass bits, in that order.
+pybind11::list pass_names(unsigned passes);
 
 /// add_body's physics keywords (inertia, friction, kinematic, collision_*, groups, axis, ...).
 void apply_body_options(RigidBodySpec& spec, const pybind11::kwargs& kw);

@@ -36,6 +36,7 @@ PYBIND11_MODULE(_core, m) {
   ambfplus::bindings::register_volume(m);
   ambfplus::bindings::register_scene(m);
   ambfplus::bindings::register_adf(m);
+  ambfplus::bindings::register_plugin(m);
 
   // Info and above go to Python, whose logging decides what to show (debug only on request, by
   // AMBFPLUS_LOG_LEVEL=debug, since every message takes the GIL).

@@ -69,8 +69,9 @@ py::dict device_dict(const AdfInputDevice& x) {
 
 AdfLoadOptions load_options(std::optional<std::vector<int>> models, const std::vector<Path>& extra,
                             const std::vector<int>& devices, bool strict, bool load_world,
-                            const std::string& prefix) {
+                            const std::string& prefix, const std::vector<std::string>& plugins) {
   AdfLoadOptions o;
+  o.plugins = plugins;
   o.indices = std::move(models);
   for (const Path& p : extra) o.extra.push_back(p.string());
   o.devices = devices;
@@ -169,17 +170,20 @@ void register_adf(py::module_& m) {
 
   auto load_launch_into = [](World& w, const Path& path, std::optional<std::vector<int>> models,
                              const std::vector<Path>& extra, const std::vector<int>& devices,
-                             bool strict, bool load_world, const std::string& prefix) {
+                             bool strict, bool load_world, const std::string& prefix,
+                             const std::vector<std::string>& plugins) {
     const AdfLoadOptions options =
-        load_options(std::move(models), extra, devices, strict, load_world, prefix);
+        load_options(std::move(models), extra, devices, strict, load_world, prefix, plugins);
     py::gil_scoped_release release;
     return std::make_shared<AdfReport>(load_launch(w, path.string(), options));
   };
   const char* launch_doc =
       "Loads an AMBF launch file: its world file, then the model files at the launch indices "
       "`models` (AMBF's -l; None: index 1 unless `extra` is given), then `extra` files (-a), "
-      "then the simulated multibodies of input `devices` (-i). A model that fails is "
-      "reported in the result's errors and leaves nothing behind; strict=True raises instead.";
+      "then the simulated multibodies of input `devices` (-i), then the launch file's and "
+      "`plugins`' simulator plugins (--plugins). A model that fails is reported in the result's "
+      "errors and leaves nothing behind, a plugin that fails is reported there too; "
+      "strict=True raises instead.";
 
   auto simulator = py::reinterpret_borrow<py::class_<Simulator, std::shared_ptr<Simulator>>>(
       m.attr("Simulator"));
@@ -189,19 +193,19 @@ void register_adf(py::module_& m) {
           [load_launch_into](const Path& path, std::optional<std::vector<int>> models,
                              const std::vector<Path>& extra, const std::vector<int>& devices,
                              bool strict, bool load_world, const std::string& prefix,
-                             double time_step) {
+                             double time_step, const std::vector<std::string>& plugins) {
             SimulatorOptions options;
             options.time_step = time_step;
             auto sim = Simulator::create(options);
             auto report = load_launch_into(sim->world(), path, std::move(models), extra, devices,
-                                           strict, load_world, prefix);
+                                           strict, load_world, prefix, plugins);
             sim->set_load_report(report);
             return sim;
           },
           py::arg("path"), py::arg("models") = py::none(), py::arg("extra") = std::vector<Path>{},
           py::arg("devices") = std::vector<int>{}, py::arg("strict") = false,
           py::arg("load_world") = true, py::arg("namespace_prefix") = "",
-          py::arg("time_step") = 0.001,
+          py::arg("time_step") = 0.001, py::arg("plugins") = std::vector<std::string>{},
           (std::string(launch_doc) + " Returns a new simulator; see its load_report.").c_str())
       .def_property_readonly(
           "load_report",
@@ -222,7 +226,8 @@ void register_adf(py::module_& m) {
       .def("load_launch", load_launch_into, py::arg("path"), py::arg("models") = py::none(),
            py::arg("extra") = std::vector<Path>{}, py::arg("devices") = std::vector<int>{},
            py::arg("strict") = false, py::arg("load_world") = true,
-           py::arg("namespace_prefix") = "", launch_doc)
+           py::arg("namespace_prefix") = "", py::arg("plugins") = std::vector<std::string>{},
+           launch_doc)
       .def(
           "load_adf",
           [](World& w, const Path& path) {

@@ -10,6 +10,7 @@
 
 #include "ambfplus/capture/frame.h"
 #include "ambfplus/scene/camera.h"
+#include "ambfplus/scene/world.h"
 #include "bindings.h"
 
 namespace py = pybind11;
@@ -74,19 +75,94 @@ double process_cpu_seconds() {
 
 }  // namespace
 
-py::object capture(Camera& camera, py::object out) {
+unsigned parse_passes(const py::handle& names) {
+  if (py::isinstance<py::str>(names)) {
+    throw py::type_error("passes must be a list of names, e.g. ['rgb', 'depth']");
+  }
+  unsigned passes = 0;
+  for (const py::handle& n : names) {
+    const std::string name = py::str(n);
+    if (name == "rgb") {
+      passes |= kPassRgb;
+    } else if (name == "depth") {
+      passes |= kPassDepth;
+    } else if (name == "label") {
+      passes |= kPassLabel;
+    } else if (name == "instance") {
+      passes |= kPassInstance;
+    } else if (name == "voxel") {
+      passes |= kPassVoxel;
+    } else {
+      throw py::value_error("unknown pass '" + name +
+                            "': expected rgb, depth, label, instance or voxel");
+    }
+  }
+  if (passes == 0) throw py::value_error("passes must name at least one image");
+  return passes;
+}
+
+py::list pass_names(unsigned passes) {
+  py::list out;
+  const char* names[5] = {"rgb", "depth", "label", "instance", "voxel"};
+  for (int i = 0; i < 5; ++i) {
+    if (passes & (1u << i)) out.append(names[i]);
+  }
+  return out;
+}
+
+namespace {
+
+// frame.poses: the world poses of the objects asked for, at the capture.
+void record_poses(Camera& camera, py::object frame, const py::object& poses) {
+  if (poses.is_none() || (py::isinstance<py::bool_>(poses) && !poses.cast<bool>())) return;
+  py::dict out;
+  World& world = camera.world();
+  if (py::isinstance<py::bool_>(poses)) {
+    for (Object* o : world.objects()) out[py::str(o->name())] = Eigen::Matrix4d(o->pose().matrix());
+  } else {
+    for (const py::handle& n : poses) {
+      const std::string name = py::str(n);
+      Object* o = world.find(name);
+      if (o == nullptr) throw py::key_error("poses: no object named '" + name + "' in the world");
+      out[py::str(name)] = Eigen::Matrix4d(o->pose().matrix());
+    }
+  }
+  frame.attr("poses") = out;
+}
+
+}  // namespace
+
+py::object capture(Camera& camera, py::object out, py::object passes, py::object poses) {
   if (out.is_none()) {
     auto frame = std::make_shared<Frame>();
+    if (!passes.is_none()) {
+      // The frame's buffers decide what a capture renders.
+      const unsigned p = parse_passes(passes);
+      const int h = camera.height(), w = camera.width();
+      if (p & kPassRgb) frame->rgb.allocate(h, w, 3);
+      if (p & kPassDepth) frame->depth.allocate(h, w, 1);
+      if (p & kPassLabel) frame->label.allocate(h, w, 1);
+      if (p & kPassInstance) frame->instance.allocate(h, w, 1);
+      if (p & kPassVoxel) frame->voxel.allocate(h, w, 1);
+    }
     {
       py::gil_scoped_release release;
       camera.capture(*frame);
     }
-    return py::cast(frame);
+    py::object result = py::cast(frame);
+    record_poses(camera, result, poses);
+    return result;
+  }
+  if (!passes.is_none()) {
+    throw py::value_error("passes goes with a new frame; out's buffers already decide them");
   }
   if (py::isinstance<Frame>(out)) {
     Frame& frame = out.cast<Frame&>();
-    py::gil_scoped_release release;
-    camera.capture(frame);
+    {
+      py::gil_scoped_release release;
+      camera.capture(frame);
+    }
+    record_poses(camera, out, poses);
     return out;
   }
   if (py::isinstance<py::dict>(out)) {
@@ -105,9 +181,15 @@ py::object capture(Camera& camera, py::object out) {
       } else if (key == "label") {
         targets.label = checked_output<std::uint16_t>(item.second, "label", {h, w});
         frame->label.attach(targets.label, camera.height(), camera.width(), 1);
+      } else if (key == "instance") {
+        targets.instance = checked_output<std::int32_t>(item.second, "instance", {h, w});
+        frame->instance.attach(targets.instance, camera.height(), camera.width(), 1);
+      } else if (key == "voxel") {
+        targets.voxel = checked_output<std::int32_t>(item.second, "voxel", {h, w});
+        frame->voxel.attach(targets.voxel, camera.height(), camera.width(), 1);
       } else {
         throw py::value_error("out has an unknown key '" + key +
-                              "': expected 'rgb', 'depth' and/or 'label'");
+                              "': expected 'rgb', 'depth', 'label', 'instance', 'voxel'");
       }
     }
     py::object result = py::cast(frame);
@@ -117,6 +199,7 @@ py::object capture(Camera& camera, py::object out) {
       py::gil_scoped_release release;
       camera.capture(targets, *frame);
     }
+    record_poses(camera, result, poses);
     return result;
   }
   throw py::type_error(
@@ -135,6 +218,39 @@ void register_capture(py::module_& m) {
       .def_property_readonly(
           "label", [](py::object self) { return view(self, self.cast<Frame&>().label, true); },
           "uint16 (H, W) view: the volume label id seen at each pixel, 0 elsewhere")
+      .def_property_readonly(
+          "instance",
+          [](py::object self) { return view(self, self.cast<Frame&>().instance, true); },
+          "int32 (H, W) view: the id of the object seen (meshes and volumes), 0 where nothing "
+          "was hit, or None when not rendered")
+      .def_property_readonly(
+          "voxel", [](py::object self) { return view(self, self.cast<Frame&>().voxel, true); },
+          "int32 (H, W) view: the linear index i + nx (j + ny k) of the volume voxel whose label "
+          "the pixel shows, -1 elsewhere, or None when not rendered")
+      .def_property_readonly(
+          "points",
+          [](Frame& f) -> py::object {
+            if (f.depth.empty()) return py::none();
+            const auto h = static_cast<py::ssize_t>(f.height),
+                       w = static_cast<py::ssize_t>(f.width);
+            py::array_t<float> out({h, w, static_cast<py::ssize_t>(3)});
+            float* p = out.mutable_data();
+            const float* z = f.depth.data();
+            const double fx = f.intrinsics(0, 0), fy = f.intrinsics(1, 1);
+            const double cx = f.intrinsics(0, 2), cy = f.intrinsics(1, 2);
+            for (py::ssize_t r = 0; r < h; ++r) {
+              for (py::ssize_t c = 0; c < w; ++c, ++z, p += 3) {
+                const double d = *z;
+                p[0] = static_cast<float>((static_cast<double>(c) + 0.5 - cx) / fx * d);
+                p[1] = static_cast<float>((static_cast<double>(r) + 0.5 - cy) / fy * d);
+                p[2] = static_cast<float>(d);
+              }
+            }
+            return std::move(out);
+          },
+          "float32 (H, W, 3) organised point cloud in the camera frame (OpenCV: x right, y "
+          "down, z forward) from depth and the intrinsics; (0, 0, 0) where nothing was hit. Its "
+          "colours and labels are rgb and label at the same pixels (a new array per access).")
       .def_readonly("width", &Frame::width)
       .def_readonly("height", &Frame::height)
       .def_readonly("time", &Frame::time, "simulation time of the capture, seconds")

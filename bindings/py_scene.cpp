@@ -512,6 +512,23 @@ void register_scene(py::module_& m) {
           "RGBA in 0..1");
 
   camera.def_property_readonly("width", &Camera::width)
+      .def_property_readonly(
+          "publish",
+          [](Camera& c) {
+            const CameraPublish& p = c.publish();
+            py::dict d;
+            d["image"] = p.image;
+            d["image_interval"] = p.image_interval;
+            d["depth"] = p.depth;
+            d["depth_interval"] = p.depth_interval;
+            d["depth_noise"] =
+                p.depth_noise
+                    ? py::cast(std::vector<double>{p.noise_mean, p.noise_std, p.noise_bias})
+                    : py::none();
+            return d;
+          },
+          "what an ADF asked it to publish: image/depth flags and intervals (every n-th "
+          "render), depth noise (mean, std_dev, bias) or None")
       .def_property_readonly("height", &Camera::height)
       .def_property_readonly("fov_y", &Camera::fov_y, "vertical field of view, radians")
       .def_property_readonly("near", &Camera::near)
@@ -524,9 +541,21 @@ void register_scene(py::module_& m) {
       .def("look_at", &Camera::look_at, py::arg("eye"), py::arg("target"),
            py::arg("up") = Vec3(0, 0, 1),
            "Places the camera at eye looking at target, with image up along up.")
-      .def("capture", &capture, py::arg("out") = py::none(),
-           "Renders (GIL released) and returns a Frame of NumPy views; out=Frame refills that "
-           "frame in place, out={'rgb': a, 'depth': b} renders into preallocated arrays.");
+      .def("capture", &capture, py::arg("out") = py::none(), py::arg("passes") = py::none(),
+           py::arg("poses") = py::none(),
+           "Renders (GIL released) and returns a Frame of NumPy views. passes: the images to "
+           "render ('rgb', 'depth', 'label', 'instance', 'voxel'; default camera.passes), and "
+           "only those. out=Frame refills that frame's images in place; out={'rgb': a, "
+           "'depth': b, ...} renders into preallocated arrays. poses: object names (or True for "
+           "all) whose world poses the frame records in frame.poses.")
+      .def_property(
+          "passes", [](Camera& c) { return pass_names(c.passes()); },
+          [](Camera& c, const py::object& names) { c.set_passes(parse_passes(names)); },
+          "what a capture renders unless told otherwise")
+      .def_property(
+          "principal_point", [](Camera& c) { return c.principal_point(); },
+          [](Camera& c, const Eigen::Vector2d& p) { c.set_principal_point(p.x(), p.y()); },
+          "(cx, cy) in pixels; (W/2, H/2) unless moved (an off-axis camera)");
 
   volume.def_property_readonly("data", &Volume::data)
       .def_property_readonly(

@@ -126,6 +126,7 @@ py::object hit_dict(const VolumeHit& h) {
   d["position"] = h.position;
   d["normal"] = h.normal;
   d["label"] = h.label;
+  d["voxel"] = h.voxel;
   return d;
 }
 

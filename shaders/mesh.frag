@@ -1,24 +1,37 @@
 #version 450 core
-// Shaded colour, and metric depth from the perspective-correct camera-frame position: exact and
+// Shaded colour (flat with SHADE 0, when no rgb pass is asked for), object id, and metric depth from the perspective-correct camera-frame position: exact and
 // linear whatever the depth buffer holds, also on triangles clipped from points at infinity (where
 // gl_FragCoord.w is not 1/z because the clipped vertices carry a homogeneous scale).
 
 #include "lighting.glsl"
 
+#ifndef SHADE
+#define SHADE 1
+#endif
+
 in vec4 v_position;
 in vec3 v_normal;
 
 uniform vec4 u_color;
+uniform int u_instance;  // the object's id
 
 layout(location = 0) out vec4 o_color;
 layout(location = 1) out float o_depth;
 layout(location = 2) out uint o_label;  // volume labels only
+layout(location = 3) out int o_instance;
+layout(location = 4) out int o_voxel;  // volume voxels only
 
 void main() {
   vec3 p = v_position.xyz / v_position.w;
   o_depth = p.z;
   o_label = 0u;
+  o_instance = u_instance;
+  o_voxel = -1;
+#if SHADE
   vec3 n = normalize(v_normal);
   if (!gl_FrontFacing) n = -n;
   o_color = vec4(lit(u_color.rgb, n, p), u_color.a);
+#else
+  o_color = u_color;
+#endif
 }

@@ -10,6 +10,10 @@
 
 #include "lighting.glsl"
 
+#ifndef SHADE
+#define SHADE 1
+#endif
+
 #ifndef NORMAL_SPAN
 #define NORMAL_SPAN 1.2  // VolumeData::kNormalSpan
 #endif
@@ -35,6 +39,10 @@ uniform int u_brick_size;
 layout(location = 0) out vec4 o_color;
 layout(location = 1) out float o_depth;
 layout(location = 2) out uint o_label;
+layout(location = 3) out int o_instance;
+layout(location = 4) out int o_voxel;
+
+uniform int u_instance;  // the volume's object id
 
 vec3 inv_shape;
 float field(vec3 u) { return texture(u_occupancy, u * inv_shape).r; }
@@ -52,12 +60,14 @@ uint label_at(ivec3 v) {
   return texelFetch(u_labels, v, 0).r;
 }
 
-uint dominant_label(vec3 u) {
+// The solid voxel with the largest trilinear weight at u (its label; the voxel in `voxel`).
+uint dominant_label(vec3 u, out ivec3 voxel) {
   vec3 c = u - 0.5;
   ivec3 base = ivec3(floor(c));
   vec3 f = c - vec3(base);
   uint best = 0u;
   float best_w = -1.0;
+  voxel = ivec3(-1);
   for (int corner = 0; corner < 8; ++corner) {
     ivec3 d = ivec3(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
     uint l = label_at(base + d);
@@ -67,6 +77,7 @@ uint dominant_label(vec3 u) {
     if (w > best_w) {
       best_w = w;
       best = l;
+      voxel = base + d;
     }
   }
   return best;
@@ -155,23 +166,34 @@ void main() {
   }
   vec3 u = u_eye + t * dir;
 
-  // The gradient from the four corners of a tetrahedron around the hit.
+  vec4 camera = u_camera_from_voxel * vec4(u, 1.0);
+  vec4 clip = u_clip_from_voxel * vec4(u, 1.0);
+
+  // The gradient from the four corners of a tetrahedron around the hit (it points inwards).
   const float h = NORMAL_SPAN;
   float a0 = field(u + h * vec3(1, 1, 1)), a1 = field(u + h * vec3(1, -1, -1));
   float a2 = field(u + h * vec3(-1, 1, -1)), a3 = field(u + h * vec3(-1, -1, 1));
   vec3 g = vec3(a0 + a1 - a2 - a3, a0 - a1 + a2 - a3, a0 - a1 - a2 + a3);
-  vec3 n = normalize(u_normal_from_voxel * -g);
-  vec4 camera = u_camera_from_voxel * vec4(u, 1.0);
-  vec4 clip = u_clip_from_voxel * vec4(u, 1.0);
-  if (dot(n, camera.xyz) > 0.0) n = -n;  // grazing hits: light the side the camera sees
 
-  // The voxel half a step further in is solid almost always; thin features fall back to the
-  // solid neighbour with the largest trilinear weight.
-  uint label = label_at(ivec3(floor(u + 0.25 * dir)));
-  if (label == 0u) label = dominant_label(u);
+  // The voxel a quarter voxel in from the surface (along the gradient, so every view sees the
+  // same voxel at a surface point) is solid almost always; thin features fall back to the solid
+  // neighbour with the largest trilinear weight.
+  vec3 inward = dot(g, g) > 1e-12 ? normalize(g) : dir;
+  ivec3 voxel = ivec3(floor(u + 0.25 * inward));
+  uint label = label_at(voxel);
+  if (label == 0u) label = dominant_label(u, voxel);
   vec3 base = texelFetch(u_colors, ivec2(int(label & 255u), int(label >> 8)), 0).rgb;
+#if SHADE
+  vec3 n = normalize(u_normal_from_voxel * -g);
+  if (dot(n, camera.xyz) > 0.0) n = -n;  // grazing hits: light the side the camera sees
   o_color = vec4(lit(base, n, camera.xyz), 1.0);
+#else
+  o_color = vec4(base, 1.0);
+#endif
   o_depth = camera.z;
   o_label = label;
+  o_instance = u_instance;
+  ivec3 shape = ivec3(u_shape);
+  o_voxel = label == 0u ? -1 : voxel.x + shape.x * (voxel.y + shape.y * voxel.z);
   gl_FragDepth = clip.z / clip.w;
 }

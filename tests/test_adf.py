@@ -535,8 +535,14 @@ def test_drilling_fixture_cameras_ride_on_the_main_camera(fixtures):
     # The original drilling scene: its stereo pair and its headlight are children of a camera,
     # placed in that camera's AMBF frame (x back from the view, y right, z up).
     launch = fixtures / "volumetric_drilling" / "launch.yaml"
-    sim = ambfplus.Simulator.from_launch(launch, models=[0, 2, 5], strict=True)
-    assert sim.load_report.errors == []
+    sim = ambfplus.Simulator.from_launch(launch, models=[0, 2, 5])
+    # Only the launch file's plugin (the original's drilling plugin binary) may be missing.
+    assert all("libvolumetric_drilling" in e[1] for e in sim.load_report.errors)
+    assert [m.name for m in sim.load_report.models][-3:] == [
+        "drills",
+        "volume_256",
+        "stereo_cameras",
+    ]
     assert not [w for w in sim.load_report.warnings if "not found" in w[1] and "parent" in w[1]]
     main, left, right = (sim.get(n) for n in ("main_camera", "stereoL", "stereoR"))
     assert left.attached_to.name == "main_camera" and right.attached_to.name == "main_camera"

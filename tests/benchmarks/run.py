@@ -317,6 +317,53 @@ def adf(args) -> Iterator[dict]:
         }
 
 
+DRILLING_LAUNCH = FIXTURES / "volumetric_drilling" / "launch.yaml"
+
+
+@benchmark
+def stereo(args) -> Iterator[dict]:
+    """The original's stereo pair (stereoL/R, 640x480) on the drill and the 256^3 ear."""
+    if not DRILLING_LAUNCH.is_file():
+        print(f"stereo: skipped, fixtures not found at {DRILLING_LAUNCH}", file=sys.stderr)
+        return
+    from ambfplus.stereo import StereoRig
+
+    sim = ambfplus.Simulator.from_launch(DRILLING_LAUNCH, models=[0, 2, 5])
+    rig = StereoRig.from_cameras(sim.get("stereoL"), sim.get("stereoR"))
+    repeats = 3 if args.quick else 7
+
+    def cpu_per_capture(passes) -> float:
+        rig.capture(passes)  # warm-up: programs, targets
+        times = []
+        for _ in range(repeats):
+            c0 = time.process_time()
+            rig.capture(passes)
+            times.append(time.process_time() - c0)
+        return statistics.median(times)
+
+    full = cpu_per_capture(("rgb", "depth", "instance", "label"))
+    rgb = cpu_per_capture(("rgb",))
+    yield {
+        "bench": "stereo_capture_640x480_cpu",
+        "value": round(full, 4),
+        "unit": "CPU-s per stereo pair",
+        "target": 0.3,
+        "passes": "rgb+depth+instance+label",
+        "original_cpu_s": 3.3,
+        "what": "drill + ear 256^3, both views of the fixture's stereoL/stereoR",
+    }
+    for name in ("rgb", "depth", "instance", "label", "voxel"):
+        cost = rgb if name == "rgb" else cpu_per_capture((name,))
+        yield {
+            "bench": f"stereo_pass_{name}_cpu",
+            "value": round(cost, 4),
+            "unit": "CPU-s per stereo pair",
+            "baseline": round(rgb, 4),
+            "ratio": round(cost / rgb, 3),
+            "what": f"the {name} pass alone, relative to rgb alone",
+        }
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--only", choices=sorted(BENCHMARKS), help="run one benchmark")

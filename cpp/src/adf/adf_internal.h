@@ -13,8 +13,10 @@
 namespace ambfplus {
 
 class Model;
+class Object;
 class RigidBody;
 class World;
+struct PluginSite;
 
 namespace adf {
 
@@ -23,7 +25,28 @@ struct Context {
   const AdfColors* colors = nullptr;
   Diagnostics* diag = nullptr;
   std::string prefix;  ///< AMBF's --ns
+  /// A plugin that fails is an error of the load report (a non-strict launch) instead of a
+  /// PluginError.
+  bool report_plugin_errors = false;
 };
+
+/// The `plugins: [{name, filename, path}]` list under a block, `path` made absolute.
+std::vector<AdfPlugin> read_plugins(const Doc& doc, const YAML::Node& list,
+                                    const std::string& where);
+
+/// The plugins an object's block declares, loaded once its whole file is built.
+struct ObjectPlugins {
+  Object* object = nullptr;
+  std::string where;  ///< its block, "BODY l1"
+  std::vector<AdfPlugin> plugins;
+};
+
+/// Loads plugins declared in file (at `where`: "launch", "world", "model", "BODY l1") at
+/// site. A failure throws PluginError naming the file, or with ctx.report_plugin_errors is an
+/// error of the report; a plugin whose init() declines is a warning.
+void load_plugins(const std::vector<AdfPlugin>& plugins, const PluginSite& site,
+                  const std::string& file, const std::string& where, Context& ctx);
+void load_plugins(const std::vector<ObjectPlugins>& objects, const std::string& file, Context& ctx);
 
 /// A namespace as AMBF resolves it: absolute ones kept (after the prefix), relative ones
 /// appended to base, none gives base; always ending in '/'.
@@ -34,9 +57,10 @@ std::string unique_name(const World& world, const std::string& name);
 std::string unique_model_name(const World& world, const std::string& base);
 
 /// The `cameras` and `lights` a file lists, added to model; parents are looked up in `own`
-/// (identifier, body) and then the world.
+/// (identifier, body) and then the world. The plugins their blocks declare go to plugins.
 void add_cameras_and_lights(Model& model, const Doc& doc, const std::string& base_ns, Context& ctx,
-                            const std::vector<std::pair<std::string, RigidBody*>>& own);
+                            const std::vector<std::pair<std::string, RigidBody*>>& own,
+                            std::vector<ObjectPlugins>& plugins);
 
 /// A model file, all or nothing.
 Model& load_model(World& world, const std::string& path, Context& ctx);

@@ -10,6 +10,8 @@
 #include <Eigen/Geometry>
 
 #include "adf/adf_internal.h"
+#include "ambfplus/plugin/registry.h"
+#include "ambfplus/scene/simulator.h"
 #include "ambfplus/scene/world.h"
 
 namespace ambfplus {
@@ -17,10 +19,8 @@ namespace ambfplus {
 using adf::Doc;
 namespace fs = std::filesystem;
 
-namespace {
-
-std::vector<AdfPlugin> read_plugins(const Doc& doc, const YAML::Node& list,
-                                    const std::string& where) {
+std::vector<AdfPlugin> adf::read_plugins(const Doc& doc, const YAML::Node& list,
+                                         const std::string& where) {
   std::vector<AdfPlugin> out;
   if (!list) return out;
   if (!list.IsSequence()) adf::fail(doc, list, where, "'plugins' must be a list");
@@ -35,6 +35,30 @@ std::vector<AdfPlugin> read_plugins(const Doc& doc, const YAML::Node& list,
   }
   return out;
 }
+
+void adf::load_plugins(const std::vector<AdfPlugin>& plugins, const PluginSite& site,
+                       const std::string& file, const std::string& where, Context& ctx) {
+  for (const AdfPlugin& p : plugins) {
+    try {
+      if (site.world->plugins().load(PluginSpec{p.name, p.filename, p.path}, site) == nullptr) {
+        ctx.diag->warn(file, where + ": plugin '" + (p.name.empty() ? p.filename : p.name) +
+                                 "' is not kept: its init() returned less than 1");
+      }
+    } catch (const PluginError& e) {
+      if (!ctx.report_plugin_errors) throw PluginError(file + ": " + where + ": " + e.what());
+      ctx.diag->error(file, where + ": " + e.what());
+    }
+  }
+}
+
+void adf::load_plugins(const std::vector<ObjectPlugins>& objects, const std::string& file,
+                       Context& ctx) {
+  for (const ObjectPlugins& o : objects) {
+    load_plugins(o.plugins, PluginSite::of(*o.object), file, o.where, ctx);
+  }
+}
+
+namespace {
 
 // Static planes around the origin: AMBF's `enclosure` when a world has no environment.
 void add_enclosure(World& world, const Doc& doc, const YAML::Node& node) {
@@ -93,12 +117,12 @@ void load_world(World& world, const std::string& path, adf::Context& ctx) {
   if (root["environment"]) {
     environment = adf::resolve(doc.dir, adf::text(doc, root["environment"], where, "environment"));
   }
-  for (const char* key : {"skybox", "shaders", "plugins"}) {
+  for (const char* key : {"skybox", "shaders"}) {
     if (root[key]) {
       ctx.diag->warn(doc.path, adf::at(root[key]) + "world '" + key + "' is not applied yet");
     }
   }
-  if (root["plugins"]) read_plugins(doc, root["plugins"], where);  // checked, loaded elsewhere
+  const std::vector<AdfPlugin> plugins = adf::read_plugins(doc, root["plugins"], where);
 
   world.set_name_space(ns);
   world.set_gravity(gravity);
@@ -112,7 +136,11 @@ void load_world(World& world, const std::string& path, adf::Context& ctx) {
   } else if (root["enclosure"]) {
     add_enclosure(world, doc, root["enclosure"]);
   }
-  adf::add_cameras_and_lights(world.default_model(), doc, ns, ctx, own);
+  std::vector<adf::ObjectPlugins> object_plugins;
+  adf::add_cameras_and_lights(world.default_model(), doc, ns, ctx, own, object_plugins);
+  // Plugins once the world is built: its objects', then its own.
+  adf::load_plugins(object_plugins, doc.path, ctx);
+  adf::load_plugins(plugins, PluginSite::of(world), doc.path, where, ctx);
 }
 
 }  // namespace
@@ -140,7 +168,7 @@ AdfLaunch read_launch(const std::string& path) {
     launch.models.push_back(
         adf::resolve(doc.dir, adf::text(doc, m, "launch", "multibody configs")));
   }
-  launch.plugins = read_plugins(doc, doc.root["plugins"], "launch");
+  launch.plugins = adf::read_plugins(doc, doc.root["plugins"], "launch");
   return launch;
 }
 
@@ -264,6 +292,7 @@ AdfReport load_launch(World& world, const std::string& path, const AdfLoadOption
               "colour file " + launch.colors + " not found: colours by name fall back to grey");
   }
   adf::Context ctx{&colors, &diag, options.namespace_prefix};
+  ctx.report_plugin_errors = !options.strict;
   const std::size_t models_before = world.models().size();
   if (options.load_world) load_world(world, launch.world, ctx);
 
@@ -316,6 +345,14 @@ AdfReport load_launch(World& world, const std::string& path, const AdfLoadOption
     diag.error(launch.input_devices, "input devices file not found: no devices set up");
   } else {
     diag.warn(launch.file, "input devices file " + launch.input_devices + " not found");
+  }
+
+  // Simulator plugins last, when the scene they see is complete: the launch file's, then those
+  // given with the load (AMBF's --plugins).
+  const PluginSite simulator = PluginSite::of(world.simulator());
+  adf::load_plugins(launch.plugins, simulator, launch.file, "launch", ctx);
+  for (const std::string& file : options.plugins) {
+    adf::load_plugins({AdfPlugin{"", file, ""}}, simulator, "command line", "--plugins", ctx);
   }
 
   const std::vector<Model*> models = world.models();

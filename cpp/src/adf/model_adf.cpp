@@ -15,6 +15,7 @@
 
 #include "adf/adf_internal.h"
 #include "ambfplus/adf/volume_adf.h"
+#include "ambfplus/plugin/plugin.h"
 #include "ambfplus/scene/constraint_actuator.h"
 #include "ambfplus/scene/proximity_sensor.h"
 #include "ambfplus/scene/soft_body.h"
@@ -170,6 +171,7 @@ struct BodyPlan {
   std::string id;
   std::string ns;
   RigidBodySpec spec;
+  std::vector<AdfPlugin> plugins;
 };
 
 BodyPlan plan_body(const Doc& doc, const std::string& model_hr, const std::string& model_lr,
@@ -341,9 +343,7 @@ BodyPlan plan_body(const Doc& doc, const std::string& model_hr, const std::strin
                                  ": a collision mesh needs a visual mesh in ambfplus; ignored");
   }
   s.material = material(doc, id, b, ctx);
-  if (const YAML::Node plugins = b["plugins"]) {
-    ctx.diag->warn(doc.path, at(plugins) + id + ": object plugins are not loaded yet");
-  }
+  plan.plugins = read_plugins(doc, b["plugins"], id);
   return plan;
 }
 
@@ -353,6 +353,7 @@ struct JointPlan {
   std::string parent, child;  // as written
   YAML::Node block;
   JointSpec spec;  // without its bodies
+  std::vector<AdfPlugin> plugins;
 };
 
 JointPlan plan_joint(const Doc& doc, const std::string& model_ns, const std::string& id,
@@ -462,6 +463,7 @@ JointPlan plan_joint(const Doc& doc, const std::string& model_ns, const std::str
         boolean(doc, j["ignore inter-collision"], id, "ignore inter-collision");
   }
   if (j["passive"]) s.passive = boolean(doc, j["passive"], id, "passive");
+  plan.plugins = read_plugins(doc, j["plugins"], id);
   return plan;
 }
 
@@ -470,6 +472,9 @@ struct CameraPlan {
   CameraSpec spec;
   Eigen::Vector3d eye = Eigen::Vector3d::Zero(), target = Eigen::Vector3d::Zero(),
                   up = Eigen::Vector3d::UnitZ();
+  std::vector<AdfPlugin> plugins;
+  double eye_separation = 0.0;  // `stereo`: a left and a right eye beside the camera
+  double stereo_focal = 0.0;    // where the eyes' views converge (off-axis), m
 };
 
 CameraPlan plan_camera(const Doc& doc, const std::string& base_ns, const std::string& id,
@@ -519,18 +524,44 @@ CameraPlan plan_camera(const Doc& doc, const std::string& base_ns, const std::st
     plan.spec.width = static_cast<int>(number_or(doc, res, "width", id, plan.spec.width));
     plan.spec.height = static_cast<int>(number_or(doc, res, "height", id, plan.spec.height));
   }
+  CameraPublish& pub = plan.spec.publish;
+  if (n["publish image"]) pub.image = boolean(doc, n["publish image"], id, "publish image");
+  if (n["publish depth"]) pub.depth = boolean(doc, n["publish depth"], id, "publish depth");
+  if (n["publish image interval"]) {
+    pub.image_interval = integer(doc, n["publish image interval"], id, "publish image interval");
+  }
+  if (n["publish depth interval"]) {
+    pub.depth_interval = integer(doc, n["publish depth interval"], id, "publish depth interval");
+  }
+  if (const YAML::Node noise = n["publish depth noise"]) {
+    pub.depth_noise = true;
+    pub.noise_mean = number_or(doc, noise, "mean", id, pub.noise_mean);
+    const YAML::Node std_dev = noise["std_dev"] ? noise["std_dev"] : noise["std dev"];
+    if (std_dev) pub.noise_std = number(doc, std_dev, id, "publish depth noise.std_dev");
+    pub.noise_bias = number_or(doc, noise, "bias", id, pub.noise_bias);
+  }
+  if (pub.image_interval < 1 || pub.depth_interval < 1) {
+    fail(doc, n, id, "publish intervals must be >= 1");
+  }
+  if (const YAML::Node stereo = n["stereo"]) {
+    plan.eye_separation = number_or(doc, stereo, "eye separation", id, 0.0);
+    plan.stereo_focal = number_or(doc, stereo, "focal length", id, 0.0);
+    if (!(plan.eye_separation > 0)) fail(doc, stereo, id, "'stereo' needs 'eye separation' > 0");
+  }
   for (const char* key :
-       {"orthographic view width", "stereo", "preprocessing shaders", "depth compute shaders"}) {
+       {"orthographic view width", "preprocessing shaders", "depth compute shaders"}) {
     if (n[key]) {
       ctx.diag->warn(doc.path, at(n[key]) + id + ": '" + key + "' is not applied yet");
     }
   }
+  plan.plugins = read_plugins(doc, n["plugins"], id);
   return plan;
 }
 
 struct LightPlan {
   std::string id, ns, parent;
   LightSpec spec;
+  std::vector<AdfPlugin> plugins;
 };
 
 LightPlan plan_light(const Doc& doc, const std::string& base_ns, const std::string& id,
@@ -560,6 +591,7 @@ LightPlan plan_light(const Doc& doc, const std::string& base_ns, const std::stri
     const int q = integer(doc, n["shadow quality"], id, "shadow quality");
     if (q < 0 || q > 5) fail(doc, n["shadow quality"], id, "'shadow quality' must be 0 to 5");
   }
+  plan.plugins = read_plugins(doc, n["plugins"], id);
   return plan;
 }
 
@@ -798,7 +830,8 @@ std::string unique_name(const World& world, const std::string& name) {
 }
 
 void add_cameras_and_lights(Model& model, const Doc& doc, const std::string& base_ns, Context& ctx,
-                            const std::vector<std::pair<std::string, RigidBody*>>& own) {
+                            const std::vector<std::pair<std::string, RigidBody*>>& own,
+                            std::vector<ObjectPlugins>& plugins) {
   World& world = model.world();
   std::vector<CameraPlan> cameras;
   std::vector<LightPlan> lights;
@@ -829,6 +862,23 @@ void add_cameras_and_lights(Model& model, const Doc& doc, const std::string& bas
     if (Object* parent = parent_of(c.id, c.parent, c.ns)) {
       camera.attach_to(parent, parent_frame(*parent) * camera.pose());
     }
+    if (c.eye_separation > 0) {
+      // AMBF's passive stereo: two eyes half the separation either side, converging (off-axis)
+      // at the focal length when one is given.
+      const double f = camera.intrinsics()(0, 0);
+      const double shift = c.stereo_focal > 0 ? f * c.eye_separation / c.stereo_focal / 2 : 0.0;
+      for (const int side : {-1, 1}) {
+        CameraSpec eye = c.spec;
+        eye.name = unique_name(world, c.spec.name + (side < 0 ? "_left" : "_right"));
+        Camera& e = model.add_camera(eye);
+        e.set_name_space(c.ns);
+        Eigen::Isometry3d local = Eigen::Isometry3d::Identity();
+        local.translation().x() = side * c.eye_separation / 2;
+        e.attach_to(&camera, local);
+        e.set_principal_point(eye.width / 2.0 + side * shift, eye.height / 2.0);
+      }
+    }
+    if (!c.plugins.empty()) plugins.push_back({&camera, c.id, c.plugins});
   }
   for (LightPlan& l : lights) {
     l.spec.name = unique_name(world, l.spec.name);
@@ -838,6 +888,7 @@ void add_cameras_and_lights(Model& model, const Doc& doc, const std::string& bas
     if (Object* parent = parent_of(l.id, l.parent, l.ns)) {
       light.attach_to(parent, parent_frame(*parent) * light.pose());
     }
+    if (!l.plugins.empty()) plugins.push_back({&light, l.id, l.plugins});
   }
 }
 
@@ -897,8 +948,10 @@ Model& load_model(World& world, const std::string& path, Context& ctx) {
     joints.push_back(plan_joint(doc, model_ns, id, block, ctx));
   }
   std::vector<std::pair<std::string, SoftBodySpec>> softs;
+  std::vector<std::vector<AdfPlugin>> soft_plugins;
   for (const auto& [id, block] : listed(doc, "soft bodies")) {
     softs.emplace_back(id, plan_soft_body(doc, lr, hr, id, block, ctx));
+    soft_plugins.push_back(read_plugins(doc, block["plugins"], id));
   }
   std::vector<SensorPlan> sensors;
   for (const bool actuator : {false, true}) {
@@ -911,11 +964,10 @@ Model& load_model(World& world, const std::string& path, Context& ctx) {
       ctx.diag->warn(doc.path, at(root[key]) + "'" + key + "' are not loaded yet");
     }
   }
-  for (const char* key : {"plugins", "shaders"}) {
-    if (root[key]) {
-      ctx.diag->warn(doc.path, at(root[key]) + "model '" + key + "' are not applied yet");
-    }
+  if (root["shaders"]) {
+    ctx.diag->warn(doc.path, at(root["shaders"]) + "model 'shaders' are not applied yet");
   }
+  const std::vector<AdfPlugin> model_plugins = read_plugins(doc, root["plugins"], where);
   const bool has_volumes = static_cast<bool>(root["volumes"]);
   std::vector<AdfVolumeBlock> volumes;
   std::vector<AdfDrillBlock> drills;
@@ -927,6 +979,7 @@ Model& load_model(World& world, const std::string& path, Context& ctx) {
   std::string current = "model";
   try {
     std::vector<std::pair<std::string, RigidBody*>> own;
+    std::vector<ObjectPlugins> object_plugins;
     for (BodyPlan& b : bodies) {
       current = b.id;
       b.spec.name = unique_name(world, b.spec.name);
@@ -934,6 +987,7 @@ Model& load_model(World& world, const std::string& path, Context& ctx) {
       body.set_identifier(b.id);
       body.set_name_space(b.ns);
       own.emplace_back(b.id, &body);
+      if (!b.plugins.empty()) object_plugins.push_back({&body, b.id, b.plugins});
     }
     // The model-wide flag: its bodies pass through one another (joints have their own).
     if (ignore_inter_collision) {
@@ -943,12 +997,14 @@ Model& load_model(World& world, const std::string& path, Context& ctx) {
         }
       }
     }
-    for (auto& [id, spec] : softs) {
+    for (std::size_t i = 0; i < softs.size(); ++i) {
+      auto& [id, spec] = softs[i];
       current = id;
       spec.name = unique_name(world, spec.name);
       SoftBody& soft = model.add_soft_body(spec);
       soft.set_identifier(id);
       soft.set_name_space(model_ns);
+      if (!soft_plugins[i].empty()) object_plugins.push_back({&soft, id, soft_plugins[i]});
     }
     for (JointPlan& j : joints) {
       current = j.id;
@@ -968,6 +1024,7 @@ Model& load_model(World& world, const std::string& path, Context& ctx) {
       Joint& joint = model.add_joint(j.spec);
       joint.set_identifier(j.id);
       joint.set_name_space(j.ns);
+      if (!j.plugins.empty()) object_plugins.push_back({&joint, j.id, j.plugins});
     }
     for (SensorPlan& p : sensors) {
       current = p.id;
@@ -991,13 +1048,19 @@ Model& load_model(World& world, const std::string& path, Context& ctx) {
       made->set_name_space(p.ns);
     }
     current = "cameras and lights";
-    add_cameras_and_lights(model, doc, model_ns, ctx, own);
+    add_cameras_and_lights(model, doc, model_ns, ctx, own, object_plugins);
     current = "volumes";
     if (has_volumes || !drills.empty()) add_adf_volumes(model, path, "", volumes, drills);
+    // Plugins once the model is built: its objects' in creation order, then its own.
+    load_plugins(object_plugins, doc.path, ctx);
+    load_plugins(model_plugins, PluginSite::of(model), doc.path, where, ctx);
   } catch (const AssetNotFound&) {
     world.remove_model(model);
     throw;
   } catch (const ConfigError&) {
+    world.remove_model(model);
+    throw;
+  } catch (const PluginError&) {
     world.remove_model(model);
     throw;
   } catch (const std::exception& e) {

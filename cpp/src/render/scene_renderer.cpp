@@ -39,7 +39,7 @@ SceneRenderer::~SceneRenderer() {
     }
     for (auto& [key, t] : targets_) {
       glDeleteFramebuffers(1, &t.framebuffer);
-      glDeleteRenderbuffers(4, t.renderbuffers);
+      glDeleteRenderbuffers(RenderTarget::kBuffers, t.renderbuffers);
     }
   } catch (const Error&) {
     // The context is gone (e.g. after a fork); its objects went with it.
@@ -139,25 +139,22 @@ RenderTarget& SceneRenderer::target_for(const Camera& camera) {
   t.width = camera.width();
   t.height = camera.height();
   glGenFramebuffers(1, &t.framebuffer);
-  glGenRenderbuffers(4, t.renderbuffers);
-  const GLenum formats[4] = {GL_RGBA8, GL_R32F, GL_R16UI, GL_DEPTH_COMPONENT32F};
-  for (int i = 0; i < 4; ++i) {
+  glGenRenderbuffers(RenderTarget::kBuffers, t.renderbuffers);
+  const GLenum formats[RenderTarget::kBuffers] = {GL_RGBA8, GL_R32F, GL_R16UI,
+                                                  GL_R32I,  GL_R32I, GL_DEPTH_COMPONENT32F};
+  glBindFramebuffer(GL_FRAMEBUFFER, t.framebuffer);
+  for (int i = 0; i < RenderTarget::kBuffers; ++i) {
     glBindRenderbuffer(GL_RENDERBUFFER, t.renderbuffers[i]);
     glRenderbufferStorage(GL_RENDERBUFFER, formats[i], t.width, t.height);
+    const GLenum attachment = i + 1 < RenderTarget::kBuffers
+                                  ? static_cast<GLenum>(GL_COLOR_ATTACHMENT0 + i)
+                                  : static_cast<GLenum>(GL_DEPTH_ATTACHMENT);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, attachment, GL_RENDERBUFFER, t.renderbuffers[i]);
   }
-  glBindFramebuffer(GL_FRAMEBUFFER, t.framebuffer);
-  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER,
-                            t.renderbuffers[0]);
-  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_RENDERBUFFER,
-                            t.renderbuffers[1]);
-  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT2, GL_RENDERBUFFER,
-                            t.renderbuffers[2]);
-  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER,
-                            t.renderbuffers[3]);
   const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
   if (status != GL_FRAMEBUFFER_COMPLETE) {
     glDeleteFramebuffers(1, &t.framebuffer);
-    glDeleteRenderbuffers(4, t.renderbuffers);
+    glDeleteRenderbuffers(RenderTarget::kBuffers, t.renderbuffers);
     throw RenderError("camera '" + camera.name() + "': off-screen framebuffer of " +
                       std::to_string(t.width) + "x" + std::to_string(t.height) +
                       " is incomplete (status 0x" + std::to_string(status) + ")");
@@ -166,16 +163,24 @@ RenderTarget& SceneRenderer::target_for(const Camera& camera) {
   return targets_.emplace(camera.id(), t).first->second;
 }
 
-void SceneRenderer::draw(const Camera& camera) {
+void SceneRenderer::draw(const Camera& camera, unsigned passes) {
   Context::Scope scope;
   const Eigen::Isometry3d camera_from_world = camera.pose().inverse();
   const LightSet lights(world_, camera_from_world);
-  Program& program = Context::get().program("mesh.vert", "mesh.frag", lights.defines());
+  // Shading is the costly part: without an rgb pass the shaders skip it.
+  const std::string defines =
+      lights.defines() + ((passes & kPassRgb) ? "#define SHADE 1\n" : "#define SHADE 0\n");
+  Program& program = Context::get().program("mesh.vert", "mesh.frag", defines);
   RenderTarget& target = target_for(camera);
 
   glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
-  const GLenum draw_buffers[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
-  glDrawBuffers(3, draw_buffers);
+  // Only the passes asked for are written.
+  const unsigned order[5] = {kPassRgb, kPassDepth, kPassLabel, kPassInstance, kPassVoxel};
+  GLenum draw_buffers[5];
+  for (int i = 0; i < 5; ++i) {
+    draw_buffers[i] = (passes & order[i]) ? static_cast<GLenum>(GL_COLOR_ATTACHMENT0 + i) : GL_NONE;
+  }
+  glDrawBuffers(5, draw_buffers);
   glViewport(0, 0, target.width, target.height);
   // Reversed z: clear to 0 (far), keep the greater depth.
   glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
@@ -194,6 +199,10 @@ void SceneRenderer::draw(const Camera& camera) {
   glClearBufferfv(GL_COLOR, 1, clear_depth_image);
   const GLuint clear_label[4] = {0, 0, 0, 0};
   glClearBufferuiv(GL_COLOR, 2, clear_label);
+  const GLint clear_instance[4] = {0, 0, 0, 0};
+  const GLint clear_voxel[4] = {-1, -1, -1, -1};
+  glClearBufferiv(GL_COLOR, 3, clear_instance);
+  glClearBufferiv(GL_COLOR, 4, clear_voxel);
   glClearBufferfv(GL_DEPTH, 0, &clear_depth);
 
   program.use();
@@ -206,9 +215,12 @@ void SceneRenderer::draw(const Camera& camera) {
   const GLint u_color = program.uniform("u_color");
   const GLint u_specular = program.uniform("u_specular");
   const GLint u_shininess = program.uniform("u_shininess");
+  const GLint u_instance = program.uniform("u_instance");
 
-  auto draw = [&](const GpuMesh& mesh, const Eigen::Isometry3d& model_view, const Material& m) {
+  auto draw = [&](const GpuMesh& mesh, const Eigen::Isometry3d& model_view, const Material& m,
+                  int id) {
     if (mesh.index_count == 0) return;  // an anchor without geometry
+    glUniform1i(u_instance, id);
     const Eigen::Matrix4f mv = to_float(model_view.matrix());
     const Eigen::Matrix3f normal = model_view.linear().cast<float>();
     glUniformMatrix4fv(u_model_view, 1, GL_FALSE, mv.data());
@@ -220,12 +232,14 @@ void SceneRenderer::draw(const Camera& camera) {
     glDrawElements(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr);
   };
   for (const RigidBody* body : world_.objects_of_kind<RigidBody>()) {
+    if (body->visual_mesh()->indices.empty()) continue;  // an anchor without geometry
     // Composed in double, then rounded once, to keep depth exact far from the origin.
-    draw(mesh_for(body->visual_mesh().get()), camera_from_world * body->pose(), body->material());
+    draw(mesh_for(body->visual_mesh().get()), camera_from_world * body->pose(), body->material(),
+         body->id());
   }
   // Soft bodies: their nodes are in the world frame.
   for (const SoftBody* body : world_.objects_of_kind<SoftBody>()) {
-    draw(soft_mesh_for(*body), camera_from_world, body->material());
+    draw(soft_mesh_for(*body), camera_from_world, body->material(), body->id());
   }
   glBindVertexArray(0);
   // Volumes after the meshes: their rays write depth, so each pixel keeps the nearer surface.
@@ -233,7 +247,7 @@ void SceneRenderer::draw(const Camera& camera) {
     auto& gpu = volumes_[volume->data().get()];
     if (!gpu) gpu = std::make_unique<GpuVolume>(volume->data());
     gpu->sync(volume->iso());
-    gpu->draw(*volume, camera, camera_from_world, lights);
+    gpu->draw(*volume, camera, camera_from_world, lights, passes);
   }
   check_gl("drawing the scene");
 }
@@ -244,25 +258,27 @@ void SceneRenderer::read(const Camera& camera, const CaptureBuffers& buffers) {
   glBindFramebuffer(GL_READ_FRAMEBUFFER, target.framebuffer);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
   glPixelStorei(GL_PACK_ROW_LENGTH, 0);
-  if (buffers.rgb != nullptr) {
-    glReadBuffer(GL_COLOR_ATTACHMENT0);
-    glReadPixels(0, 0, target.width, target.height, GL_RGB, GL_UNSIGNED_BYTE, buffers.rgb);
-  }
-  if (buffers.depth != nullptr) {
-    glReadBuffer(GL_COLOR_ATTACHMENT1);
-    glReadPixels(0, 0, target.width, target.height, GL_RED, GL_FLOAT, buffers.depth);
-  }
-  if (buffers.label != nullptr) {
-    glReadBuffer(GL_COLOR_ATTACHMENT2);
-    glReadPixels(0, 0, target.width, target.height, GL_RED_INTEGER, GL_UNSIGNED_SHORT,
-                 buffers.label);
+  // Attachment i holds pass i (see draw).
+  const struct {
+    void* data;
+    GLenum format, type;
+  } images[5] = {{buffers.rgb, GL_RGB, GL_UNSIGNED_BYTE},
+                 {buffers.depth, GL_RED, GL_FLOAT},
+                 {buffers.label, GL_RED_INTEGER, GL_UNSIGNED_SHORT},
+                 {buffers.instance, GL_RED_INTEGER, GL_INT},
+                 {buffers.voxel, GL_RED_INTEGER, GL_INT}};
+  for (int i = 0; i < 5; ++i) {
+    if (images[i].data == nullptr) continue;
+    glReadBuffer(static_cast<GLenum>(GL_COLOR_ATTACHMENT0 + i));
+    glReadPixels(0, 0, target.width, target.height, images[i].format, images[i].type,
+                 images[i].data);
   }
   check_gl("reading back a capture");
 }
 
 void SceneRenderer::render(const Camera& camera, const CaptureBuffers& buffers) {
   Context::Scope scope;
-  draw(camera);
+  draw(camera, buffers.passes());
   read(camera, buffers);
 }
 

@@ -27,11 +27,12 @@ struct GpuMesh {
   GLsizei index_count = 0;
 };
 
-/// Off-screen colour, metric-depth and depth-test buffers of one camera's size.
+/// Off-screen colour, metric-depth, id and depth-test buffers of one camera's size.
 struct RenderTarget {
+  static constexpr int kBuffers = 6;
   GLuint framebuffer = 0;
-  // colour (RGBA8), depth (R32F), label (R16UI), depth test (D32F)
-  GLuint renderbuffers[4] = {0, 0, 0, 0};
+  // colour (RGBA8), depth (R32F), label (R16UI), instance (R32I), voxel (R32I), depth test (D32F)
+  GLuint renderbuffers[kBuffers] = {0, 0, 0, 0, 0, 0};
   int width = 0;
   int height = 0;
 };
@@ -47,8 +48,8 @@ class SceneRenderer {
 
   /// Renders camera's view and reads it into buffers (null ones are skipped).
   void render(const Camera& camera, const CaptureBuffers& buffers);
-  /// Renders camera's view and leaves it in the GPU (for measuring readback separately).
-  void draw(const Camera& camera);
+  /// Renders camera's view (the CapturePass bits asked for) and leaves it in the GPU.
+  void draw(const Camera& camera, unsigned passes = kPassRgb | kPassDepth | kPassLabel);
   /// Reads the last draw of camera into buffers.
   void read(const Camera& camera, const CaptureBuffers& buffers);
   /// What the last sync of this volume data sent to the GPU (nullptr before its first draw).

@@ -217,10 +217,12 @@ void GpuVolume::sync(double iso) {
 }
 
 void GpuVolume::draw(const Volume& volume, const Camera& camera,
-                     const Eigen::Isometry3d& camera_from_world, const LightSet& lights) {
+                     const Eigen::Isometry3d& camera_from_world, const LightSet& lights,
+                     unsigned passes) {
   const std::string defines =
       lights.defines() + "#define EMPTY_SPACE_SKIPPING " +
       (volume.empty_space_skipping() ? "1" : "0") + "\n" +
+      ((passes & kPassRgb) ? "#define SHADE 1\n" : "#define SHADE 0\n") +
       (std::getenv("AMBFPLUS_DEBUG_VOLUME_STEPS") ? "#define DEBUG_STEPS 1\n" : "");
   Program& program = Context::get().program("volume.vert", "volume.frag", defines);
   program.use();
@@ -248,6 +250,7 @@ void GpuVolume::draw(const Volume& volume, const Camera& camera,
   glUniform1f(program.uniform("u_ambient"), 0.2f);
   glUniform1f(program.uniform("u_specular"), volume.specular());
   glUniform1f(program.uniform("u_shininess"), volume.shininess());
+  glUniform1i(program.uniform("u_instance"), volume.id());
   lights.upload(program);
   const struct {
     const char* name;

@@ -39,8 +39,9 @@ class GpuVolume {
   /// Uploads what changed since the last sync (everything the first time).
   void sync(double iso);
   /// Ray casts the volume into the bound framebuffer (after the meshes, depth-tested).
+  /// Ray casts the volume for the CapturePass bits asked for (shading only with rgb).
   void draw(const Volume& volume, const Camera& camera, const Eigen::Isometry3d& camera_from_world,
-            const LightSet& lights);
+            const LightSet& lights, unsigned passes);
   const VolumeUpload& last_upload() const { return last_upload_; }
 
  private:

@@ -16,7 +16,10 @@ Camera::Camera(Model& model, const CameraSpec& spec, int id)
       fov_y_(spec.fov_y),
       near_(spec.near),
       far_(spec.far),
-      background_(spec.background) {
+      cx_(spec.width / 2.0),
+      cy_(spec.height / 2.0),
+      background_(spec.background),
+      publish_(spec.publish) {
   const std::string who = "camera '" + spec.name + "': ";
   if (width_ <= 0 || height_ <= 0 || width_ > 16384 || height_ > 16384) {
     throw std::invalid_argument(who + "width and height must be in 1..16384, got " +
@@ -59,8 +62,31 @@ void Camera::look_at(const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
 Eigen::Matrix3d Camera::intrinsics() const {
   const double f = height_ / (2.0 * std::tan(fov_y_ / 2.0));
   Eigen::Matrix3d k;
-  k << f, 0, width_ / 2.0, 0, f, height_ / 2.0, 0, 0, 1;
+  k << f, 0, cx_, 0, f, cy_, 0, 0, 1;
   return k;
+}
+
+void Camera::set_principal_point(double cx, double cy) {
+  if (!std::isfinite(cx) || !std::isfinite(cy)) {
+    throw std::invalid_argument("camera '" + name() + "': the principal point must be finite");
+  }
+  cx_ = cx;
+  cy_ = cy;
+}
+
+void Camera::set_passes(unsigned passes) {
+  const unsigned all = kPassRgb | kPassDepth | kPassLabel | kPassInstance | kPassVoxel;
+  if (passes == 0 || (passes & ~all) != 0) {
+    throw std::invalid_argument("camera '" + name() +
+                                "': passes must be a non-empty set of rgb, depth, label, "
+                                "instance, voxel");
+  }
+  passes_ = passes;
+}
+
+unsigned CaptureBuffers::passes() const {
+  return (rgb ? kPassRgb : 0u) | (depth ? kPassDepth : 0u) | (label ? kPassLabel : 0u) |
+         (instance ? kPassInstance : 0u) | (voxel ? kPassVoxel : 0u);
 }
 
 Eigen::Matrix4d Camera::projection() const {
@@ -95,15 +121,21 @@ void Camera::capture(Frame& frame) {
           std::to_string(height_) + "x" + std::to_string(width_) + "x" + std::to_string(want_c));
     }
   };
-  check(frame.rgb.empty(), frame.rgb.height(), frame.rgb.width(), frame.rgb.channels(), 3, "rgb");
-  check(frame.depth.empty(), frame.depth.height(), frame.depth.width(), frame.depth.channels(), 1,
-        "depth");
-  check(frame.label.empty(), frame.label.height(), frame.label.width(), frame.label.channels(), 1,
-        "label");
-  if (frame.rgb.empty()) frame.rgb.allocate(height_, width_, 3);
-  if (frame.depth.empty()) frame.depth.allocate(height_, width_, 1);
-  if (frame.label.empty()) frame.label.allocate(height_, width_, 1);
-  capture(CaptureBuffers{frame.rgb.data(), frame.depth.data(), frame.label.data()}, frame);
+  // A new frame gets the camera's passes; a used one keeps its own.
+  const bool fresh = frame.rgb.empty() && frame.depth.empty() && frame.label.empty() &&
+                     frame.instance.empty() && frame.voxel.empty();
+  auto prepare = [&](auto& buffer, unsigned pass, int channels, const char* what) {
+    check(buffer.empty(), buffer.height(), buffer.width(), buffer.channels(), channels, what);
+    if (fresh && (passes_ & pass)) buffer.allocate(height_, width_, channels);
+    return buffer.data();
+  };
+  CaptureBuffers buffers;
+  buffers.rgb = prepare(frame.rgb, kPassRgb, 3, "rgb");
+  buffers.depth = prepare(frame.depth, kPassDepth, 1, "depth");
+  buffers.label = prepare(frame.label, kPassLabel, 1, "label");
+  buffers.instance = prepare(frame.instance, kPassInstance, 1, "instance");
+  buffers.voxel = prepare(frame.voxel, kPassVoxel, 1, "voxel");
+  capture(buffers, frame);
 }
 
 void Camera::capture(const CaptureBuffers& buffers, Frame& frame) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "ambfplus/plugin/registry.h"
 #include "physics/physics_world.h"
 
 #include <cmath>
@@ -15,13 +16,16 @@ World::World(Simulator& simulator, std::string name, double time_step)
     : simulator_(&simulator),
       name_(std::move(name)),
       time_step_(time_step),
-      physics_(std::make_unique<physics::PhysicsWorld>()) {
+      physics_(std::make_unique<physics::PhysicsWorld>()),
+      plugins_(std::make_unique<PluginRegistry>(*this)) {
   models_.push_back(std::unique_ptr<Model>(new Model(*this, name_)));
 }
 
 // The renderer releases its GL objects before the objects it drew go away, and Bullet lets go
-// of bodies and joints before they are deleted.
+// of bodies and joints before they are deleted. Plugins close first, while all is intact.
 World::~World() {
+  plugins_->close_all();
+  plugins_.reset();
   renderer_.reset();
   physics_->detach_all();
   models_.clear();
@@ -103,6 +107,9 @@ void World::remove_model(Model& model) {
   const auto it = std::find_if(models_.begin(), models_.end(),
                                [&](const auto& m) { return m.get() == &model; });
   if (it == models_.end()) throw std::invalid_argument("the model is not in this world");
+  plugins_->close_model(model);
+  for (Object* object : model.objects()) plugins_->object_removed(*object);
+  ++objects_revision_;
   // Newest first: joints go before the bodies they hold.
   for (auto o = model.owned_.rbegin(); o != model.owned_.rend(); ++o) {
     Object* object = o->get();
@@ -131,13 +138,16 @@ void World::register_object(Object* object) {
   by_name_[object->name()] = object;
   objects_.push_back(object);
   next_id_ = object->id() + 1;
+  ++objects_revision_;
+  plugins_->object_added(*object);
 }
 
 void World::step(std::int64_t n) {
   if (n < 0) throw std::invalid_argument("step count must be >= 0, got " + std::to_string(n));
-  const std::vector<Drill*> drills = objects_of_kind<Drill>();
-  const std::vector<ProximitySensor*> sensors = objects_of_kind<ProximitySensor>();
-  const std::vector<ConstraintActuator*> actuators = objects_of_kind<ConstraintActuator>();
+  std::vector<Drill*> drills = objects_of_kind<Drill>();
+  std::vector<ProximitySensor*> sensors = objects_of_kind<ProximitySensor>();
+  std::vector<ConstraintActuator*> actuators = objects_of_kind<ConstraintActuator>();
+  std::uint64_t listed = objects_revision_;
   for (std::int64_t s = 0; s < n; ++s) {
     ++step_index_;
     physics_->step(time_step_);
@@ -146,10 +156,26 @@ void World::step(std::int64_t n) {
     // Sensors see where everything ended up.
     for (ConstraintActuator* a : actuators) a->update();
     for (ProximitySensor* p : sensors) p->update();
+    plugins_->physics_update(time_step_);
+    // Plugins may add or remove objects.
+    if (objects_revision_ != listed) {
+      drills = objects_of_kind<Drill>();
+      sensors = objects_of_kind<ProximitySensor>();
+      actuators = objects_of_kind<ConstraintActuator>();
+      listed = objects_revision_;
+    }
   }
 }
 
+PluginRegistry& World::plugins() { return *plugins_; }
+
+void World::reset_plugins() { plugins_->reset(); }
+
 render::SceneRenderer& World::renderer() {
+  if (graphics_step_ != step_index_) {
+    graphics_step_ = step_index_;
+    plugins_->graphics_update();
+  }
   if (!renderer_) renderer_ = std::make_unique<render::SceneRenderer>(*this);
   return *renderer_;
 }

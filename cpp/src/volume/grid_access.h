@@ -58,30 +58,34 @@ struct VolumeField {
   }
 };
 
-/// The non-zero label with the largest trilinear weight among the 8 voxels around u (0 if none).
+/// The non-zero label with the largest trilinear weight among the 8 voxels around u (0 if none),
+/// and, if asked, that voxel's linear index (-1 if none).
 template <typename T>
 std::uint16_t dominant_label(const T* labels, const std::array<int, 3>& shape,
-                             const Eigen::Vector3d& u) {
+                             const Eigen::Vector3d& u, std::int64_t* voxel = nullptr) {
   const Eigen::Vector3d c = u - Eigen::Vector3d::Constant(0.5);
   const int i0 = static_cast<int>(std::floor(c.x())), j0 = static_cast<int>(std::floor(c.y())),
             k0 = static_cast<int>(std::floor(c.z()));
   const double f[3] = {c.x() - i0, c.y() - j0, c.z() - k0};
   std::uint16_t best = 0;
   double best_w = -1;
+  if (voxel != nullptr) *voxel = -1;
   for (int corner = 0; corner < 8; ++corner) {
     const int di = corner & 1, dj = (corner >> 1) & 1, dk = (corner >> 2) & 1;
     const int i = i0 + di, j = j0 + dj, k = k0 + dk;
     if (i < 0 || j < 0 || k < 0 || i >= shape[0] || j >= shape[1] || k >= shape[2]) continue;
-    const std::uint16_t l =
-        labels[static_cast<std::size_t>(i) +
-               static_cast<std::size_t>(shape[0]) *
-                   (static_cast<std::size_t>(j) + static_cast<std::size_t>(shape[1]) * k)];
+    const std::size_t index =
+        static_cast<std::size_t>(i) +
+        static_cast<std::size_t>(shape[0]) *
+            (static_cast<std::size_t>(j) + static_cast<std::size_t>(shape[1]) * k);
+    const std::uint16_t l = labels[index];
     if (l == 0) continue;
     const double w = (di ? f[0] : 1 - f[0]) * (dj ? f[1] : 1 - f[1]) * (dk ? f[2] : 1 - f[2]);
     // Strictly greater: ties go to the lowest corner index, as in the shader.
     if (w > best_w) {
       best_w = w;
       best = l;
+      if (voxel != nullptr) *voxel = static_cast<std::int64_t>(index);
     }
   }
   return best;

@@ -469,15 +469,21 @@ VolumeHit VolumeData::raycast(const Eigen::Vector3d& origin, const Eigen::Vector
     const Eigen::Vector3d n = (-g).cwiseQuotient(s);
     result.normal = n.norm() > 0 ? n.normalized() : Eigen::Vector3d(-d);
     result.label = visit_labels(label_type_, labels_.data(), [&](auto* p) -> std::uint16_t {
-      // As the shader: the voxel a quarter voxel further in, else the dominant solid neighbour.
-      const Eigen::Vector3d in = u + 0.25 * du / du.norm();
+      // As the shader: the voxel a quarter voxel in from the surface along the gradient (the
+      // same for every view), else the dominant solid neighbour.
+      const Eigen::Vector3d inward =
+          g.norm() > 1e-12 ? Eigen::Vector3d(g.normalized()) : Eigen::Vector3d(du / du.norm());
+      const Eigen::Vector3d in = u + 0.25 * inward;
       const int i = static_cast<int>(std::floor(in.x())), j = static_cast<int>(std::floor(in.y())),
                 k = static_cast<int>(std::floor(in.z()));
       if (i >= 0 && j >= 0 && k >= 0 && i < shape_[0] && j < shape_[1] && k < shape_[2]) {
         const std::uint16_t l = p[linear_index(i, j, k)];
-        if (l != 0) return l;
+        if (l != 0) {
+          result.voxel = static_cast<std::int64_t>(linear_index(i, j, k));
+          return l;
+        }
       }
-      return dominant_label(p, shape_, u);
+      return dominant_label(p, shape_, u, &result.voxel);
     });
     return result;
   }

@@ -26,7 +26,8 @@ struct AMBFPLUS_API AdfProblem {
   std::string message;
 };
 
-/// A plugin an ADF declares (`plugins: [{name, filename, path}]`); loaded by the plugin system.
+/// A plugin an ADF declares (`plugins: [{name, filename, path}]`), loaded when its file is: at
+/// the launch (simulator scope), world, model or object level.
 struct AMBFPLUS_API AdfPlugin {
   std::string name;
   std::string filename;
@@ -89,6 +90,9 @@ struct AMBFPLUS_API AdfLoadOptions {
   bool load_world = true;        ///< the world file's lights, cameras, environment, gravity
   bool strict = false;           ///< the first model that fails throws instead of being reported
   std::string namespace_prefix;  ///< AMBF's `--ns`, put before every namespace
+  /// Simulator plugins to load after the launch file's (AMBF's `--plugins`): files or names
+  /// as a `plugins` entry's `filename`.
+  std::vector<std::string> plugins;
 };
 
 /// What a launch load did: the models it loaded (world environment first), and what it
@@ -101,21 +105,24 @@ struct AMBFPLUS_API AdfReport {
   std::vector<AdfProblem> warnings;
 };
 
-/// Loads a launch file into the world: the world file, then the models asked for. A model that
-/// fails is reported in errors and leaves nothing behind; with options.strict it throws. The
-/// launch file itself, or its world file, failing always throws.
+/// Loads a launch file into the world: the world file, then the models asked for, then the
+/// simulator plugins. A model that fails is reported in errors and leaves nothing behind; with
+/// options.strict it throws. A plugin that fails is reported in errors (its model stays); with
+/// options.strict it throws PluginError. The launch file itself, or its world file, failing
+/// always throws.
 AMBFPLUS_API AdfReport load_launch(World& world, const std::string& path,
                                    const AdfLoadOptions& options = {});
 
-/// Loads a world file (gravity, namespace, lights, cameras, environment model, enclosure).
-/// Throws AssetNotFound or ConfigError.
+/// Loads a world file (gravity, namespace, lights, cameras, environment model, enclosure), then
+/// its plugins. Throws AssetNotFound, ConfigError or PluginError.
 AMBFPLUS_API void load_world_file(World& world, const std::string& path,
                                   const AdfColors& colors = {},
                                   std::vector<AdfProblem>* warnings = nullptr);
 
 /// Loads one model file as a new model (named after the file; a number is added when taken).
 /// All or nothing: on an error nothing of it stays in the world. Throws AssetNotFound (listing
-/// every path tried for a mesh) or ConfigError (file, line, object, key).
+/// every path tried for a mesh), ConfigError (file, line, object, key) or PluginError (a
+/// plugin of the model or of one of its objects).
 AMBFPLUS_API Model& load_model_file(World& world, const std::string& path,
                                     const AdfColors& colors = {},
                                     std::vector<AdfProblem>* warnings = nullptr);

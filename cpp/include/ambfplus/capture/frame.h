@@ -10,6 +10,15 @@
 
 namespace ambfplus {
 
+/// The images a capture can render; a camera renders the ones asked for and only those.
+enum CapturePass : unsigned {
+  kPassRgb = 1u << 0,       ///< lit colour
+  kPassDepth = 1u << 1,     ///< metric z
+  kPassLabel = 1u << 2,     ///< volume label ids
+  kPassInstance = 1u << 3,  ///< object ids
+  kPassVoxel = 1u << 4,     ///< volume voxel indices
+};
+
 /// One camera capture: images plus the geometry and time they were taken at.
 ///
 /// Conventions: image row 0 is the top; rgb is uint8 RGB; depth is metric z along the optical
@@ -25,6 +34,12 @@ class AMBFPLUS_API Frame {
   ImageBuffer<std::uint8_t> rgb;     ///< height x width x 3
   ImageBuffer<float> depth;          ///< height x width
   ImageBuffer<std::uint16_t> label;  ///< height x width: volume label ids, 0 elsewhere
+  /// height x width: the id of the object seen (Object::id, meshes and volumes alike), 0 where
+  /// nothing was hit.
+  ImageBuffer<std::int32_t> instance;
+  /// height x width: the linear index (i + nx (j + ny k)) of the volume voxel whose label the
+  /// pixel shows, -1 where no volume was hit.
+  ImageBuffer<std::int32_t> voxel;
 
   int width = 0;
   int height = 0;

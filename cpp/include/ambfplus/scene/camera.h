@@ -11,6 +11,16 @@
 
 namespace ambfplus {
 
+/// What an ADF asks a camera to publish (AMBF's keys and defaults); recorders read it.
+struct AMBFPLUS_API CameraPublish {
+  bool image = false;        ///< `publish image`
+  int image_interval = 1;    ///< `publish image interval`: every n-th render
+  bool depth = false;        ///< `publish depth`
+  int depth_interval = 10;   ///< `publish depth interval`
+  bool depth_noise = false;  ///< `publish depth noise` given
+  double noise_mean = 0.1, noise_std = 0.001, noise_bias = 0.0;  ///< its mean, std_dev, bias
+};
+
 /// Everything needed to create a camera. Defaults are AMBF's (fva 0.7 rad, near 0.1, far 10).
 struct AMBFPLUS_API CameraSpec {
   std::string name;
@@ -21,13 +31,18 @@ struct AMBFPLUS_API CameraSpec {
   double far = 10.0;   ///< metres
   Eigen::Matrix4d pose = Eigen::Matrix4d::Identity();
   std::array<float, 3> background{0.0f, 0.0f, 0.0f};  ///< RGB, 0..1, where nothing is hit
+  CameraPublish publish;
 };
 
 /// Where a capture writes its images; null pointers are not captured.
 struct CaptureBuffers {
-  std::uint8_t* rgb = nullptr;     ///< height x width x 3, tightly packed
-  float* depth = nullptr;          ///< height x width, tightly packed
-  std::uint16_t* label = nullptr;  ///< height x width, tightly packed
+  std::uint8_t* rgb = nullptr;       ///< height x width x 3, tightly packed
+  float* depth = nullptr;            ///< height x width, tightly packed
+  std::uint16_t* label = nullptr;    ///< height x width, tightly packed
+  std::int32_t* instance = nullptr;  ///< height x width, tightly packed
+  std::int32_t* voxel = nullptr;     ///< height x width, tightly packed
+  /// The CapturePass bits of the non-null buffers.
+  unsigned passes() const;
 };
 
 /// A pinhole camera in the OpenCV frame (x right, y down, z forward). pose() is world from camera.
@@ -40,20 +55,31 @@ class AMBFPLUS_API Camera : public Object {
   double near() const { return near_; }
   double far() const { return far_; }
   const std::array<float, 3>& background() const { return background_; }
+  const CameraPublish& publish() const { return publish_; }
 
   /// Places the camera at eye looking at target; up fixes the roll (image up points along it).
   void look_at(const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
                const Eigen::Vector3d& up = Eigen::Vector3d::UnitZ());
 
-  /// fx = fy = H / (2 tan(fov_y / 2)), cx = W / 2, cy = H / 2 (see Frame for the pixel convention).
+  /// fx = fy = H / (2 tan(fov_y / 2)); (cx, cy) the principal point, W / 2, H / 2 unless moved
+  /// (see Frame for the pixel convention).
   Eigen::Matrix3d intrinsics() const;
+  /// Moves the principal point (pixels): an off-axis camera, e.g. one of a stereo pair whose
+  /// views converge at a working distance. The image plane stays parallel.
+  void set_principal_point(double cx, double cy);
+  Eigen::Vector2d principal_point() const { return {cx_, cy_}; }
+
+  /// The passes a capture into a new frame renders (CapturePass bits; default rgb, depth, label).
+  unsigned passes() const { return passes_; }
+  void set_passes(unsigned passes);
   /// OpenGL clip from camera (OpenCV frame), mapping image row 0 to the first row read back.
   Eigen::Matrix4d projection() const;
 
   /// Renders and returns a new frame that owns its images.
   Frame capture();
   /// Renders into an existing frame: its buffers are reused (filled in place) and must match
-  /// this camera's size; empty ones are allocated. Throws std::invalid_argument on a mismatch.
+  /// this camera's size. A frame without buffers gets the camera's passes; one with buffers is
+  /// refilled with exactly those. Throws std::invalid_argument on a mismatch.
   void capture(Frame& frame);
   /// Renders into caller-owned memory and fills frame's metadata (its buffers are left alone).
   void capture(const CaptureBuffers& buffers, Frame& frame);
@@ -67,7 +93,10 @@ class AMBFPLUS_API Camera : public Object {
   double fov_y_;
   double near_;
   double far_;
+  double cx_, cy_;
+  unsigned passes_ = kPassRgb | kPassDepth | kPassLabel;
   std::array<float, 3> background_;
+  CameraPublish publish_;
 };
 
 }  // namespace ambfplus

@@ -15,6 +15,7 @@
 namespace ambfplus {
 
 class Simulator;
+class PluginRegistry;
 namespace render {
 class SceneRenderer;
 }
@@ -75,7 +76,13 @@ class AMBFPLUS_API World {
   void set_gravity(const Eigen::Vector3d& g);
   Eigen::Vector3d gravity() const;
 
-  /// The world's renderer (created on first use; internal to the engine).
+  /// The plugins of this world, its simulator, models and objects (cpp/README.md, "Plugins").
+  PluginRegistry& plugins();
+  /// Calls every plugin's reset(). There is no scene reset yet: only plugins are reset.
+  void reset_plugins();
+
+  /// The world's renderer (created on first use; internal to the engine). Every camera render
+  /// starts here, so it also gives plugins their graphics update (once per step).
   render::SceneRenderer& renderer();
   /// The world's physics (internal to the engine).
   physics::PhysicsWorld& physics() { return *physics_; }
@@ -99,6 +106,9 @@ class AMBFPLUS_API World {
   std::map<std::string, Object*> by_name_;
   std::vector<Object*> objects_;
   std::unique_ptr<render::SceneRenderer> renderer_;
+  std::unique_ptr<PluginRegistry> plugins_;
+  std::int64_t graphics_step_ = -1;     // the step of the last graphics update
+  std::uint64_t objects_revision_ = 0;  // counts objects added and models removed
 };
 
 template <typename T>

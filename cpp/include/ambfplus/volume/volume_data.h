@@ -53,6 +53,7 @@ struct AMBFPLUS_API VolumeHit {
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();  ///< outward, unit
   std::uint16_t label = 0;
+  std::int64_t voxel = -1;  ///< linear index of the voxel whose label this is
 };
 
 /// A segmented volume: a label grid with its table, an optional intensity grid, its physical size,

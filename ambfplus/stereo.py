@@ -1,0 +1,210 @@
+"""Stereo rigs, segmentation colours, the id legend and the conversions a dataset needs.
+
+Conventions (see the package docstring): camera poses are world-from-camera in the OpenCV frame
+(x right, y down, z forward); pixel (row r, column c) is centred at (c + 0.5, r + 0.5).
+
+A rig's right camera sits `baseline` metres along the left camera's +x, with the same orientation
+(rectified). Disparity d = x_left - x_right (pixels). With principal points cx_left, cx_right and
+dcx = cx_right - cx_left, a point at depth Z has d = f B / Z - dcx, so Z = f B / (d + dcx). A
+parallel rig has dcx = 0; an off-axis rig moves the principal points apart by dcx = f B / Z0 so
+that points at the working distance Z0 have zero disparity and the two views overlap there.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._core import Camera, Frame, World
+
+PASSES = ("rgb", "depth", "label", "instance")
+
+
+@dataclass
+class StereoFrame:
+    """A left and a right frame taken at the same simulation time, with the rig's geometry."""
+
+    left: Frame
+    right: Frame
+    baseline: float  #: metres, from the two cameras' poses
+    dcx: float  #: cx_right - cx_left, pixels
+
+    @property
+    def focal(self) -> float:
+        return float(self.left.intrinsics[0, 0])
+
+    @property
+    def right_from_left(self) -> np.ndarray:
+        """4x4 transform taking left-camera coordinates to right-camera coordinates."""
+        return np.linalg.inv(self.right.pose) @ self.left.pose
+
+    def disparity(self) -> np.ndarray:
+        """The left image's disparity predicted from its depth (NaN where nothing was hit)."""
+        return depth_to_disparity(self.left.depth, self.focal, self.baseline, self.dcx)
+
+
+def depth_to_disparity(depth, focal: float, baseline: float, dcx: float = 0.0) -> np.ndarray:
+    """d = f B / Z - dcx; NaN where depth is 0 (no hit)."""
+    z = np.asarray(depth, dtype=np.float64)
+    with np.errstate(divide="ignore"):
+        d = focal * baseline / z - dcx
+    return np.where(z > 0, d, np.nan)
+
+
+def disparity_to_depth(disparity, focal: float, baseline: float, dcx: float = 0.0) -> np.ndarray:
+    """Z = f B / (d + dcx); NaN where d + dcx <= 0."""
+    d = np.asarray(disparity, dtype=np.float64) + dcx
+    with np.errstate(divide="ignore", invalid="ignore"):
+        z = focal * baseline / d
+    return np.where(d > 0, z, np.nan)
+
+
+# AMBF's camera frame (its point clouds): x back from the view direction, y right, z up.
+_AMBF_FROM_OPENCV = np.array([[0.0, 0.0, -1.0], [1.0, 0.0, 0.0], [0.0, -1.0, 0.0]])
+
+
+def opencv_to_ambf(points) -> np.ndarray:
+    """Camera-frame points from the OpenCV frame to AMBF's (x = -depth, y right, z up)."""
+    return np.asarray(points, dtype=np.float64) @ _AMBF_FROM_OPENCV.T
+
+
+def ambf_to_opencv(points) -> np.ndarray:
+    """Camera-frame points from AMBF's frame (its DepthData clouds) to the OpenCV frame."""
+    return np.asarray(points, dtype=np.float64) @ _AMBF_FROM_OPENCV
+
+
+class StereoRig:
+    """Two cameras a baseline apart along the left camera's x axis, captured together.
+
+    ``StereoRig(world, "rig", baseline=0.065, width=640, height=480, fov_y=...)`` makes cameras
+    ``rig_left`` and ``rig_right``; ``working_distance`` (metres) makes it off-axis. Move it with
+    ``look_at`` or ``pose`` (the left camera's). ``StereoRig.from_cameras(left, right)`` wraps two
+    existing cameras (e.g. an ADF file's stereoL and stereoR), keeping their poses.
+    """
+
+    def __init__(
+        self,
+        world: World,
+        name: str,
+        baseline: float = 0.065,
+        width: int = 640,
+        height: int = 480,
+        fov_y: float = 0.4,
+        near: float = 0.01,
+        far: float = 10.0,
+        working_distance: float | None = None,
+    ) -> None:
+        if not baseline > 0:
+            raise ValueError(f"baseline must be > 0 m, got {baseline}")
+        left = world.add_camera(f"{name}_left", width, height, fov_y=fov_y, near=near, far=far)
+        right = world.add_camera(f"{name}_right", width, height, fov_y=fov_y, near=near, far=far)
+        offset = np.eye(4)
+        offset[0, 3] = baseline
+        right.attach_to(left, offset)
+        self.left, self.right = left, right
+        self.name = name
+        self._offset = offset
+        if working_distance is not None:
+            self.set_working_distance(working_distance)
+
+    @classmethod
+    def from_cameras(cls, left: Camera, right: Camera) -> StereoRig:
+        rig = cls.__new__(cls)
+        rig.left, rig.right, rig.name = left, right, left.name
+        rig._offset = np.linalg.inv(left.pose) @ right.pose
+        if abs(rig._offset[0, 3]) <= 0 or not np.allclose(
+            rig._offset[:3, :3], np.eye(3), atol=1e-6
+        ):
+            raise ValueError(
+                f"{left.name} and {right.name} are not a rectified pair: the right camera must "
+                "have the left one's orientation and sit along its x axis"
+            )
+        return rig
+
+    @property
+    def baseline(self) -> float:
+        """Metres between the optical centres."""
+        return float(np.linalg.norm((np.linalg.inv(self.left.pose) @ self.right.pose)[:3, 3]))
+
+    @property
+    def dcx(self) -> float:
+        """cx_right - cx_left, pixels (0 for a parallel rig)."""
+        return float(self.right.principal_point[0] - self.left.principal_point[0])
+
+    def set_working_distance(self, distance: float | None) -> None:
+        """Off-axis: points at this depth get zero disparity (None: parallel again)."""
+        w, h = self.left.width, self.left.height
+        shift = 0.0
+        if distance is not None:
+            if not distance > 0:
+                raise ValueError(f"working distance must be > 0 m, got {distance}")
+            shift = self.left.intrinsics[0, 0] * self.baseline / distance / 2
+        self.left.principal_point = (w / 2 - shift, h / 2)
+        self.right.principal_point = (w / 2 + shift, h / 2)
+
+    @property
+    def pose(self) -> np.ndarray:
+        return self.left.pose
+
+    @pose.setter
+    def pose(self, value) -> None:
+        self.left.pose = value
+        self.right.pose = np.asarray(value) @ self._offset
+
+    def look_at(self, eye, target, up=(0.0, 0.0, 1.0)) -> None:
+        """Places the left camera at eye looking at target (the right one follows)."""
+        self.left.look_at(eye, target, up)
+        self.right.pose = self.left.pose @ self._offset
+
+    def capture(self, passes=PASSES, poses=None) -> StereoFrame:
+        """Both views at the same simulation time."""
+        self.right.pose = self.left.pose @ self._offset
+        left = self.left.capture(passes=list(passes), poses=poses)
+        right = self.right.capture(passes=list(passes), poses=poses)
+        return StereoFrame(left, right, self.baseline, self.dcx)
+
+
+def legend(world: World) -> dict[int, dict]:
+    """Every object id a capture's instance image can hold: name, kind, model and flat colour
+    (RGB 0..255; bodies their material colour); volumes also list their labels (id -> name,
+    colour)."""
+    out = {}
+    for o in world.objects:
+        entry = {"name": o.name, "kind": o.kind, "model": o.model.name}
+        color = getattr(o, "color", None)
+        if color is not None:
+            entry["color"] = tuple(int(round(255 * c)) for c in list(color)[:3])
+        if o.kind == "volume":
+            entry["labels"] = {
+                label.id: {"name": label.name, "color": tuple(label.color)}
+                for label in o.data.label_table
+            }
+        out[o.id] = entry
+    return out
+
+
+def segmentation(frame: Frame, world: World, background=(0, 0, 0)) -> np.ndarray:
+    """Flat colours as AMBF's preprocessing shaders draw them: each object in its colour, volumes
+    in their labels' colours. Needs the frame's instance image (and label for volumes)."""
+    if frame.instance is None:
+        raise ValueError("segmentation needs a frame captured with the 'instance' pass")
+    ids = frame.instance
+    lut = np.zeros((int(ids.max()) + 1, 3), dtype=np.uint8)
+    lut[0] = background
+    entries = legend(world)
+    for i, entry in entries.items():
+        if i < len(lut) and "color" in entry:
+            lut[i] = entry["color"]
+    image = lut[ids]
+    if frame.label is not None:
+        labels = frame.label
+        on_volume = labels > 0
+        if on_volume.any():
+            table = np.zeros((int(labels.max()) + 1, 3), dtype=np.uint8)
+            for entry in entries.values():
+                for label_id, label in entry.get("labels", {}).items():
+                    if label_id < len(table):
+                        table[label_id] = label["color"]
+            image[on_volume] = table[labels[on_volume]]
+    return image

@@ -1,0 +1,402 @@
+// Plugins from Python: Python plugins (ambfplus.Plugin) behind a C++ adapter that takes the GIL
+// for each hook only, World/Simulator.load_plugin, the registry's hooks, and the Python language
+// the engine's loader uses for `.py` files and `ambfplus.plugins` entry points.
+
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <memory>
+#include <string>
+
+#include "ambfplus/errors.h"
+#include "ambfplus/plugin/registry.h"
+#include "ambfplus/scene/simulator.h"
+#include "ambfplus/scene/world.h"
+#include "bindings.h"
+
+namespace py = pybind11;
+
+namespace ambfplus::bindings {
+namespace {
+
+// What a Python plugin reaches its site through (`self._site`); it forgets the plugin when the
+// plugin is destroyed, so a Python object kept longer cannot reach a dead world.
+struct PythonSite {
+  Plugin* plugin = nullptr;
+};
+
+enum Hook {
+  kPhysics,
+  kGraphics,
+  kKeyboard,
+  kMouseButton,
+  kMouseMove,
+  kMouseScroll,
+  kReset,
+  kClose,
+  kObjectAdded,
+  kObjectRemoved,
+  kHookCount
+};
+const char* const kHookNames[kHookCount] = {
+    "physics_update", "graphics_update", "keyboard", "mouse_button",    "mouse_move",
+    "mouse_scroll",   "reset",           "close",    "on_object_added", "on_object_removed"};
+
+// The exception being handled as Python prints it: the traceback for unexpected errors, the
+// message alone for a PluginError raised on purpose.
+std::string describe_python_error(py::error_already_set& e) {
+  try {
+    const py::module_ traceback = py::module_::import("traceback");
+    const bool expected = e.matches(py::module_::import("ambfplus").attr("PluginError"));
+    py::list lines = expected ? traceback.attr("format_exception_only")(e.type(), e.value())
+                              : traceback.attr("format_exception")(e.type(), e.value(), e.trace());
+    std::string out;
+    for (const py::handle line : lines) out += line.cast<std::string>();
+    while (!out.empty() && out.back() == '\n') out.pop_back();
+    return out;
+  } catch (const std::exception&) {
+    return e.what();
+  }
+}
+
+// A Python object with plugin hooks, as a C++ plugin. Only the hooks its class defines (other
+// than ambfplus.Plugin's empty ones) are called, each with the GIL held for the call alone; a
+// Python exception becomes a PluginError, which the registry logs before disabling the plugin.
+class PythonPlugin final : public Plugin {
+ public:
+  // With the GIL held.
+  explicit PythonPlugin(py::object instance) : instance_(std::move(instance)) {
+    const py::object base = py::module_::import("ambfplus.plugins").attr("Plugin");
+    const py::object type = py::type::of(instance_);
+    for (int h = 0; h < kHookCount; ++h) {
+      const py::object own = py::getattr(type, kHookNames[h], py::none());
+      defines_[h] = !own.is_none() && !own.is(py::getattr(base, kHookNames[h], py::none()));
+    }
+    site_ = py::cast(PythonSite{this});
+    try {
+      py::setattr(instance_, "_site", site_);
+    } catch (py::error_already_set& e) {
+      throw PluginError(
+          "a " + py::str(type.attr("__qualname__")).cast<std::string>() +
+          " cannot be a plugin: setting its _site failed: " + describe_python_error(e));
+    }
+  }
+
+  ~PythonPlugin() override {
+    if (!Py_IsInitialized()) {
+      // The interpreter is gone: nothing to release into.
+      instance_.release();
+      site_.release();
+      return;
+    }
+    py::gil_scoped_acquire gil;
+    site_.cast<PythonSite&>().plugin = nullptr;
+    site_ = py::object();
+    instance_ = py::object();
+  }
+
+  const py::object& instance() const { return instance_; }
+
+  int init() override {
+    py::gil_scoped_acquire gil;
+    try {
+      if (!py::hasattr(instance_, "init")) return 1;
+      const py::object result = instance_.attr("init")();
+      // None (no return statement) keeps the plugin, as does True; False drops it.
+      if (result.is_none()) return 1;
+      if (py::isinstance<py::bool_>(result)) return result.cast<bool>() ? 1 : 0;
+      if (py::isinstance<py::int_>(result)) return result.cast<int>();
+      throw PluginError("init() must return an int (>= 1 keeps the plugin), not " +
+                        py::str(py::type::of(result).attr("__name__")).cast<std::string>());
+    } catch (py::error_already_set& e) {
+      throw PluginError(describe_python_error(e));
+    }
+  }
+
+  void physics_update(double dt) override {
+    run(kPhysics, [&] { instance_.attr("physics_update")(dt); });
+  }
+  void graphics_update() override {
+    run(kGraphics, [&] { instance_.attr("graphics_update")(); });
+  }
+  void keyboard(int key, int scancode, int action, int mods) override {
+    run(kKeyboard, [&] { instance_.attr("keyboard")(key, scancode, action, mods); });
+  }
+  void mouse_button(int button, int action, int mods) override {
+    run(kMouseButton, [&] { instance_.attr("mouse_button")(button, action, mods); });
+  }
+  void mouse_move(double x, double y) override {
+    run(kMouseMove, [&] { instance_.attr("mouse_move")(x, y); });
+  }
+  void mouse_scroll(double dx, double dy) override {
+    run(kMouseScroll, [&] { instance_.attr("mouse_scroll")(dx, dy); });
+  }
+  void reset() override {
+    run(kReset, [&] { instance_.attr("reset")(); });
+  }
+  void close() override {
+    run(kClose, [&] { instance_.attr("close")(); });
+  }
+  void on_object_added(Object& object) override {
+    run(kObjectAdded, [&] { instance_.attr("on_object_added")(to_python(&object)); });
+  }
+  void on_object_removed(Object& object) override {
+    run(kObjectRemoved, [&] { instance_.attr("on_object_removed")(to_python(&object)); });
+  }
+
+ private:
+  template <typename Call>
+  void run(Hook hook, const Call& call) {
+    if (!defines_[hook]) return;
+    py::gil_scoped_acquire gil;
+    try {
+      call();
+    } catch (py::error_already_set& e) {
+      throw PluginError(describe_python_error(e));
+    }
+  }
+
+  py::object instance_;
+  py::object site_;
+  bool defines_[kHookCount] = {};
+};
+
+// The plugin behind a site, or PluginError; for handles, its simulator must be alive too.
+Plugin& live(const PythonSite& s, bool for_handles = true) {
+  if (s.plugin == nullptr) throw PluginError("this plugin is closed: its world is out of reach");
+  if (for_handles && s.plugin->simulator().weak_from_this().expired()) {
+    throw PluginError("plugin '" + s.plugin->name() +
+                      "': its simulator is being destroyed, so handles to it cannot be made in "
+                      "close(); call World.close_plugins() first to close plugins while it lives");
+  }
+  return *s.plugin;
+}
+
+// A plugin made by Python code (the ambfplus.plugins module's loaders), or null for None.
+std::shared_ptr<Plugin> from_python(const char* loader, const std::string& argument) {
+  if (!Py_IsInitialized()) throw PluginError("Python plugins need a running interpreter");
+  py::gil_scoped_acquire gil;
+  try {
+    py::object instance = py::module_::import("ambfplus.plugins").attr(loader)(argument);
+    if (instance.is_none()) return nullptr;
+    return std::make_shared<PythonPlugin>(std::move(instance));
+  } catch (py::error_already_set& e) {
+    throw PluginError(describe_python_error(e));
+  }
+}
+
+// A snapshot of one attached plugin.
+struct PluginInfo {
+  std::string name, file, scope, language;
+  bool enabled = true;
+  py::object instance;     // the Python object, or None
+  py::object attached_to;  // simulator, world, model or object
+};
+
+PluginInfo info(World& world, Plugin& p) {
+  PluginInfo out;
+  out.name = p.name();
+  out.file = p.file();
+  out.scope = plugin_scope_name(p.scope());
+  out.enabled = world.plugins().enabled(p);
+  auto* python = dynamic_cast<PythonPlugin*>(&p);
+  out.language = python != nullptr ? "python" : "c++";
+  out.instance = python != nullptr ? python->instance() : py::none();
+  switch (p.scope()) {
+    case PluginScope::kSimulator:
+      out.attached_to = py::cast(p.simulator().shared_from_this());
+      break;
+    case PluginScope::kWorld:
+      out.attached_to = py::cast(handle(&world, world));
+      break;
+    case PluginScope::kModel:
+      out.attached_to = py::cast(handle(p.model(), world));
+      break;
+    case PluginScope::kObject:
+      out.attached_to = to_python(p.object());
+      break;
+  }
+  return out;
+}
+
+// World.load_plugin / Simulator.load_plugin: a file or name (str or path), or a Python plugin
+// object, attached at site.
+py::object load(World& world, const py::object& plugin, const PluginSite& site,
+                const std::optional<std::string>& name) {
+  const py::object os = py::module_::import("os");
+  Plugin* loaded = nullptr;
+  if (py::isinstance<py::str>(plugin) || py::isinstance(plugin, os.attr("PathLike"))) {
+    PluginSpec spec;
+    spec.filename = os.attr("fspath")(plugin).cast<std::string>();
+    spec.name = name.value_or("");
+    py::gil_scoped_release release;
+    loaded = world.plugins().load(spec, site);
+  } else {
+    auto adapter = std::make_shared<PythonPlugin>(plugin);
+    const std::string type = py::str(py::type::of(plugin).attr("__name__")).cast<std::string>();
+    std::string file = "<" + type + " object>";
+    try {
+      file = py::str(py::module_::import("inspect").attr("getfile")(py::type::of(plugin)));
+    } catch (py::error_already_set&) {
+      // Defined where Python keeps no file (an interactive session).
+    }
+    py::gil_scoped_release release;
+    loaded = world.plugins().attach(adapter, name.value_or(type), file, site);
+  }
+  if (loaded == nullptr) return py::none();
+  return py::cast(info(world, *loaded));
+}
+
+PluginSite site_of(World& world, const py::object& scope_object) {
+  if (scope_object.is_none()) return PluginSite::of(world);
+  if (py::isinstance<Simulator>(scope_object)) {
+    return PluginSite::of(scope_object.cast<Simulator&>());
+  }
+  if (py::isinstance<World>(scope_object)) return PluginSite::of(scope_object.cast<World&>());
+  if (py::isinstance<Model>(scope_object)) return PluginSite::of(scope_object.cast<Model&>());
+  if (py::isinstance<Object>(scope_object)) return PluginSite::of(scope_object.cast<Object&>());
+  throw py::type_error(
+      "scope_object must be None (this world), a Simulator, World, Model or an "
+      "object of the world");
+}
+
+}  // namespace
+
+void register_plugin(py::module_& m) {
+  register_plugin_language(
+      {"python", ".py", [](const std::string& file) { return from_python("_from_file", file); },
+       [](const std::string& name) { return from_python("_from_entry_point", name); }});
+
+  py::class_<PythonSite>(m, "PluginSite",
+                         "Where a Python plugin is attached (its `_site`); handles are made on "
+                         "each access, so keep names on a plugin rather than handles.")
+      .def_property_readonly(
+          "name", [](const PythonSite& s) { return live(s, false).name(); }, "the declared name")
+      .def_property_readonly(
+          "file", [](const PythonSite& s) { return live(s, false).file(); },
+          "the file it came from")
+      .def_property_readonly(
+          "scope", [](const PythonSite& s) { return plugin_scope_name(live(s, false).scope()); },
+          "'simulator', 'world', 'model' or 'object'")
+      .def_property_readonly(
+          "simulator", [](const PythonSite& s) { return live(s).simulator().shared_from_this(); })
+      .def_property_readonly("world",
+                             [](const PythonSite& s) {
+                               Plugin& p = live(s);
+                               return handle(&p.world(), p.world());
+                             })
+      .def_property_readonly(
+          "model",
+          [](const PythonSite& s) -> py::object {
+            Plugin& p = live(s);
+            if (p.model() == nullptr) return py::none();
+            return py::cast(handle(p.model(), p.world()));
+          },
+          "the model (model scope) or the object's model (object scope), else None")
+      .def_property_readonly(
+          "object", [](const PythonSite& s) { return to_python(live(s).object()); },
+          "the object (object scope), else None");
+
+  py::class_<PluginInfo>(m, "PluginInfo", "A plugin attached to a world (a snapshot).")
+      .def_readonly("name", &PluginInfo::name)
+      .def_readonly("file", &PluginInfo::file, "the file it was loaded from")
+      .def_readonly("scope", &PluginInfo::scope, "'simulator', 'world', 'model' or 'object'")
+      .def_readonly("language", &PluginInfo::language, "'c++' or 'python'")
+      .def_readonly("enabled", &PluginInfo::enabled, "False once a hook of it raised")
+      .def_readonly("instance", &PluginInfo::instance, "the Python plugin object, or None")
+      .def_readonly("attached_to", &PluginInfo::attached_to,
+                    "the simulator, world, model or object it belongs to")
+      .def("__repr__", [](const PluginInfo& i) {
+        return "<PluginInfo '" + i.name + "' " + i.language + " " + i.scope +
+               (i.enabled ? "" : " disabled") + ">";
+      });
+
+  const char* load_doc =
+      "Loads a plugin and calls its init(): `plugin` is a C++ library (libx.so, or a name "
+      "searched in AMBFPLUS_PLUGIN_PATH, the package's plugin folder and the linker's path), a "
+      "Python file (x.py), an `ambfplus.plugins` entry-point name, or an ambfplus.Plugin "
+      "object. Returns its PluginInfo, or None when init() declined. Raises PluginError.";
+  auto world = py::reinterpret_borrow<py::class_<World, std::shared_ptr<World>>>(m.attr("World"));
+  world
+      .def(
+          "load_plugin",
+          [](World& w, const py::object& plugin, const py::object& scope_object,
+             const std::optional<std::string>& name) {
+            return load(w, plugin, site_of(w, scope_object), name);
+          },
+          py::arg("plugin"), py::arg("scope_object") = py::none(), py::arg("name") = py::none(),
+          (std::string(load_doc) +
+           " scope_object: None (this world), the simulator, a model or an object.")
+              .c_str())
+      .def_property_readonly(
+          "plugins",
+          [](World& w) {
+            py::list out;
+            for (Plugin* p : w.plugins().plugins()) out.append(info(w, *p));
+            return out;
+          },
+          "The attached plugins in call order: simulator, world, model, then object scope, "
+          "each in the order attached.")
+      .def(
+          "reset_plugins",
+          [](World& w) {
+            py::gil_scoped_release release;
+            w.reset_plugins();
+          },
+          "Calls every plugin's reset() (the scene itself is not reset).")
+      .def(
+          "close_plugins",
+          [](World& w) {
+            py::gil_scoped_release release;
+            w.plugins().close_all();
+          },
+          "Calls close() on every plugin (reverse call order) and lets them go; the world "
+          "does it when it is destroyed.")
+      .def(
+          "send_key",
+          [](World& w, int key, int scancode, int action, int mods) {
+            py::gil_scoped_release release;
+            w.plugins().keyboard(key, scancode, action, mods);
+          },
+          py::arg("key"), py::arg("scancode") = 0, py::arg("action") = 1, py::arg("mods") = 0,
+          "Gives the plugins a key event (GLFW's codes; action 0 release, 1 press, 2 repeat).")
+      .def(
+          "send_mouse_button",
+          [](World& w, int button, int action, int mods) {
+            py::gil_scoped_release release;
+            w.plugins().mouse_button(button, action, mods);
+          },
+          py::arg("button"), py::arg("action") = 1, py::arg("mods") = 0,
+          "Gives the plugins a mouse button event.")
+      .def(
+          "send_mouse_move",
+          [](World& w, double x, double y) {
+            py::gil_scoped_release release;
+            w.plugins().mouse_move(x, y);
+          },
+          py::arg("x"), py::arg("y"), "Gives the plugins a cursor position.")
+      .def(
+          "send_mouse_scroll",
+          [](World& w, double dx, double dy) {
+            py::gil_scoped_release release;
+            w.plugins().mouse_scroll(dx, dy);
+          },
+          py::arg("dx"), py::arg("dy"), "Gives the plugins a scroll event.");
+
+  auto simulator = py::reinterpret_borrow<py::class_<Simulator, std::shared_ptr<Simulator>>>(
+      m.attr("Simulator"));
+  simulator.def(
+      "load_plugin",
+      [](Simulator& s, const py::object& plugin, const std::optional<std::string>& name) {
+        return load(s.world(), plugin, PluginSite::of(s), name);
+      },
+      py::arg("plugin"), py::arg("name") = py::none(),
+      (std::string(load_doc) + " The plugin is attached to the simulator.").c_str());
+
+  m.attr("PLUGIN_ABI_VERSION") = kPluginAbiVersion;
+  m.def("plugin_search_path", &plugin_search_path,
+        "The folders searched for a plugin after its declaration's own path: "
+        "AMBFPLUS_PLUGIN_PATH, then the package's plugin folder.");
+}
+
+}  // namespace ambfplus::bindings

@@ -1,0 +1,91 @@
+#pragma once
+
+// Loading plugins and calling their hooks: every world holds a PluginRegistry (World::plugins())
+// with the plugins of its simulator, itself, its models and its objects.
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "ambfplus/export.h"
+#include "ambfplus/plugin/plugin.h"
+
+namespace ambfplus {
+
+/// A plugin to load: an ADF `plugins:` entry, a `--plugins` item or a load_plugin call.
+struct AMBFPLUS_API PluginSpec {
+  std::string name;      ///< what to call it; "" means the file's stem
+  std::string filename;  ///< libx.so, x (tried as x, x.so, libx.so), x.py, a path, or an
+                         ///< entry-point name of another language
+  std::string path;      ///< a folder to look in first ("" for none)
+};
+
+/// Plugins written in another language than C++ (the Python module registers Python's). The
+/// functions may throw PluginError.
+struct AMBFPLUS_API PluginLanguage {
+  std::string name;       ///< "python"
+  std::string extension;  ///< files it loads, ".py"
+  /// A plugin from a file the search found.
+  std::function<std::shared_ptr<Plugin>(const std::string& file)> from_file;
+  /// A plugin registered under a bare name (Python's entry points), or null when none is.
+  std::function<std::shared_ptr<Plugin>(const std::string& name)> from_name;
+};
+
+/// Makes a language known to every registry (replacing one of the same name).
+AMBFPLUS_API void register_plugin_language(PluginLanguage language);
+
+/// The folders searched after a declaration's own `path`: those of AMBFPLUS_PLUGIN_PATH (colon
+/// separated), then the package's plugin folder (`plugins` beside libambfplus).
+AMBFPLUS_API std::vector<std::string> plugin_search_path();
+
+/// The plugins of one world, in call order: simulator, world, model, then object scope, and
+/// within a scope in the order they were attached. Every hook call goes through it, so a hook
+/// that throws disables its plugin (logged once) without stopping the others.
+class AMBFPLUS_API PluginRegistry {
+ public:
+  explicit PluginRegistry(World& world);
+  ~PluginRegistry();
+  PluginRegistry(const PluginRegistry&) = delete;
+  PluginRegistry& operator=(const PluginRegistry&) = delete;
+
+  /// Finds and loads a plugin (search order in cpp/README.md, "Plugins"), attaches it to site
+  /// and calls its init(). Returns it, or nullptr when init() returned < 1 (it is dropped).
+  /// Throws PluginError naming the file and every path tried, dlerror()'s message, or both ABI
+  /// versions; std::invalid_argument for a site of another world.
+  Plugin* load(const PluginSpec& spec, const PluginSite& site);
+  /// Attaches a plugin made elsewhere (a Python object's adapter) as load does.
+  Plugin* attach(std::shared_ptr<Plugin> plugin, const std::string& name, const std::string& file,
+                 const PluginSite& site);
+
+  /// Attached plugins in call order, disabled ones included.
+  std::vector<Plugin*> plugins() const;
+  /// False once a hook of the plugin threw.
+  bool enabled(const Plugin& plugin) const;
+  bool empty() const;
+
+  void physics_update(double dt);
+  void graphics_update();
+  void keyboard(int key, int scancode, int action, int mods);
+  void mouse_button(int button, int action, int mods);
+  void mouse_move(double x, double y);
+  void mouse_scroll(double dx, double dy);
+  void reset();
+  void object_added(Object& object);
+  void object_removed(Object& object);
+  /// Calls close() on every plugin in the reverse of call order, then destroys them.
+  void close_all();
+  /// Closes (reverse order) and destroys the plugins of a model and of its objects.
+  void close_model(const Model& model);
+
+ private:
+  struct Entry;
+  template <typename Call>
+  void each(const char* hook, const Call& call, const Model* model_scope_of = nullptr);
+  void close_where(const std::function<bool(const Entry&)>& which);
+
+  World* world_;
+  std::vector<std::shared_ptr<Entry>> entries_[4];  // by PluginScope
+};
+
+}  // namespace ambfplus

@@ -1,0 +1,214 @@
+#include "plugin/loader.h"
+
+#include <dlfcn.h>
+#include <link.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <map>
+#include <mutex>
+#include <system_error>
+
+#include "ambfplus/errors.h"
+#include "ambfplus/version.h"
+
+namespace ambfplus {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Languages {
+  std::mutex mutex;
+  std::map<std::string, PluginLanguage> by_name;
+};
+
+Languages& languages() {
+  static Languages l;
+  return l;
+}
+
+std::vector<PluginLanguage> registered_languages() {
+  std::lock_guard<std::mutex> lock(languages().mutex);
+  std::vector<PluginLanguage> out;
+  for (const auto& [name, language] : languages().by_name) out.push_back(language);
+  return out;
+}
+
+bool ends_with(const std::string& s, const std::string& end) {
+  return s.size() >= end.size() && s.compare(s.size() - end.size(), end.size(), end) == 0;
+}
+
+std::string join(const std::vector<std::string>& items) {
+  std::string out;
+  for (const std::string& s : items) out += (out.empty() ? "" : ", ") + s;
+  return out;
+}
+
+std::string dl_error() {
+  const char* e = dlerror();
+  return e != nullptr ? e : "unknown error";
+}
+
+// The file a handle came from (the dynamic linker's own search finds it by name).
+std::string loaded_path(void* handle, const std::string& fallback) {
+  link_map* map = nullptr;
+  if (dlinfo(handle, RTLD_DI_LINKMAP, &map) == 0 && map != nullptr && map->l_name != nullptr &&
+      map->l_name[0] != '\0') {
+    return map->l_name;
+  }
+  return fallback;
+}
+
+// A plugin from an open library; the library stays open while the plugin lives.
+std::shared_ptr<Plugin> from_library(void* handle, const std::string& file,
+                                     const std::string& name) {
+  std::shared_ptr<void> library(handle, [](void* h) { dlclose(h); });
+  const std::string what = "plugin '" + name + "' (" + file + ")";
+  dlerror();
+  void* symbol = dlsym(handle, AMBFPLUS_PLUGIN_ENTRY_SYMBOL);
+  if (symbol == nullptr) {
+    throw PluginError(what +
+                      ": no entry point " AMBFPLUS_PLUGIN_ENTRY_SYMBOL
+                      " (export one with AMBFPLUS_PLUGIN(YourClass) from "
+                      "ambfplus/plugin/plugin.h): " +
+                      dl_error());
+  }
+  const AmbfplusPluginEntry* entry = reinterpret_cast<AmbfplusPluginEntryFunction>(symbol)();
+  if (entry == nullptr) throw PluginError(what + ": its entry point returned null");
+  if (entry->abi_version != kPluginAbiVersion) {
+    throw PluginError(what + ": built for plugin ABI version " +
+                      std::to_string(entry->abi_version) + ", but this ambfplus (" + version() +
+                      ") has plugin ABI version " + std::to_string(kPluginAbiVersion) +
+                      "; rebuild the plugin against it");
+  }
+  if (entry->create == nullptr || entry->destroy == nullptr) {
+    throw PluginError(what + ": its entry point has no create or destroy function");
+  }
+  Plugin* plugin = nullptr;
+  try {
+    plugin = entry->create();
+  } catch (const std::exception& e) {
+    throw PluginError(what + ": creating " + entry->type_name + " failed: " + e.what());
+  } catch (...) {
+    throw PluginError(what + ": creating " + entry->type_name + " failed");
+  }
+  if (plugin == nullptr) throw PluginError(what + ": create() returned null");
+  // The deleter holds the library: it is closed only after the plugin is destroyed.
+  auto destroy = entry->destroy;
+  return std::shared_ptr<Plugin>(plugin, [destroy, library](Plugin* p) { destroy(p); });
+}
+
+std::shared_ptr<Plugin> open_library(const std::string& file, const std::string& name) {
+  dlerror();
+  void* handle = dlopen(file.c_str(), RTLD_NOW | RTLD_LOCAL);
+  if (handle == nullptr) {
+    throw PluginError("plugin '" + name + "': cannot load " + file + ": " + dl_error());
+  }
+  return from_library(handle, file, name);
+}
+
+}  // namespace
+
+void register_plugin_language(PluginLanguage language) {
+  std::lock_guard<std::mutex> lock(languages().mutex);
+  languages().by_name[language.name] = std::move(language);
+}
+
+std::vector<std::string> plugin_search_path() {
+  std::vector<std::string> out;
+  if (const char* env = std::getenv("AMBFPLUS_PLUGIN_PATH")) {
+    const std::string value = env;
+    std::size_t start = 0;
+    while (start <= value.size()) {
+      const std::size_t end = std::min(value.find(':', start), value.size());
+      if (end > start) out.push_back(value.substr(start, end - start));
+      start = end + 1;
+    }
+  }
+  // The folder of the library holding this function: the package (or its build-tree mirror).
+  Dl_info info{};
+  if (dladdr(reinterpret_cast<void*>(&plugin_search_path), &info) != 0 &&
+      info.dli_fname != nullptr) {
+    std::error_code ec;
+    const fs::path library = fs::canonical(info.dli_fname, ec);
+    if (!ec) out.push_back((library.parent_path() / "plugins").string());
+  }
+  return out;
+}
+
+namespace plugin {
+
+std::shared_ptr<Plugin> make(const PluginSpec& spec, const std::string& name, std::string& file) {
+  const std::string& f = spec.filename;
+  if (f.empty()) throw PluginError("plugin '" + name + "': no filename given");
+  const std::vector<PluginLanguage> others = registered_languages();
+  const PluginLanguage* language = nullptr;
+  for (const PluginLanguage& l : others) {
+    if (!l.extension.empty() && ends_with(f, l.extension)) language = &l;
+  }
+  if (ends_with(f, ".py") && language == nullptr) {
+    throw PluginError("plugin '" + name + "': " + f +
+                      " is a Python plugin, which needs the ambfplus Python module");
+  }
+  // A library may be named without its extension, as on AMBF's other platforms.
+  std::vector<std::string> names{f};
+  const bool bare = fs::path(f).extension().empty() && f.find('/') == std::string::npos;
+  if (language == nullptr && bare) {
+    names.push_back(f + ".so");
+    names.push_back("lib" + f + ".so");
+  }
+  std::vector<std::string> tried;
+  std::error_code ec;
+  auto exists = [&](const fs::path& p) {
+    tried.push_back(p.string());
+    return fs::is_regular_file(p, ec);
+  };
+  auto load_file = [&](const fs::path& p) {
+    file = fs::absolute(p, ec).lexically_normal().string();
+    return language != nullptr ? language->from_file(file) : open_library(file, name);
+  };
+
+  if (f.find('/') != std::string::npos) {
+    // A path: no search.
+    fs::path p = f;
+    if (p.is_relative() && !spec.path.empty()) p = fs::path(spec.path) / p;
+    if (exists(p)) return load_file(p);
+  } else {
+    std::vector<std::string> dirs;
+    if (!spec.path.empty()) dirs.push_back(spec.path);
+    for (const std::string& d : plugin_search_path()) dirs.push_back(d);
+    for (const std::string& dir : dirs) {
+      for (const std::string& n : names) {
+        if (exists(fs::path(dir) / n)) return load_file(fs::path(dir) / n);
+      }
+    }
+    if (language != nullptr) {
+      if (exists(fs::path(f))) return load_file(fs::path(f));  // the working directory
+    } else {
+      // A name another language registered (Python's entry points).
+      if (bare) {
+        for (const PluginLanguage& l : others) {
+          if (!l.from_name) continue;
+          if (std::shared_ptr<Plugin> p = l.from_name(f)) {
+            file = l.name + " entry point '" + f + "'";
+            return p;
+          }
+          tried.push_back(l.name + " entry point '" + f + "'");
+        }
+      }
+      // The dynamic linker's own search (LD_LIBRARY_PATH, its cache, system folders).
+      for (const std::string& n : names) {
+        dlerror();
+        if (void* handle = dlopen(n.c_str(), RTLD_NOW | RTLD_LOCAL)) {
+          file = loaded_path(handle, n);
+          return from_library(handle, file, name);
+        }
+        tried.push_back("dlopen(\"" + n + "\"): " + dl_error());
+      }
+    }
+  }
+  throw PluginError("plugin '" + name + "': '" + f + "' not found; tried " + join(tried));
+}
+
+}  // namespace plugin
+}  // namespace ambfplus

@@ -1,0 +1,20 @@
+#pragma once
+
+// Finding a plugin's file and making the plugin: C++ libraries through dlopen, other languages
+// through the factories they registered.
+
+#include <memory>
+#include <string>
+
+#include "ambfplus/plugin/registry.h"
+
+namespace ambfplus::plugin {
+
+/// A new plugin for spec (called `name` in messages), found in the documented order: a path
+/// (a filename with '/', relative to spec.path or else the working directory) is taken as
+/// given; otherwise spec.path, plugin_search_path(), then another language's bare names (entry
+/// points), then the dynamic linker's own search by name. Sets file to what was loaded.
+/// Throws PluginError listing every place tried.
+std::shared_ptr<Plugin> make(const PluginSpec& spec, const std::string& name, std::string& file);
+
+}  // namespace ambfplus::plugin

@@ -206,3 +206,24 @@ ACTUATOR grasp:
     grasp.deactuate()
     world.step(300)
     assert part.pose[2, 3] < 0.6  # free again, it falls
+
+
+def test_ambf_client_real_time_mode_steps_in_step_with_the_clock():
+    import time
+
+    world = ambfplus.World()
+    world.add_body("ball", "sphere", radius=0.05, pose=ambfplus.make_pose((0, 0, 1)))
+    client = Client(simulator=world.simulator, realtime=True)
+    client.connect()
+    ball = client.get_obj_handle("ball")
+    start = time.perf_counter()
+    time.sleep(0.4)  # as an AMBF client script waits for the simulator
+    z = ball.get_pos().z
+    client.clean_up()
+    elapsed = time.perf_counter() - start
+    assert 0.8 * elapsed - 0.05 <= world.time <= elapsed + 0.01
+    # It fell for (about) that long: z = 1 - g t^2 / 2 at the time read.
+    assert z < 1.0 - 9.8 * (0.8 * 0.4 - 0.05) ** 2 / 2
+    stopped = world.time
+    time.sleep(0.05)
+    assert world.time == stopped  # clean_up stops the thread

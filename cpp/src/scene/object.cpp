@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "ambfplus/scene/model.h"
+#include "ambfplus/scene/world.h"
 
 namespace ambfplus {
 
@@ -43,6 +44,7 @@ void Object::attach_to(const Object* parent, const Eigen::Isometry3d& local) {
   for (const Object* p = parent; p != nullptr; p = p->attached_to_) {
     if (p == this) throw std::invalid_argument("'" + name_ + "' cannot ride on itself");
   }
+  world().track_attached(this, parent != nullptr);
   attached_to_ = parent;
   local_ = local;
   follow_parent();

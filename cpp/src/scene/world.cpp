@@ -117,6 +117,7 @@ void World::remove_model(Model& model) {
     if (auto* body = dynamic_cast<RigidBody*>(object)) physics_->remove(*body);
     by_name_.erase(object->name());
     objects_.erase(std::find(objects_.begin(), objects_.end(), object));
+    track_attached(object, false);
   }
   while (!model.owned_.empty()) model.owned_.pop_back();
   // Its GPU copies are keyed by addresses that may be reused.
@@ -132,6 +133,19 @@ int World::claim_name(const std::string& name, const char* what) {
                                 " with that name");
   }
   return next_id_;
+}
+
+void World::track_attached(Object* object, bool attached) {
+  const auto it = std::find(attached_.begin(), attached_.end(), object);
+  if (attached && it == attached_.end()) {
+    // Creation order (ids grow with it), so a child of a child follows after its parent.
+    attached_.insert(
+        std::upper_bound(attached_.begin(), attached_.end(), object,
+                         [](const Object* a, const Object* b) { return a->id() < b->id(); }),
+        object);
+  } else if (!attached && it != attached_.end()) {
+    attached_.erase(it);
+  }
 }
 
 void World::register_object(Object* object) {
@@ -152,7 +166,7 @@ void World::step(std::int64_t n) {
     ++step_index_;
     physics_->step(time_step_);
     for (Drill* d : drills) d->tick(time_step_, step_index_);
-    for (Object* o : objects_) o->follow_parent();
+    for (Object* o : attached_) o->follow_parent();
     // Sensors see where everything ended up.
     for (ConstraintActuator* a : actuators) a->update();
     for (ProximitySensor* p : sensors) p->update();

@@ -92,6 +92,9 @@ class AMBFPLUS_API World {
   friend class Model;
   World(Simulator& simulator, std::string name, double time_step);
   int claim_name(const std::string& name, const char* what);
+  // Objects riding on a parent, in creation order: the only ones a step moves after physics.
+  friend class Object;
+  void track_attached(Object* object, bool attached);
   void register_object(Object* object);
 
   Simulator* simulator_;
@@ -105,6 +108,7 @@ class AMBFPLUS_API World {
   std::vector<std::unique_ptr<Model>> models_;
   std::map<std::string, Object*> by_name_;
   std::vector<Object*> objects_;
+  std::vector<Object*> attached_;
   std::unique_ptr<render::SceneRenderer> renderer_;
   std::unique_ptr<PluginRegistry> plugins_;
   std::int64_t graphics_step_ = -1;     // the step of the last graphics update

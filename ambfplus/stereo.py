@@ -185,8 +185,9 @@ def legend(world: World) -> dict[int, dict]:
 
 
 def segmentation(frame: Frame, world: World, background=(0, 0, 0)) -> np.ndarray:
-    """Flat colours as AMBF's preprocessing shaders draw them: each object in its colour, volumes
-    in their labels' colours. Needs the frame's instance image (and label for volumes)."""
+    """Each object in its legend colour (its material colour, at full strength), volumes in their
+    labels' colours, from the frame's instance image (and label for volumes). For the colours
+    AMBF's preprocessing shaders draw, capture the "segmentation" pass instead."""
     if frame.instance is None:
         raise ValueError("segmentation needs a frame captured with the 'instance' pass")
     ids = frame.instance

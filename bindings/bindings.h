@@ -21,6 +21,7 @@ void register_plugin(pybind11::module_& m);
 #include <optional>
 #include <string>
 
+#include "ambfplus/render/shader.h"
 #include "ambfplus/scene/simulator.h"
 
 namespace ambfplus {
@@ -57,7 +58,14 @@ pybind11::object to_python(Object* o);
 pybind11::object capture(Camera& camera, pybind11::object out, pybind11::object passes,
                          pybind11::object poses);
 
-/// CapturePass bits from pass names ("rgb", "depth", "label", "instance", "voxel").
+/// A shader from Python: None (unset: inherit), "builtin" (the engine's own), or a pair of
+/// paths (vertex, fragment), made absolute.
+std::optional<ShaderSpec> to_shader(const pybind11::handle& value, const char* what);
+/// The Python value of a shader setting (None, "builtin" or a pair of paths).
+pybind11::object from_shader(const std::optional<ShaderSpec>& shader);
+
+/// CapturePass bits from pass names ("rgb", "depth", "label", "instance", "voxel",
+/// "segmentation").
 unsigned parse_passes(const pybind11::handle& names);
 /// The names of CapturePass bits, in that order.
 pybind11::list pass_names(unsigned passes);

@@ -5,6 +5,7 @@
 #include <time.h>
 
 #include <chrono>
+#include <filesystem>
 #include <sstream>
 #include <vector>
 
@@ -82,20 +83,13 @@ unsigned parse_passes(const py::handle& names) {
   unsigned passes = 0;
   for (const py::handle& n : names) {
     const std::string name = py::str(n);
-    if (name == "rgb") {
-      passes |= kPassRgb;
-    } else if (name == "depth") {
-      passes |= kPassDepth;
-    } else if (name == "label") {
-      passes |= kPassLabel;
-    } else if (name == "instance") {
-      passes |= kPassInstance;
-    } else if (name == "voxel") {
-      passes |= kPassVoxel;
-    } else {
+    int index = 0;
+    while (index < kPassCount && name != pass_name(index)) ++index;
+    if (index == kPassCount) {
       throw py::value_error("unknown pass '" + name +
-                            "': expected rgb, depth, label, instance or voxel");
+                            "': expected rgb, depth, label, instance, voxel or segmentation");
     }
+    passes |= 1u << index;
   }
   if (passes == 0) throw py::value_error("passes must name at least one image");
   return passes;
@@ -103,11 +97,37 @@ unsigned parse_passes(const py::handle& names) {
 
 py::list pass_names(unsigned passes) {
   py::list out;
-  const char* names[5] = {"rgb", "depth", "label", "instance", "voxel"};
-  for (int i = 0; i < 5; ++i) {
-    if (passes & (1u << i)) out.append(names[i]);
+  for (int i = 0; i < kPassCount; ++i) {
+    if (passes & (1u << i)) out.append(pass_name(i));
   }
   return out;
+}
+
+std::optional<ShaderSpec> to_shader(const py::handle& value, const char* what) {
+  if (value.is_none()) return std::nullopt;
+  if (py::isinstance<py::str>(value) && value.cast<std::string>() == "builtin") {
+    return ShaderSpec{};
+  }
+  const std::string expected = std::string(what) +
+                               " must be None, 'builtin' or a pair of file paths (vertex, "
+                               "fragment)";
+  if (py::isinstance<py::str>(value) || !py::isinstance<py::sequence>(value) ||
+      py::len(value) != 2) {
+    throw py::type_error(expected);
+  }
+  auto path = [&](const py::handle& p) {
+    const std::string s = py::str(py::module_::import("os").attr("fspath")(p));
+    if (s.empty()) throw py::value_error(expected);
+    return std::filesystem::absolute(s).lexically_normal().string();
+  };
+  auto pair = py::reinterpret_borrow<py::sequence>(value);
+  return ShaderSpec{path(pair[0]), path(pair[1])};
+}
+
+py::object from_shader(const std::optional<ShaderSpec>& shader) {
+  if (!shader) return py::none();
+  if (shader->builtin()) return py::str("builtin");
+  return py::make_tuple(shader->vertex, shader->fragment);
 }
 
 namespace {
@@ -144,6 +164,7 @@ py::object capture(Camera& camera, py::object out, py::object passes, py::object
       if (p & kPassLabel) frame->label.allocate(h, w, 1);
       if (p & kPassInstance) frame->instance.allocate(h, w, 1);
       if (p & kPassVoxel) frame->voxel.allocate(h, w, 1);
+      if (p & kPassSegmentation) frame->segmentation.allocate(h, w, 3);
     }
     {
       py::gil_scoped_release release;
@@ -187,9 +208,13 @@ py::object capture(Camera& camera, py::object out, py::object passes, py::object
       } else if (key == "voxel") {
         targets.voxel = checked_output<std::int32_t>(item.second, "voxel", {h, w});
         frame->voxel.attach(targets.voxel, camera.height(), camera.width(), 1);
+      } else if (key == "segmentation") {
+        targets.segmentation = checked_output<std::uint8_t>(item.second, "segmentation", {h, w, 3});
+        frame->segmentation.attach(targets.segmentation, camera.height(), camera.width(), 3);
       } else {
-        throw py::value_error("out has an unknown key '" + key +
-                              "': expected 'rgb', 'depth', 'label', 'instance', 'voxel'");
+        throw py::value_error(
+            "out has an unknown key '" + key +
+            "': expected 'rgb', 'depth', 'label', 'instance', 'voxel', 'segmentation'");
       }
     }
     py::object result = py::cast(frame);
@@ -227,6 +252,11 @@ void register_capture(py::module_& m) {
           "voxel", [](py::object self) { return view(self, self.cast<Frame&>().voxel, true); },
           "int32 (H, W) view: the linear index i + nx (j + ny k) of the volume voxel whose label "
           "the pixel shows, -1 elsewhere, or None when not rendered")
+      .def_property_readonly(
+          "segmentation",
+          [](py::object self) { return view(self, self.cast<Frame&>().segmentation, false); },
+          "uint8 (H, W, 3) view: flat RGB colours as AMBF's preprocessing shaders draw them (the "
+          "camera's preprocessing shader where set), or None when not rendered")
       .def_property_readonly(
           "points",
           [](Frame& f) -> py::object {

@@ -453,6 +453,11 @@ void register_scene(py::module_& m) {
       .def_property_readonly("volumes",
                              [](World& w) { return to_python_list(w.objects_of_kind<Volume>()); })
       .def_property("gravity", &World::gravity, &World::set_gravity, "m/s^2, world frame")
+      .def_property(
+          "shader", [](World& w) { return from_shader(w.shader()); },
+          [](World& w, const py::object& v) { w.set_shader(to_shader(v, "shader")); },
+          "the shader of bodies whose model and own material name none (AMBF's world "
+          "`shaders`): None (the engine's own), 'builtin', or (vertex_path, fragment_path)")
       .def_property_readonly("joints",
                              [](World& w) { return to_python_list(w.objects_of_kind<Joint>()); })
       .def_property_readonly("drills",
@@ -482,6 +487,11 @@ void register_scene(py::module_& m) {
 
   model.def_property_readonly("name", &Model::name)
       .def_property_readonly("world", [](Model& md) { return handle(&md.world(), md.world()); })
+      .def_property(
+          "shader", [](Model& md) { return from_shader(md.shader()); },
+          [](Model& md, const py::object& v) { md.set_shader(to_shader(v, "shader")); },
+          "the shader of its bodies that name none (AMBF's model `shaders`): None (the world's), "
+          "'builtin' (the engine's own), or (vertex_path, fragment_path)")
       .def_property_readonly("objects", [](Model& md) { return to_python_list(md.objects()); })
       .def("__repr__", [](Model& md) { return "<Model '" + md.name() + "'>"; });
   def_adders(model, [](Model& md) -> Model& { return md; });
@@ -509,7 +519,16 @@ void register_scene(py::module_& m) {
             m.color = rgba(c, "color");
             b.set_material(m);
           },
-          "RGBA in 0..1");
+          "RGBA in 0..1")
+      .def_property(
+          "shader", [](RigidBody& b) { return from_shader(b.material().shader); },
+          [](RigidBody& b, const py::object& v) {
+            Material m = b.material();
+            m.shader = to_shader(v, "shader");
+            b.set_material(m);
+          },
+          "the body's own shader (AMBF's body `shaders`): None (its model's), 'builtin' (the "
+          "engine's own), or (vertex_path, fragment_path); it colours the rgb image only");
 
   camera.def_property_readonly("width", &Camera::width)
       .def_property_readonly(
@@ -544,10 +563,18 @@ void register_scene(py::module_& m) {
       .def("capture", &capture, py::arg("out") = py::none(), py::arg("passes") = py::none(),
            py::arg("poses") = py::none(),
            "Renders (GIL released) and returns a Frame of NumPy views. passes: the images to "
-           "render ('rgb', 'depth', 'label', 'instance', 'voxel'; default camera.passes), and "
+           "render ('rgb', 'depth', 'label', 'instance', 'voxel', 'segmentation'; default "
+           "camera.passes), and "
            "only those. out=Frame refills that frame's images in place; out={'rgb': a, "
            "'depth': b, ...} renders into preallocated arrays. poses: object names (or True for "
            "all) whose world poses the frame records in frame.poses.")
+      .def_property(
+          "preprocessing_shader", [](Camera& c) { return from_shader(c.preprocessing_shader()); },
+          [](Camera& c, const py::object& v) {
+            c.set_preprocessing_shader(to_shader(v, "preprocessing_shader"));
+          },
+          "AMBF's `preprocessing shaders`: what the segmentation pass draws meshes with (volumes "
+          "keep their label colours); None or 'builtin': the engine's equivalent of AMBF's")
       .def_property(
           "passes", [](Camera& c) { return pass_names(c.passes()); },
           [](Camera& c, const py::object& names) { c.set_passes(parse_passes(names)); },

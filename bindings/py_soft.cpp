@@ -409,7 +409,15 @@ void register_soft(
             mat.color = parse_color(c);
             s.set_material(mat);
           },
-          "RGBA in 0..1");
+          "RGBA in 0..1")
+      .def_property(
+          "shader", [](SoftBody& s) { return from_shader(s.material().shader); },
+          [](SoftBody& s, const py::object& v) {
+            Material mat = s.material();
+            mat.shader = to_shader(v, "shader");
+            s.set_material(mat);
+          },
+          "its own shader: None (its model's), 'builtin', or (vertex_path, fragment_path)");
 
   sensor.def_property_readonly("parent", [](ProximitySensor& s) { return handle(&s.parent()); })
       .def_property_readonly(

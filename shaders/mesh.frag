@@ -1,6 +1,7 @@
 #version 450 core
-// Shaded colour (flat with SHADE 0, when no rgb pass is asked for), object id, and metric depth from the perspective-correct camera-frame position: exact and
-// linear whatever the depth buffer holds, also on triangles clipped from points at infinity (where
+// Shaded colour (flat with SHADE 0, when no rgb pass is asked for), object id, segmentation
+// colour, and metric depth from the perspective-correct camera-frame position: exact and linear
+// whatever the depth buffer holds, also on triangles clipped from points at infinity (where
 // gl_FragCoord.w is not 1/z because the clipped vertices carry a homogeneous scale).
 
 #include "lighting.glsl"
@@ -14,12 +15,14 @@ in vec3 v_normal;
 
 uniform vec4 u_color;
 uniform int u_instance;  // the object's id
+uniform vec3 u_segmentation_color;  // flat, as AMBF's preprocessing shader draws it
 
 layout(location = 0) out vec4 o_color;
 layout(location = 1) out float o_depth;
 layout(location = 2) out uint o_label;  // volume labels only
 layout(location = 3) out int o_instance;
 layout(location = 4) out int o_voxel;  // volume voxels only
+layout(location = 5) out vec4 o_segmentation;
 
 void main() {
   vec3 p = v_position.xyz / v_position.w;
@@ -27,6 +30,7 @@ void main() {
   o_label = 0u;
   o_instance = u_instance;
   o_voxel = -1;
+  o_segmentation = vec4(u_segmentation_color, 1.0);
 #if SHADE
   vec3 n = normalize(v_normal);
   if (!gl_FrontFacing) n = -n;

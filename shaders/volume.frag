@@ -41,6 +41,7 @@ layout(location = 1) out float o_depth;
 layout(location = 2) out uint o_label;
 layout(location = 3) out int o_instance;
 layout(location = 4) out int o_voxel;
+layout(location = 5) out vec4 o_segmentation;  // the label's colour (AMBF's voxel-colour mode)
 
 uniform int u_instance;  // the volume's object id
 
@@ -190,6 +191,7 @@ void main() {
 #else
   o_color = vec4(base, 1.0);
 #endif
+  o_segmentation = vec4(base, 1.0);
   o_depth = camera.z;
   o_label = label;
   o_instance = u_instance;

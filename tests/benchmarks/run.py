@@ -352,7 +352,7 @@ def stereo(args) -> Iterator[dict]:
         "original_cpu_s": 3.3,
         "what": "drill + ear 256^3, both views of the fixture's stereoL/stereoR",
     }
-    for name in ("rgb", "depth", "instance", "label", "voxel"):
+    for name in ("rgb", "depth", "instance", "label", "voxel", "segmentation"):
         cost = rgb if name == "rgb" else cpu_per_capture((name,))
         yield {
             "bench": f"stereo_pass_{name}_cpu",

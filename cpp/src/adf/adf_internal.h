@@ -2,6 +2,7 @@
 
 // What the ADF readers share inside the engine.
 
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -9,6 +10,7 @@
 #include "adf/adf_yaml.h"
 #include "ambfplus/adf/adf.h"
 #include "ambfplus/adf/volume_adf.h"
+#include "ambfplus/render/shader.h"
 
 namespace ambfplus {
 
@@ -40,6 +42,13 @@ struct ObjectPlugins {
   std::string where;  ///< its block, "BODY l1"
   std::vector<AdfPlugin> plugins;
 };
+
+/// A `shaders: {path, vertex, fragment}` block (key names it in messages): `path` relative to
+/// the file, the two files relative to `path`. A missing file is a warning and gives nullopt
+/// (the engine's own shader draws).
+std::optional<ShaderSpec> read_shader(const Doc& doc, const YAML::Node& block,
+                                      const std::string& where, const std::string& key,
+                                      Context& ctx);
 
 /// Loads plugins declared in file (at `where`: "launch", "world", "model", "BODY l1") at
 /// site. A failure throws PluginError naming the file, or with ctx.report_plugin_errors is an

@@ -36,6 +36,31 @@ std::vector<AdfPlugin> adf::read_plugins(const Doc& doc, const YAML::Node& list,
   return out;
 }
 
+std::optional<ShaderSpec> adf::read_shader(const Doc& doc, const YAML::Node& block,
+                                           const std::string& where, const std::string& key,
+                                           Context& ctx) {
+  if (!block) return std::nullopt;
+  if (!block.IsMap())
+    adf::fail(doc, block, where, "'" + key + "' must be {path, vertex, fragment}");
+  for (const char* part : {"vertex", "fragment"}) {
+    if (!block[part]) adf::fail(doc, block, where, "'" + key + "' needs '" + part + "'");
+  }
+  const std::string dir =
+      block["path"] ? adf::resolve(doc.dir, adf::text(doc, block["path"], where, key + ".path"))
+                    : doc.dir.string();
+  ShaderSpec spec;
+  spec.vertex = adf::resolve(dir, adf::text(doc, block["vertex"], where, key + ".vertex"));
+  spec.fragment = adf::resolve(dir, adf::text(doc, block["fragment"], where, key + ".fragment"));
+  for (const std::string* file : {&spec.vertex, &spec.fragment}) {
+    if (!fs::is_regular_file(*file)) {
+      ctx.diag->warn(doc.path, adf::at(block) + where + ": '" + key + "': " + *file +
+                                   " not found; the engine's own shader draws instead");
+      return std::nullopt;
+    }
+  }
+  return spec;
+}
+
 void adf::load_plugins(const std::vector<AdfPlugin>& plugins, const PluginSite& site,
                        const std::string& file, const std::string& where, Context& ctx) {
   for (const AdfPlugin& p : plugins) {
@@ -117,11 +142,11 @@ void load_world(World& world, const std::string& path, adf::Context& ctx) {
   if (root["environment"]) {
     environment = adf::resolve(doc.dir, adf::text(doc, root["environment"], where, "environment"));
   }
-  for (const char* key : {"skybox", "shaders"}) {
-    if (root[key]) {
-      ctx.diag->warn(doc.path, adf::at(root[key]) + "world '" + key + "' is not applied yet");
-    }
+  if (root["skybox"]) {
+    ctx.diag->warn(doc.path, adf::at(root["skybox"]) + "world 'skybox' is not applied yet");
   }
+  const std::optional<ShaderSpec> shader =
+      adf::read_shader(doc, root["shaders"], where, "shaders", ctx);
   const std::vector<AdfPlugin> plugins = adf::read_plugins(doc, root["plugins"], where);
 
   world.set_name_space(ns);
@@ -130,12 +155,16 @@ void load_world(World& world, const std::string& path, adf::Context& ctx) {
   std::vector<std::pair<std::string, RigidBody*>> own;
   if (!environment.empty()) {
     Model& env = adf::load_model(world, environment, ctx);
+    // AMBF builds the environment before it compiles the world's shader, which the
+    // environment therefore never gets.
+    if (shader && !env.shader()) env.set_shader(ShaderSpec{});
     for (Object* o : env.objects()) {
       if (auto* b = dynamic_cast<RigidBody*>(o)) own.emplace_back(b->identifier(), b);
     }
   } else if (root["enclosure"]) {
     add_enclosure(world, doc, root["enclosure"]);
   }
+  if (shader) world.set_shader(shader);
   std::vector<adf::ObjectPlugins> object_plugins;
   adf::add_cameras_and_lights(world.default_model(), doc, ns, ctx, own, object_plugins);
   // Plugins once the world is built: its objects', then its own.

@@ -148,6 +148,13 @@ Material material(const Doc& doc, const std::string& where, const YAML::Node& bl
       m.shininess = static_cast<float>(number(doc, parts["shininess"], where, "shininess"));
     }
     m.color[3] = static_cast<float>(number_or(doc, parts, "transparency", where, 1.0));
+    // AMBF: ambient = level x diffuse when given, else CHAI3D's grey default.
+    const float level =
+        parts["ambient"] ? static_cast<float>(number_or(doc, parts["ambient"], "level", where, 1.0))
+                         : -1.0f;
+    m.ambient = level >= 0 ? std::array<float, 3>{level * m.color[0], level * m.color[1],
+                                                  level * m.color[2]}
+                           : std::array<float, 3>{0.3f, 0.3f, 0.3f};
   } else if (const YAML::Node name = block["color"]) {
     const std::string c = text(doc, name, where, "color");
     const auto it = ctx.colors ? ctx.colors->find(c) : AdfColors::const_iterator();
@@ -343,6 +350,7 @@ BodyPlan plan_body(const Doc& doc, const std::string& model_hr, const std::strin
                                  ": a collision mesh needs a visual mesh in ambfplus; ignored");
   }
   s.material = material(doc, id, b, ctx);
+  s.material.shader = read_shader(doc, b["shaders"], id, "shaders", ctx);
   plan.plugins = read_plugins(doc, b["plugins"], id);
   return plan;
 }
@@ -475,6 +483,7 @@ struct CameraPlan {
   std::vector<AdfPlugin> plugins;
   double eye_separation = 0.0;  // `stereo`: a left and a right eye beside the camera
   double stereo_focal = 0.0;    // where the eyes' views converge (off-axis), m
+  std::optional<ShaderSpec> preprocessing;
 };
 
 CameraPlan plan_camera(const Doc& doc, const std::string& base_ns, const std::string& id,
@@ -548,11 +557,17 @@ CameraPlan plan_camera(const Doc& doc, const std::string& base_ns, const std::st
     plan.stereo_focal = number_or(doc, stereo, "focal length", id, 0.0);
     if (!(plan.eye_separation > 0)) fail(doc, stereo, id, "'stereo' needs 'eye separation' > 0");
   }
-  for (const char* key :
-       {"orthographic view width", "preprocessing shaders", "depth compute shaders"}) {
-    if (n[key]) {
-      ctx.diag->warn(doc.path, at(n[key]) + id + ": '" + key + "' is not applied yet");
-    }
+  plan.preprocessing =
+      read_shader(doc, n["preprocessing shaders"], id, "preprocessing shaders", ctx);
+  if (n["orthographic view width"]) {
+    ctx.diag->warn(doc.path, at(n["orthographic view width"]) + id +
+                                 ": 'orthographic view width' is not applied yet");
+  }
+  if (n["depth compute shaders"]) {
+    // AMBF's unprojection of a non-linear depth buffer; ours renders metric depth directly.
+    ctx.diag->warn(doc.path, at(n["depth compute shaders"]) + id +
+                                 ": 'depth compute shaders' are not needed (depth is rendered "
+                                 "metric) and are ignored");
   }
   plan.plugins = read_plugins(doc, n["plugins"], id);
   return plan;
@@ -667,6 +682,7 @@ SoftBodySpec plan_soft_body(const Doc& doc, const std::string& model_lr,
     s.randomize_constraints = boolean(doc, b["randomize constraints"], id, "randomize constraints");
   }
   s.material = material(doc, id, b, ctx);
+  s.material.shader = read_shader(doc, b["shaders"], id, "shaders", ctx);
   return s;
 }
 
@@ -858,6 +874,7 @@ void add_cameras_and_lights(Model& model, const Doc& doc, const std::string& bas
     Camera& camera = model.add_camera(c.spec);
     camera.set_identifier(c.id);
     camera.set_name_space(c.ns);
+    camera.set_preprocessing_shader(c.preprocessing);
     camera.look_at(c.eye, c.target, c.up);
     if (Object* parent = parent_of(c.id, c.parent, c.ns)) {
       camera.attach_to(parent, parent_frame(*parent) * camera.pose());
@@ -872,6 +889,7 @@ void add_cameras_and_lights(Model& model, const Doc& doc, const std::string& bas
         eye.name = unique_name(world, c.spec.name + (side < 0 ? "_left" : "_right"));
         Camera& e = model.add_camera(eye);
         e.set_name_space(c.ns);
+        e.set_preprocessing_shader(c.preprocessing);
         Eigen::Isometry3d local = Eigen::Isometry3d::Identity();
         local.translation().x() = side * c.eye_separation / 2;
         e.attach_to(&camera, local);
@@ -964,9 +982,8 @@ Model& load_model(World& world, const std::string& path, Context& ctx) {
       ctx.diag->warn(doc.path, at(root[key]) + "'" + key + "' are not loaded yet");
     }
   }
-  if (root["shaders"]) {
-    ctx.diag->warn(doc.path, at(root["shaders"]) + "model 'shaders' are not applied yet");
-  }
+  const std::optional<ShaderSpec> model_shader =
+      read_shader(doc, root["shaders"], where, "shaders", ctx);
   const std::vector<AdfPlugin> model_plugins = read_plugins(doc, root["plugins"], where);
   const bool has_volumes = static_cast<bool>(root["volumes"]);
   std::vector<AdfVolumeBlock> volumes;
@@ -976,6 +993,7 @@ Model& load_model(World& world, const std::string& path, Context& ctx) {
 
   std::string model_name = unique_model_name(world, fs::path(path).stem().string());
   Model& model = world.add_model(model_name);
+  model.set_shader(model_shader);
   std::string current = "model";
   try {
     std::vector<std::pair<std::string, RigidBody*>> own;

@@ -305,6 +305,13 @@ Program& Context::program(const std::string& vertex_file, const std::string& fra
   return *it->second;
 }
 
+Program& Context::program(const std::string& key,
+                          const std::function<std::unique_ptr<Program>()>& make) {
+  auto it = programs_.find(key);
+  if (it == programs_.end()) it = programs_.emplace(key, make()).first;
+  return *it->second;
+}
+
 void Context::make_current() {
   if (!eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_)) {
     throw RenderError("eglMakeCurrent failed: " + egl_error_name(eglGetError()));

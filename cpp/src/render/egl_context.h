@@ -4,6 +4,7 @@
 #include <epoxy/gl.h>
 #include <sys/types.h>
 
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -34,6 +35,9 @@ class Context {
   /// process. Needs a Scope.
   Program& program(const std::string& vertex_file, const std::string& fragment_file,
                    const std::string& defines = "");
+  /// A program cached under key, made by make() on its first request (which may throw, caching
+  /// nothing). Needs a Scope.
+  Program& program(const std::string& key, const std::function<std::unique_ptr<Program>()>& make);
 
   /// Serialises GL work across threads and keeps the context current on this thread while alive.
   class Scope {

@@ -41,7 +41,6 @@ std::string info_log(GLuint object, GetIv get_iv, GetLog get_log) {
   return log.data();
 }
 
-// The source with each `#include "file"` line replaced by that file (found beside the includer).
 std::string with_includes(const std::string& source, const std::string& path, int depth = 0) {
   if (depth > 8) throw RenderError(path + ": #include nested too deep");
   std::istringstream in(source);
@@ -54,7 +53,8 @@ std::string with_includes(const std::string& source, const std::string& path, in
     if (at != std::string::npos && line.find_first_not_of(" \t") == at &&
         open != std::string::npos && close > open) {
       const std::string name = line.substr(open + 1, close - open - 1);
-      const std::string included = (std::filesystem::path(path).parent_path() / name).string();
+      std::string included = (std::filesystem::path(path).parent_path() / name).string();
+      if (!std::filesystem::exists(included)) included = shader_dir() + "/" + name;
       out << with_includes(read_text(included), included, depth + 1) << "\n";
     } else {
       out << line << "\n";
@@ -63,8 +63,7 @@ std::string with_includes(const std::string& source, const std::string& path, in
   return out.str();
 }
 
-GLuint compile(GLenum stage, const std::string& path, const std::string& defines) {
-  const std::string source = with_defines(with_includes(read_text(path), path), defines);
+GLuint compile(GLenum stage, const std::string& path, const std::string& source) {
   const GLuint shader = glCreateShader(stage);
   const char* text = source.c_str();
   glShaderSource(shader, 1, &text, nullptr);
@@ -80,6 +79,8 @@ GLuint compile(GLenum stage, const std::string& path, const std::string& defines
 }
 
 }  // namespace
+
+std::string read_shader(const std::string& path) { return with_includes(read_text(path), path); }
 
 std::string shader_dir() {
   if (const char* env = std::getenv("AMBFPLUS_SHADER_DIR"); env != nullptr && *env != '\0') {
@@ -98,11 +99,17 @@ std::string shader_dir() {
 }
 
 Program::Program(const std::string& vertex_path, const std::string& fragment_path,
-                 const std::string& defines) {
-  const GLuint vs = compile(GL_VERTEX_SHADER, vertex_path, defines);
+                 const std::string& defines)
+    : Program(vertex_path, with_defines(read_shader(vertex_path), defines), fragment_path,
+              with_defines(read_shader(fragment_path), defines), {}) {}
+
+Program::Program(const std::string& vertex_path, const std::string& vertex_source,
+                 const std::string& fragment_path, const std::string& fragment_source,
+                 const AttributeBindings& attributes) {
+  const GLuint vs = compile(GL_VERTEX_SHADER, vertex_path, vertex_source);
   GLuint fs = 0;
   try {
-    fs = compile(GL_FRAGMENT_SHADER, fragment_path, defines);
+    fs = compile(GL_FRAGMENT_SHADER, fragment_path, fragment_source);
   } catch (...) {
     glDeleteShader(vs);
     throw;
@@ -110,6 +117,9 @@ Program::Program(const std::string& vertex_path, const std::string& fragment_pat
   id_ = glCreateProgram();
   glAttachShader(id_, vs);
   glAttachShader(id_, fs);
+  for (const auto& [name, location] : attributes) {
+    glBindAttribLocation(id_, location, name.c_str());
+  }
   glLinkProgram(id_);
   glDeleteShader(vs);
   glDeleteShader(fs);

@@ -1,11 +1,14 @@
 #include "render/scene_renderer.h"
 
+#include <array>
 #include <cmath>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "ambfplus/errors.h"
 #include "ambfplus/scene/world.h"
+#include "render/custom_shader.h"
 #include "render/egl_context.h"
 #include "render/light_set.h"
 #include "render/volume_renderer.h"
@@ -29,14 +32,13 @@ SceneRenderer::~SceneRenderer() {
   try {
     Context::Scope scope;
     volumes_.clear();
-    for (auto& [key, m] : meshes_) {
+    auto release = [](GpuMesh& m) {
       glDeleteVertexArrays(1, &m.vao);
+      if (m.legacy_vao != 0) glDeleteVertexArrays(1, &m.legacy_vao);
       glDeleteBuffers(3, m.buffers);
-    }
-    for (auto& [key, m] : soft_meshes_) {
-      glDeleteVertexArrays(1, &m.vao);
-      glDeleteBuffers(3, m.buffers);
-    }
+    };
+    for (auto& entry : meshes_) release(entry.second);
+    for (auto& entry : soft_meshes_) release(entry.second);
     for (auto& [key, t] : targets_) {
       glDeleteFramebuffers(1, &t.framebuffer);
       glDeleteRenderbuffers(RenderTarget::kBuffers, t.renderbuffers);
@@ -56,6 +58,7 @@ GpuMesh& SceneRenderer::mesh_for(const MeshData* mesh) {
   auto it = meshes_.find(mesh);
   if (it != meshes_.end()) return it->second;
   GpuMesh g;
+  g.position_size = mesh->position_size;
   glGenVertexArrays(1, &g.vao);
   glGenBuffers(3, g.buffers);
   glBindVertexArray(g.vao);
@@ -140,8 +143,8 @@ RenderTarget& SceneRenderer::target_for(const Camera& camera) {
   t.height = camera.height();
   glGenFramebuffers(1, &t.framebuffer);
   glGenRenderbuffers(RenderTarget::kBuffers, t.renderbuffers);
-  const GLenum formats[RenderTarget::kBuffers] = {GL_RGBA8, GL_R32F, GL_R16UI,
-                                                  GL_R32I,  GL_R32I, GL_DEPTH_COMPONENT32F};
+  const GLenum formats[RenderTarget::kBuffers] = {
+      GL_RGBA8, GL_R32F, GL_R16UI, GL_R32I, GL_R32I, GL_RGBA8, GL_DEPTH_COMPONENT32F};
   glBindFramebuffer(GL_FRAMEBUFFER, t.framebuffer);
   for (int i = 0; i < RenderTarget::kBuffers; ++i) {
     glBindRenderbuffer(GL_RENDERBUFFER, t.renderbuffers[i]);
@@ -174,13 +177,13 @@ void SceneRenderer::draw(const Camera& camera, unsigned passes) {
   RenderTarget& target = target_for(camera);
 
   glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
-  // Only the passes asked for are written.
-  const unsigned order[5] = {kPassRgb, kPassDepth, kPassLabel, kPassInstance, kPassVoxel};
-  GLenum draw_buffers[5];
-  for (int i = 0; i < 5; ++i) {
-    draw_buffers[i] = (passes & order[i]) ? static_cast<GLenum>(GL_COLOR_ATTACHMENT0 + i) : GL_NONE;
+  // Only the passes asked for are written (pass i on attachment i).
+  GLenum draw_buffers[kPassCount];
+  for (int i = 0; i < kPassCount; ++i) {
+    draw_buffers[i] =
+        (passes & (1u << i)) ? static_cast<GLenum>(GL_COLOR_ATTACHMENT0 + i) : GL_NONE;
   }
-  glDrawBuffers(5, draw_buffers);
+  glDrawBuffers(kPassCount, draw_buffers);
   glViewport(0, 0, target.width, target.height);
   // Reversed z: clear to 0 (far), keep the greater depth.
   glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
@@ -203,6 +206,7 @@ void SceneRenderer::draw(const Camera& camera, unsigned passes) {
   const GLint clear_voxel[4] = {-1, -1, -1, -1};
   glClearBufferiv(GL_COLOR, 3, clear_instance);
   glClearBufferiv(GL_COLOR, 4, clear_voxel);
+  glClearBufferfv(GL_COLOR, 5, clear_color);
   glClearBufferfv(GL_DEPTH, 0, &clear_depth);
 
   program.use();
@@ -216,6 +220,7 @@ void SceneRenderer::draw(const Camera& camera, unsigned passes) {
   const GLint u_specular = program.uniform("u_specular");
   const GLint u_shininess = program.uniform("u_shininess");
   const GLint u_instance = program.uniform("u_instance");
+  const GLint u_segmentation_color = program.uniform("u_segmentation_color");
 
   auto draw = [&](const GpuMesh& mesh, const Eigen::Isometry3d& model_view, const Material& m,
                   int id) {
@@ -228,6 +233,10 @@ void SceneRenderer::draw(const Camera& camera, unsigned passes) {
     glUniform4fv(u_color, 1, m.color.data());
     glUniform1f(u_specular, m.specular);
     glUniform1f(u_shininess, m.shininess);
+    // What AMBF's preprocessing shader draws: material ambient x light ambient.
+    const std::array<float, 3> a = m.ambient_color();
+    glUniform3f(u_segmentation_color, kAmbfLightAmbient * a[0], kAmbfLightAmbient * a[1],
+                kAmbfLightAmbient * a[2]);
     glBindVertexArray(mesh.vao);
     glDrawElements(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr);
   };
@@ -249,7 +258,45 @@ void SceneRenderer::draw(const Camera& camera, unsigned passes) {
     gpu->sync(volume->iso());
     gpu->draw(*volume, camera, camera_from_world, lights, passes);
   }
+  // Users' shaders colour their meshes; the camera's preprocessing shader its segmentation.
+  if (passes & kPassRgb) {
+    overlay(
+        camera, camera_from_world, lights, GL_COLOR_ATTACHMENT0,
+        [&](const Material& m, const Model& model) { return effective_shader(m, model, world_); });
+  }
+  const auto& preprocessing = camera.preprocessing_shader();
+  if ((passes & kPassSegmentation) && preprocessing && !preprocessing->builtin()) {
+    overlay(camera, camera_from_world, lights, GL_COLOR_ATTACHMENT5,
+            [&](const Material&, const Model&) { return &*preprocessing; });
+  }
   check_gl("drawing the scene");
+}
+
+template <typename ShaderOf>
+void SceneRenderer::overlay(const Camera& camera, const Eigen::Isometry3d& camera_from_world,
+                            const LightSet& lights, GLenum attachment, ShaderOf shader_of) {
+  std::optional<ShaderOverlay> pass;  // begun at the first mesh that has a shader that runs
+  auto draw = [&](const Material& m, const Model& model, auto&& mesh, const Eigen::Isometry3d& mv,
+                  int id) {
+    const ShaderSpec* spec = shader_of(m, model);
+    const UserShader* shader = spec != nullptr ? user_shader(*spec, lights) : nullptr;
+    if (shader == nullptr) return;
+    if (!pass) pass.emplace(camera, lights, world_.time(), attachment);
+    pass->draw(*shader, mesh(), mv, m, id);
+  };
+  for (const RigidBody* body : world_.objects_of_kind<RigidBody>()) {
+    if (body->visual_mesh()->indices.empty()) continue;
+    draw(
+        body->material(), body->model(),
+        [&]() -> GpuMesh& { return mesh_for(body->visual_mesh().get()); },
+        camera_from_world * body->pose(), body->id());
+  }
+  for (const SoftBody* body : world_.objects_of_kind<SoftBody>()) {
+    // Its nodes were uploaded by the main pass of this draw.
+    draw(
+        body->material(), body->model(), [&]() -> GpuMesh& { return soft_meshes_.at(body->id()); },
+        camera_from_world, body->id());
+  }
 }
 
 void SceneRenderer::read(const Camera& camera, const CaptureBuffers& buffers) {
@@ -262,12 +309,13 @@ void SceneRenderer::read(const Camera& camera, const CaptureBuffers& buffers) {
   const struct {
     void* data;
     GLenum format, type;
-  } images[5] = {{buffers.rgb, GL_RGB, GL_UNSIGNED_BYTE},
-                 {buffers.depth, GL_RED, GL_FLOAT},
-                 {buffers.label, GL_RED_INTEGER, GL_UNSIGNED_SHORT},
-                 {buffers.instance, GL_RED_INTEGER, GL_INT},
-                 {buffers.voxel, GL_RED_INTEGER, GL_INT}};
-  for (int i = 0; i < 5; ++i) {
+  } images[kPassCount] = {{buffers.rgb, GL_RGB, GL_UNSIGNED_BYTE},
+                          {buffers.depth, GL_RED, GL_FLOAT},
+                          {buffers.label, GL_RED_INTEGER, GL_UNSIGNED_SHORT},
+                          {buffers.instance, GL_RED_INTEGER, GL_INT},
+                          {buffers.voxel, GL_RED_INTEGER, GL_INT},
+                          {buffers.segmentation, GL_RGB, GL_UNSIGNED_BYTE}};
+  for (int i = 0; i < kPassCount; ++i) {
     if (images[i].data == nullptr) continue;
     glReadBuffer(static_cast<GLenum>(GL_COLOR_ATTACHMENT0 + i));
     glReadPixels(0, 0, target.width, target.height, images[i].format, images[i].type,

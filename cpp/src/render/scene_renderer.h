@@ -18,21 +18,26 @@ struct MeshData;
 namespace ambfplus::render {
 
 class GpuVolume;
+struct LightSet;
 struct VolumeUpload;
 
 /// A mesh in GPU buffers.
 struct GpuMesh {
   GLuint vao = 0;
+  GLuint legacy_vao = 0;  // AMBF's attribute layout, made when a legacy shader first draws it
   GLuint buffers[3] = {0, 0, 0};  // positions, normals, indices
   GLsizei index_count = 0;
+  int position_size = 3;
 };
 
 /// Off-screen colour, metric-depth, id and depth-test buffers of one camera's size.
 struct RenderTarget {
-  static constexpr int kBuffers = 6;
+  // One colour attachment per capture pass (pass i on attachment i), then the depth test.
+  static constexpr int kBuffers = kPassCount + 1;
   GLuint framebuffer = 0;
-  // colour (RGBA8), depth (R32F), label (R16UI), instance (R32I), voxel (R32I), depth test (D32F)
-  GLuint renderbuffers[kBuffers] = {0, 0, 0, 0, 0, 0};
+  // colour (RGBA8), depth (R32F), label (R16UI), instance (R32I), voxel (R32I), segmentation
+  // (RGBA8), depth test (D32F)
+  GLuint renderbuffers[kBuffers] = {};
   int width = 0;
   int height = 0;
 };
@@ -60,6 +65,11 @@ class SceneRenderer {
   /// The soft body's GPU mesh, its vertices refreshed from the nodes (normals recomputed).
   GpuMesh& soft_mesh_for(const SoftBody& body);
   RenderTarget& target_for(const Camera& camera);
+  /// Colours, into one attachment over the main pass, the meshes shader_of gives a user's
+  /// shader for (nullptr: keep the engine's colours).
+  template <typename ShaderOf>
+  void overlay(const Camera& camera, const Eigen::Isometry3d& camera_from_world,
+               const LightSet& lights, GLenum attachment, ShaderOf shader_of);
 
   World& world_;
   std::map<const MeshData*, GpuMesh> meshes_;

@@ -74,19 +74,25 @@ void Camera::set_principal_point(double cx, double cy) {
   cy_ = cy;
 }
 
+const char* pass_name(int index) {
+  static const char* const kNames[kPassCount] = {"rgb",      "depth", "label",
+                                                 "instance", "voxel", "segmentation"};
+  return index >= 0 && index < kPassCount ? kNames[index] : "?";
+}
+
 void Camera::set_passes(unsigned passes) {
-  const unsigned all = kPassRgb | kPassDepth | kPassLabel | kPassInstance | kPassVoxel;
-  if (passes == 0 || (passes & ~all) != 0) {
+  if (passes == 0 || (passes & ~kAllPasses) != 0) {
     throw std::invalid_argument("camera '" + name() +
                                 "': passes must be a non-empty set of rgb, depth, label, "
-                                "instance, voxel");
+                                "instance, voxel, segmentation");
   }
   passes_ = passes;
 }
 
 unsigned CaptureBuffers::passes() const {
   return (rgb ? kPassRgb : 0u) | (depth ? kPassDepth : 0u) | (label ? kPassLabel : 0u) |
-         (instance ? kPassInstance : 0u) | (voxel ? kPassVoxel : 0u);
+         (instance ? kPassInstance : 0u) | (voxel ? kPassVoxel : 0u) |
+         (segmentation ? kPassSegmentation : 0u);
 }
 
 Eigen::Matrix4d Camera::projection() const {
@@ -123,7 +129,7 @@ void Camera::capture(Frame& frame) {
   };
   // A new frame gets the camera's passes; a used one keeps its own.
   const bool fresh = frame.rgb.empty() && frame.depth.empty() && frame.label.empty() &&
-                     frame.instance.empty() && frame.voxel.empty();
+                     frame.instance.empty() && frame.voxel.empty() && frame.segmentation.empty();
   auto prepare = [&](auto& buffer, unsigned pass, int channels, const char* what) {
     check(buffer.empty(), buffer.height(), buffer.width(), buffer.channels(), channels, what);
     if (fresh && (passes_ & pass)) buffer.allocate(height_, width_, channels);
@@ -135,6 +141,7 @@ void Camera::capture(Frame& frame) {
   buffers.label = prepare(frame.label, kPassLabel, 1, "label");
   buffers.instance = prepare(frame.instance, kPassInstance, 1, "instance");
   buffers.voxel = prepare(frame.voxel, kPassVoxel, 1, "voxel");
+  buffers.segmentation = prepare(frame.segmentation, kPassSegmentation, 3, "segmentation");
   capture(buffers, frame);
 }
 

@@ -17,7 +17,18 @@ enum CapturePass : unsigned {
   kPassLabel = 1u << 2,     ///< volume label ids
   kPassInstance = 1u << 3,  ///< object ids
   kPassVoxel = 1u << 4,     ///< volume voxel indices
+  /// Flat colours as AMBF's preprocessing shaders draw them: the camera's preprocessing shader
+  /// where one is set, else the engine's equivalent (material ambient x light ambient for
+  /// meshes, label colours for volumes).
+  kPassSegmentation = 1u << 5,
 };
+
+/// Number of capture passes; pass i is the bit 1 << i.
+constexpr int kPassCount = 6;
+/// Every pass.
+constexpr unsigned kAllPasses = (1u << kPassCount) - 1;
+/// A pass's name as users write it: "rgb", "depth", "label", "instance", "voxel", "segmentation".
+AMBFPLUS_API const char* pass_name(int index);
 
 /// One camera capture: images plus the geometry and time they were taken at.
 ///
@@ -40,6 +51,7 @@ class AMBFPLUS_API Frame {
   /// height x width: the linear index (i + nx (j + ny k)) of the volume voxel whose label the
   /// pixel shows, -1 where no volume was hit.
   ImageBuffer<std::int32_t> voxel;
+  ImageBuffer<std::uint8_t> segmentation;  ///< height x width x 3, RGB
 
   int width = 0;
   int height = 0;

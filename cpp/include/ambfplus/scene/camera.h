@@ -2,11 +2,13 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include <Eigen/Core>
 
 #include "ambfplus/capture/frame.h"
+#include "ambfplus/render/shader.h"
 #include "ambfplus/scene/object.h"
 
 namespace ambfplus {
@@ -36,11 +38,12 @@ struct AMBFPLUS_API CameraSpec {
 
 /// Where a capture writes its images; null pointers are not captured.
 struct CaptureBuffers {
-  std::uint8_t* rgb = nullptr;       ///< height x width x 3, tightly packed
-  float* depth = nullptr;            ///< height x width, tightly packed
-  std::uint16_t* label = nullptr;    ///< height x width, tightly packed
-  std::int32_t* instance = nullptr;  ///< height x width, tightly packed
-  std::int32_t* voxel = nullptr;     ///< height x width, tightly packed
+  std::uint8_t* rgb = nullptr;           ///< height x width x 3, tightly packed
+  float* depth = nullptr;                ///< height x width, tightly packed
+  std::uint16_t* label = nullptr;        ///< height x width, tightly packed
+  std::int32_t* instance = nullptr;      ///< height x width, tightly packed
+  std::int32_t* voxel = nullptr;         ///< height x width, tightly packed
+  std::uint8_t* segmentation = nullptr;  ///< height x width x 3, tightly packed
   /// The CapturePass bits of the non-null buffers.
   unsigned passes() const;
 };
@@ -72,6 +75,13 @@ class AMBFPLUS_API Camera : public Object {
   /// The passes a capture into a new frame renders (CapturePass bits; default rgb, depth, label).
   unsigned passes() const { return passes_; }
   void set_passes(unsigned passes);
+  /// AMBF's `preprocessing shaders`: what the segmentation pass draws meshes with (volumes keep
+  /// their label colours); unset or empty: the engine's equivalent of AMBF's own.
+  const std::optional<ShaderSpec>& preprocessing_shader() const { return preprocessing_shader_; }
+  void set_preprocessing_shader(std::optional<ShaderSpec> shader) {
+    preprocessing_shader_ = std::move(shader);
+  }
+
   /// OpenGL clip from camera (OpenCV frame), mapping image row 0 to the first row read back.
   Eigen::Matrix4d projection() const;
 
@@ -97,6 +107,7 @@ class AMBFPLUS_API Camera : public Object {
   unsigned passes_ = kPassRgb | kPassDepth | kPassLabel;
   std::array<float, 3> background_;
   CameraPublish publish_;
+  std::optional<ShaderSpec> preprocessing_shader_;
 };
 
 }  // namespace ambfplus

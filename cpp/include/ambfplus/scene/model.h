@@ -1,6 +1,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,11 @@ class AMBFPLUS_API Model {
   World& world() const { return *world_; }
   /// Objects in creation order.
   const std::vector<Object*>& objects() const { return objects_; }
+
+  /// The shader of its bodies that name none (AMBF's model `shaders`); unset: the world's. An
+  /// empty spec is the engine's own shader.
+  const std::optional<ShaderSpec>& shader() const { return shader_; }
+  void set_shader(std::optional<ShaderSpec> shader) { shader_ = std::move(shader); }
 
   /// Creates a body. Throws std::invalid_argument for a bad spec or a taken name, AssetNotFound
   /// or ConfigError for a mesh that cannot be read.
@@ -66,6 +72,7 @@ class AMBFPLUS_API Model {
   std::string name_;
   std::vector<std::unique_ptr<Object>> owned_;
   std::vector<Object*> objects_;
+  std::optional<ShaderSpec> shader_;
 };
 
 }  // namespace ambfplus

@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 
 #include "ambfplus/io/mesh.h"
+#include "ambfplus/render/shader.h"
 #include "ambfplus/scene/object.h"
 
 namespace ambfplus {
@@ -84,9 +85,20 @@ AMBFPLUS_API const char* shape_kind_name(Shape::Kind kind);
 
 /// Surface appearance.
 struct AMBFPLUS_API Material {
-  std::array<float, 4> color{0.8f, 0.8f, 0.8f, 1.0f};  ///< RGBA, 0..1
+  std::array<float, 4> color{0.8f, 0.8f, 0.8f, 1.0f};  ///< RGBA, 0..1 (diffuse)
   float specular = 0.2f;
   float shininess = 32.0f;
+  /// Ambient reflectance (AMBF's material ambient, which its segmentation shaders draw); unset:
+  /// half the colour, as AMBF's `color rgba` gives.
+  std::optional<std::array<float, 3>> ambient;
+  /// The shader drawing this surface; unset: the model's, else the world's, else the engine's.
+  std::optional<ShaderSpec> shader;
+
+  /// ambient, or half the colour when unset.
+  std::array<float, 3> ambient_color() const {
+    return ambient ? *ambient
+                   : std::array<float, 3>{0.5f * color[0], 0.5f * color[1], 0.5f * color[2]};
+  }
 };
 
 /// Everything needed to create a rigid body.

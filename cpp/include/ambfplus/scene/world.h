@@ -76,6 +76,11 @@ class AMBFPLUS_API World {
   void set_gravity(const Eigen::Vector3d& g);
   Eigen::Vector3d gravity() const;
 
+  /// The shader of bodies whose model and material name none (AMBF's world `shaders`); unset:
+  /// the engine's own.
+  const std::optional<ShaderSpec>& shader() const { return shader_; }
+  void set_shader(std::optional<ShaderSpec> shader) { shader_ = std::move(shader); }
+
   /// The plugins of this world, its simulator, models and objects (cpp/README.md, "Plugins").
   PluginRegistry& plugins();
   /// Calls every plugin's reset(). There is no scene reset yet: only plugins are reset.
@@ -113,6 +118,7 @@ class AMBFPLUS_API World {
   std::unique_ptr<PluginRegistry> plugins_;
   std::int64_t graphics_step_ = -1;     // the step of the last graphics update
   std::uint64_t objects_revision_ = 0;  // counts objects added and models removed
+  std::optional<ShaderSpec> shader_;
 };
 
 template <typename T>

@@ -351,6 +351,7 @@ BodyPlan plan_body(const Doc& doc, const std::string& model_hr, const std::strin
   }
   s.material = material(doc, id, b, ctx);
   s.material.shader = read_shader(doc, b["shaders"], id, "shaders", ctx);
+  if (b["visible"]) s.material.visible = boolean(doc, b["visible"], id, "visible");
   plan.plugins = read_plugins(doc, b["plugins"], id);
   return plan;
 }
@@ -636,6 +637,7 @@ SoftBodySpec plan_soft_body(const Doc& doc, const std::string& model_lr,
                           "publish frequency",
                           "passive",
                           "shaders",
+                          "visible",
                           "plugins"});
   SoftBodySpec s;
   s.name = block_name(doc, id, b);
@@ -683,6 +685,7 @@ SoftBodySpec plan_soft_body(const Doc& doc, const std::string& model_lr,
   }
   s.material = material(doc, id, b, ctx);
   s.material.shader = read_shader(doc, b["shaders"], id, "shaders", ctx);
+  if (b["visible"]) s.material.visible = boolean(doc, b["visible"], id, "visible");
   return s;
 }
 

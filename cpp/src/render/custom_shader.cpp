@@ -10,7 +10,6 @@
 
 #include "ambfplus/errors.h"
 #include "ambfplus/log.h"
-#include "ambfplus/scene/camera.h"
 #include "ambfplus/scene/model.h"
 #include "ambfplus/scene/world.h"
 #include "render/egl_context.h"
@@ -283,9 +282,13 @@ const UserShader* user_shader(const ShaderSpec& spec, const LightSet& lights) {
   return shaders.emplace(key, std::move(shader)).first->second.get();
 }
 
-ShaderOverlay::ShaderOverlay(const Camera& camera, const LightSet& lights, double time,
-                             GLenum attachment)
-    : camera_(camera), lights_(lights), time_(time) {
+ShaderOverlay::ShaderOverlay(const Eigen::Matrix4d& projection, int width, int height,
+                             const LightSet& lights, double time, GLenum attachment)
+    : projection_(projection.cast<float>()),
+      width_(width),
+      height_(height),
+      lights_(lights),
+      time_(time) {
   const GLenum buffers[1] = {attachment};
   glDrawBuffers(1, buffers);
   glDepthFunc(GL_GEQUAL);
@@ -309,13 +312,13 @@ void ShaderOverlay::begin(const UserShader& shader) {
   current_ = &shader;
   Program& program = *shader.program;
   program.use();
-  const Eigen::Matrix4f projection = camera_.projection().cast<float>();
+  const Eigen::Matrix4f& projection = projection_;
   if (shader.dialect == ShaderDialect::kModern) {
     glUniformMatrix4fv(program.uniform("u_projection"), 1, GL_FALSE, projection.data());
     glUniform1f(program.uniform("u_ambient"), 0.15f);
     glUniform1f(program.uniform("u_time"), static_cast<float>(time_));
-    glUniform2f(program.uniform("u_resolution"), static_cast<float>(camera_.width()),
-                static_cast<float>(camera_.height()));
+    glUniform2f(program.uniform("u_resolution"), static_cast<float>(width_),
+                static_cast<float>(height_));
     lights_.upload(program);
     return;
   }

@@ -9,7 +9,6 @@
 #include "render/gl_program.h"
 
 namespace ambfplus {
-class Camera;
 class Model;
 class World;
 }  // namespace ambfplus
@@ -53,7 +52,10 @@ const UserShader* user_shader(const ShaderSpec& spec, const LightSet& lights);
 /// pass's state when destroyed.
 class ShaderOverlay {
  public:
-  ShaderOverlay(const Camera& camera, const LightSet& lights, double time, GLenum attachment);
+  /// projection: clip from camera (OpenCV frame); lights in the camera frame; time: simulation
+  /// seconds (modern shaders' u_time).
+  ShaderOverlay(const Eigen::Matrix4d& projection, int width, int height, const LightSet& lights,
+                double time, GLenum attachment);
   ~ShaderOverlay();
   ShaderOverlay(const ShaderOverlay&) = delete;
   ShaderOverlay& operator=(const ShaderOverlay&) = delete;
@@ -65,7 +67,8 @@ class ShaderOverlay {
  private:
   void begin(const UserShader& shader);
 
-  const Camera& camera_;
+  Eigen::Matrix4f projection_;
+  int width_, height_;
   const LightSet& lights_;
   double time_;
   const UserShader* current_ = nullptr;

@@ -20,6 +20,10 @@ constexpr float kAmbient = 0.15f;
 
 Eigen::Matrix4f to_float(const Eigen::Matrix4d& m) { return m.cast<float>(); }
 
+std::optional<ShaderSpec> copy_of(const ShaderSpec* spec) {
+  return spec != nullptr ? std::optional<ShaderSpec>(*spec) : std::nullopt;
+}
+
 }  // namespace
 
 SceneRenderer::SceneRenderer(World& world) : world_(world) {}
@@ -49,16 +53,79 @@ SceneRenderer::~SceneRenderer() {
   }
 }
 
-const VolumeUpload* SceneRenderer::last_upload(const VolumeData* data) const {
+std::optional<VolumeUpload> SceneRenderer::last_upload(const VolumeData* data) const {
+  std::lock_guard<std::mutex> lock(volumes_mutex_);
   auto it = volumes_.find(data);
-  return it == volumes_.end() ? nullptr : &it->second->last_upload();
+  if (it == volumes_.end()) return std::nullopt;
+  return it->second->last_upload();
 }
 
-GpuMesh& SceneRenderer::mesh_for(const MeshData* mesh) {
+void SceneRenderer::render(const Camera& camera, const CaptureBuffers& buffers, Frame& frame) {
+  Snapshot snapshot;
+  {
+    auto lock = world_.lock_state();
+    world_.graphics_update();
+    take(camera, buffers.passes(), snapshot);
+    frame.width = camera.width();
+    frame.height = camera.height();
+    frame.time = world_.time();
+    frame.step = world_.step_index();
+    frame.camera = camera.name();
+    frame.intrinsics = camera.intrinsics();
+    frame.pose = camera.pose().matrix();
+  }
+  Context::Scope scope;
+  draw(snapshot);
+  read(snapshot, buffers);
+}
+
+void SceneRenderer::take(const Camera& camera, unsigned passes, Snapshot& s) {
+  s.camera_id = camera.id();
+  s.camera_name = camera.name();
+  s.width = camera.width();
+  s.height = camera.height();
+  s.camera_pose = camera.pose();
+  s.projection = camera.projection();
+  s.background = camera.background();
+  s.preprocessing = camera.preprocessing_shader();
+  s.passes = passes;
+  s.time = world_.time();
+  s.lights.emplace(world_, camera.pose().inverse());
+  for (const RigidBody* body : world_.objects_of_kind<RigidBody>()) {
+    if (body->visual_mesh()->indices.empty() || !body->material().visible) continue;
+    s.bodies.push_back({body->visual_mesh(), body->pose(), body->material(),
+                        copy_of(effective_shader(body->material(), body->model(), world_)),
+                        body->id()});
+  }
+  for (const SoftBody* body : world_.objects_of_kind<SoftBody>()) {
+    if (!body->material().visible) continue;
+    const std::vector<double>& x = body->node_positions();
+    Snapshot::Soft soft{body->id(), std::vector<float>(x.begin(), x.end()), &body->triangles(),
+                        body->material(),
+                        copy_of(effective_shader(body->material(), body->model(), world_))};
+    s.softs.push_back(std::move(soft));
+  }
+  for (const Volume* volume : world_.objects_of_kind<Volume>()) {
+    GpuVolume* gpu = nullptr;
+    {
+      std::lock_guard<std::mutex> lock(volumes_mutex_);
+      auto& slot = volumes_[volume->data().get()];
+      if (!slot) slot = std::make_unique<GpuVolume>(volume->data());
+      gpu = slot.get();
+    }
+    gpu->stage(volume->iso());
+    s.volumes.push_back({gpu, volume->pose(), volume->iso(), volume->specular(),
+                         volume->shininess(), volume->id(), volume->empty_space_skipping()});
+  }
+}
+
+GpuMesh& SceneRenderer::mesh_for(const std::shared_ptr<const MeshData>& source) {
+  const MeshData* mesh = source.get();
   auto it = meshes_.find(mesh);
   if (it != meshes_.end()) return it->second;
   GpuMesh g;
   g.position_size = mesh->position_size;
+  g.source = source;
   glGenVertexArrays(1, &g.vao);
   glGenBuffers(3, g.buffers);
   glBindVertexArray(g.vao);
@@ -81,19 +148,17 @@ GpuMesh& SceneRenderer::mesh_for(const MeshData* mesh) {
   return meshes_.emplace(mesh, g).first->second;
 }
 
-GpuMesh& SceneRenderer::soft_mesh_for(const SoftBody& body) {
-  const std::vector<double>& x = body.node_positions();
-  const std::vector<std::uint32_t>& tri = body.triangles();
+GpuMesh& SceneRenderer::soft_mesh_for(const Snapshot::Soft& soft) {
+  const std::vector<float>& x = soft.positions;
+  const std::vector<std::uint32_t>& tri = *soft.triangles;
   const std::size_t n = x.size() / 3;
   // Smooth normals: each node's triangles' normals weighted by their area.
-  soft_scratch_.assign(6 * n, 0.0f);
-  float* positions = soft_scratch_.data();
-  float* normals = positions + 3 * n;
-  for (std::size_t i = 0; i < 3 * n; ++i) positions[i] = static_cast<float>(x[i]);
+  soft_scratch_.assign(3 * n, 0.0f);
+  float* normals = soft_scratch_.data();
   for (std::size_t t = 0; t < tri.size(); t += 3) {
-    const Eigen::Vector3d a(x.data() + 3 * tri[t]), b(x.data() + 3 * tri[t + 1]),
+    const Eigen::Vector3f a(x.data() + 3 * tri[t]), b(x.data() + 3 * tri[t + 1]),
         c(x.data() + 3 * tri[t + 2]);
-    const Eigen::Vector3f area_normal = (b - a).cross(c - a).cast<float>();
+    const Eigen::Vector3f area_normal = (b - a).cross(c - a);
     for (int k = 0; k < 3; ++k) {
       Eigen::Map<Eigen::Vector3f>(normals + 3 * tri[t + k]) += area_normal;
     }
@@ -104,7 +169,7 @@ GpuMesh& SceneRenderer::soft_mesh_for(const SoftBody& body) {
     if (length > 0) v /= length;
   }
 
-  auto it = soft_meshes_.find(body.id());
+  auto it = soft_meshes_.find(soft.id);
   if (it == soft_meshes_.end()) {
     GpuMesh g;
     glGenVertexArrays(1, &g.vao);
@@ -123,11 +188,11 @@ GpuMesh& SceneRenderer::soft_mesh_for(const SoftBody& body) {
                  GL_STATIC_DRAW);
     glBindVertexArray(0);
     g.index_count = static_cast<GLsizei>(tri.size());
-    it = soft_meshes_.emplace(body.id(), g).first;
+    it = soft_meshes_.emplace(soft.id, g).first;
   }
   const GpuMesh& g = it->second;
   glBindBuffer(GL_ARRAY_BUFFER, g.buffers[0]);
-  glBufferSubData(GL_ARRAY_BUFFER, 0, 3 * n * sizeof(float), positions);
+  glBufferSubData(GL_ARRAY_BUFFER, 0, 3 * n * sizeof(float), x.data());
   glBindBuffer(GL_ARRAY_BUFFER, g.buffers[1]);
   glBufferSubData(GL_ARRAY_BUFFER, 0, 3 * n * sizeof(float), normals);
   glBindBuffer(GL_ARRAY_BUFFER, 0);
@@ -135,12 +200,12 @@ GpuMesh& SceneRenderer::soft_mesh_for(const SoftBody& body) {
   return it->second;
 }
 
-RenderTarget& SceneRenderer::target_for(const Camera& camera) {
-  auto it = targets_.find(camera.id());
+RenderTarget& SceneRenderer::target_for(const Snapshot& snapshot) {
+  auto it = targets_.find(snapshot.camera_id);
   if (it != targets_.end()) return it->second;
   RenderTarget t;
-  t.width = camera.width();
-  t.height = camera.height();
+  t.width = snapshot.width;
+  t.height = snapshot.height;
   glGenFramebuffers(1, &t.framebuffer);
   glGenRenderbuffers(RenderTarget::kBuffers, t.renderbuffers);
   const GLenum formats[RenderTarget::kBuffers] = {
@@ -158,23 +223,24 @@ RenderTarget& SceneRenderer::target_for(const Camera& camera) {
   if (status != GL_FRAMEBUFFER_COMPLETE) {
     glDeleteFramebuffers(1, &t.framebuffer);
     glDeleteRenderbuffers(RenderTarget::kBuffers, t.renderbuffers);
-    throw RenderError("camera '" + camera.name() + "': off-screen framebuffer of " +
+    throw RenderError("camera '" + snapshot.camera_name + "': off-screen framebuffer of " +
                       std::to_string(t.width) + "x" + std::to_string(t.height) +
                       " is incomplete (status 0x" + std::to_string(status) + ")");
   }
   check_gl("creating a render target");
-  return targets_.emplace(camera.id(), t).first->second;
+  return targets_.emplace(snapshot.camera_id, t).first->second;
 }
 
-void SceneRenderer::draw(const Camera& camera, unsigned passes) {
-  Context::Scope scope;
-  const Eigen::Isometry3d camera_from_world = camera.pose().inverse();
-  const LightSet lights(world_, camera_from_world);
+void SceneRenderer::draw(const Snapshot& s) {
+  const unsigned passes = s.passes;
+  const Eigen::Isometry3d camera_from_world = s.camera_pose.inverse();
+  const LightSet& lights = *s.lights;
+  for (const Snapshot::Volume& v : s.volumes) v.gpu->upload();
   // Shading is the costly part: without an rgb pass the shaders skip it.
   const std::string defines =
       lights.defines() + ((passes & kPassRgb) ? "#define SHADE 1\n" : "#define SHADE 0\n");
   Program& program = Context::get().program("mesh.vert", "mesh.frag", defines);
-  RenderTarget& target = target_for(camera);
+  RenderTarget& target = target_for(s);
 
   glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
   // Only the passes asked for are written (pass i on attachment i).
@@ -194,8 +260,7 @@ void SceneRenderer::draw(const Camera& camera, unsigned passes) {
   glDisable(GL_BLEND);
   // Our projection flips image y relative to GL's window y, so visible fronts wind clockwise.
   glFrontFace(GL_CW);
-  const auto& bg = camera.background();
-  const GLfloat clear_color[4] = {bg[0], bg[1], bg[2], 1.0f};
+  const GLfloat clear_color[4] = {s.background[0], s.background[1], s.background[2], 1.0f};
   const GLfloat clear_depth_image[4] = {0, 0, 0, 0};
   const GLfloat clear_depth = 0.0f;
   glClearBufferfv(GL_COLOR, 0, clear_color);
@@ -210,7 +275,7 @@ void SceneRenderer::draw(const Camera& camera, unsigned passes) {
   glClearBufferfv(GL_DEPTH, 0, &clear_depth);
 
   program.use();
-  const Eigen::Matrix4f projection = to_float(camera.projection());
+  const Eigen::Matrix4f projection = to_float(s.projection);
   glUniformMatrix4fv(program.uniform("u_projection"), 1, GL_FALSE, projection.data());
   glUniform1f(program.uniform("u_ambient"), kAmbient);
   lights.upload(program);
@@ -240,68 +305,53 @@ void SceneRenderer::draw(const Camera& camera, unsigned passes) {
     glBindVertexArray(mesh.vao);
     glDrawElements(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr);
   };
-  for (const RigidBody* body : world_.objects_of_kind<RigidBody>()) {
-    if (body->visual_mesh()->indices.empty()) continue;  // an anchor without geometry
+  for (const Snapshot::Body& body : s.bodies) {
     // Composed in double, then rounded once, to keep depth exact far from the origin.
-    draw(mesh_for(body->visual_mesh().get()), camera_from_world * body->pose(), body->material(),
-         body->id());
+    draw(mesh_for(body.mesh), camera_from_world * body.pose, body.material, body.id);
   }
   // Soft bodies: their nodes are in the world frame.
-  for (const SoftBody* body : world_.objects_of_kind<SoftBody>()) {
-    draw(soft_mesh_for(*body), camera_from_world, body->material(), body->id());
+  for (const Snapshot::Soft& soft : s.softs) {
+    draw(soft_mesh_for(soft), camera_from_world, soft.material, soft.id);
   }
   glBindVertexArray(0);
   // Volumes after the meshes: their rays write depth, so each pixel keeps the nearer surface.
-  for (const Volume* volume : world_.objects_of_kind<Volume>()) {
-    auto& gpu = volumes_[volume->data().get()];
-    if (!gpu) gpu = std::make_unique<GpuVolume>(volume->data());
-    gpu->sync(volume->iso());
-    gpu->draw(*volume, camera, camera_from_world, lights, passes);
-  }
+  for (const Snapshot::Volume& v : s.volumes) v.gpu->draw(v, s);
   // Users' shaders colour their meshes; the camera's preprocessing shader its segmentation.
   if (passes & kPassRgb) {
-    overlay(
-        camera, camera_from_world, lights, GL_COLOR_ATTACHMENT0,
-        [&](const Material& m, const Model& model) { return effective_shader(m, model, world_); });
+    overlay(s, GL_COLOR_ATTACHMENT0, [](const Material&, const std::optional<ShaderSpec>& own) {
+      return own ? &*own : nullptr;
+    });
   }
-  const auto& preprocessing = camera.preprocessing_shader();
-  if ((passes & kPassSegmentation) && preprocessing && !preprocessing->builtin()) {
-    overlay(camera, camera_from_world, lights, GL_COLOR_ATTACHMENT5,
-            [&](const Material&, const Model&) { return &*preprocessing; });
+  if ((passes & kPassSegmentation) && s.preprocessing && !s.preprocessing->builtin()) {
+    overlay(s, GL_COLOR_ATTACHMENT5,
+            [&](const Material&, const std::optional<ShaderSpec>&) { return &*s.preprocessing; });
   }
   check_gl("drawing the scene");
 }
 
 template <typename ShaderOf>
-void SceneRenderer::overlay(const Camera& camera, const Eigen::Isometry3d& camera_from_world,
-                            const LightSet& lights, GLenum attachment, ShaderOf shader_of) {
-  std::optional<ShaderOverlay> pass;  // begun at the first mesh that has a shader that runs
-  auto draw = [&](const Material& m, const Model& model, auto&& mesh, const Eigen::Isometry3d& mv,
-                  int id) {
-    const ShaderSpec* spec = shader_of(m, model);
-    const UserShader* shader = spec != nullptr ? user_shader(*spec, lights) : nullptr;
+void SceneRenderer::overlay(const Snapshot& s, GLenum attachment, ShaderOf shader_of) {
+  const Eigen::Isometry3d camera_from_world = s.camera_pose.inverse();
+  std::optional<ShaderOverlay> pass;  // begun at the first mesh whose shader runs
+  auto draw = [&](const Material& m, const std::optional<ShaderSpec>& own, GpuMesh& mesh,
+                  const Eigen::Isometry3d& mv, int id) {
+    const ShaderSpec* spec = shader_of(m, own);
+    const UserShader* shader = spec != nullptr ? user_shader(*spec, *s.lights) : nullptr;
     if (shader == nullptr) return;
-    if (!pass) pass.emplace(camera, lights, world_.time(), attachment);
-    pass->draw(*shader, mesh(), mv, m, id);
+    if (!pass) pass.emplace(s.projection, s.width, s.height, *s.lights, s.time, attachment);
+    pass->draw(*shader, mesh, mv, m, id);
   };
-  for (const RigidBody* body : world_.objects_of_kind<RigidBody>()) {
-    if (body->visual_mesh()->indices.empty()) continue;
-    draw(
-        body->material(), body->model(),
-        [&]() -> GpuMesh& { return mesh_for(body->visual_mesh().get()); },
-        camera_from_world * body->pose(), body->id());
+  for (const Snapshot::Body& body : s.bodies) {
+    draw(body.material, body.shader, mesh_for(body.mesh), camera_from_world * body.pose, body.id);
   }
-  for (const SoftBody* body : world_.objects_of_kind<SoftBody>()) {
+  for (const Snapshot::Soft& soft : s.softs) {
     // Its nodes were uploaded by the main pass of this draw.
-    draw(
-        body->material(), body->model(), [&]() -> GpuMesh& { return soft_meshes_.at(body->id()); },
-        camera_from_world, body->id());
+    draw(soft.material, soft.shader, soft_meshes_.at(soft.id), camera_from_world, soft.id);
   }
 }
 
-void SceneRenderer::read(const Camera& camera, const CaptureBuffers& buffers) {
-  Context::Scope scope;
-  RenderTarget& target = target_for(camera);
+void SceneRenderer::read(const Snapshot& s, const CaptureBuffers& buffers) {
+  RenderTarget& target = target_for(s);
   glBindFramebuffer(GL_READ_FRAMEBUFFER, target.framebuffer);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
   glPixelStorei(GL_PACK_ROW_LENGTH, 0);
@@ -322,12 +372,6 @@ void SceneRenderer::read(const Camera& camera, const CaptureBuffers& buffers) {
                  images[i].data);
   }
   check_gl("reading back a capture");
-}
-
-void SceneRenderer::render(const Camera& camera, const CaptureBuffers& buffers) {
-  Context::Scope scope;
-  draw(camera, buffers.passes());
-  read(camera, buffers);
 }
 
 }  // namespace ambfplus::render

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
+#include <cstring>
 
 #include "ambfplus/render/render_stats.h"
 #include "ambfplus/scene/world.h"
@@ -62,22 +63,33 @@ GLuint make_texture_3d(GLenum filter, GLenum wrap) {
   return t;
 }
 
-// Sends box of a grid stored i fastest with `shape` to a 3D texture, reading it in place.
-void upload_sub_box(GLuint texture, const VoxelBox& box, const std::array<int, 3>& shape,
-                    GLenum format, GLenum type, const void* data) {
+// Copies box of a grid stored i fastest with `shape` (element size `bytes`), packed.
+std::vector<std::uint8_t> pack_box(const void* grid, const std::array<int, 3>& shape,
+                                   const VoxelBox& box, int bytes) {
+  const auto* src = static_cast<const std::uint8_t*>(grid);
+  const std::size_t row = static_cast<std::size_t>(box.hi[0] - box.lo[0]) * bytes;
+  std::vector<std::uint8_t> out(row * (box.hi[1] - box.lo[1]) * (box.hi[2] - box.lo[2]));
+  std::uint8_t* dst = out.data();
+  for (int k = box.lo[2]; k < box.hi[2]; ++k) {
+    for (int j = box.lo[1]; j < box.hi[1]; ++j, dst += row) {
+      const std::size_t at =
+          (static_cast<std::size_t>(box.lo[0]) +
+           static_cast<std::size_t>(shape[0]) * (j + static_cast<std::size_t>(shape[1]) * k)) *
+          bytes;
+      std::memcpy(dst, src + at, row);
+    }
+  }
+  return out;
+}
+
+// Sends a packed box to a 3D texture.
+void upload_box(GLuint texture, const VoxelBox& box, GLenum format, GLenum type,
+                const std::vector<std::uint8_t>& bytes) {
+  if (box.empty()) return;
   glBindTexture(GL_TEXTURE_3D, texture);
   glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  glPixelStorei(GL_UNPACK_ROW_LENGTH, shape[0]);
-  glPixelStorei(GL_UNPACK_IMAGE_HEIGHT, shape[1]);
-  glPixelStorei(GL_UNPACK_SKIP_PIXELS, box.lo[0]);
-  glPixelStorei(GL_UNPACK_SKIP_ROWS, box.lo[1]);
-  glPixelStorei(GL_UNPACK_SKIP_IMAGES, box.lo[2]);
   glTexSubImage3D(GL_TEXTURE_3D, 0, box.lo[0], box.lo[1], box.lo[2], box.hi[0] - box.lo[0],
-                  box.hi[1] - box.lo[1], box.hi[2] - box.lo[2], format, type, data);
-  for (GLenum p : {GL_UNPACK_ROW_LENGTH, GL_UNPACK_IMAGE_HEIGHT, GL_UNPACK_SKIP_PIXELS,
-                   GL_UNPACK_SKIP_ROWS, GL_UNPACK_SKIP_IMAGES}) {
-    glPixelStorei(p, 0);
-  }
+                  box.hi[1] - box.lo[1], box.hi[2] - box.lo[2], format, type, bytes.data());
 }
 
 // The 36 corners of the unit cube's 12 triangles, counter-clockwise seen from outside.
@@ -92,7 +104,9 @@ const float kCube[] = {
 
 }  // namespace
 
-GpuVolume::GpuVolume(std::shared_ptr<VolumeData> data) : data_(std::move(data)) {
+GpuVolume::GpuVolume(std::shared_ptr<VolumeData> data) : data_(std::move(data)) {}
+
+void GpuVolume::create_textures() {
   const auto& n = data_->shape();
   occupancy_ = make_texture_3d(GL_LINEAR, GL_CLAMP_TO_BORDER);
   glTexImage3D(GL_TEXTURE_3D, 0, GL_R8, n[0], n[1], n[2], 0, GL_RED, GL_UNSIGNED_BYTE, nullptr);
@@ -120,42 +134,31 @@ GpuVolume::GpuVolume(std::shared_ptr<VolumeData> data) : data_(std::move(data)) 
 }
 
 GpuVolume::~GpuVolume() {
+  if (vao_ == 0) return;  // never uploaded
   const GLuint textures[4] = {occupancy_, labels_, bricks_, colors_};
   glDeleteTextures(4, textures);
   glDeleteBuffers(1, &vbo_);
   glDeleteVertexArrays(1, &vao_);
 }
 
-void GpuVolume::upload_box(const VoxelBox& box) {
-  const auto& n = data_->shape();
-  const bool wide = data_->label_type() == LabelType::kUInt16;
-  upload_sub_box(labels_, box, n, GL_RED_INTEGER, wide ? GL_UNSIGNED_SHORT : GL_UNSIGNED_BYTE,
-                 data_->label_data());
-  // The smoothed field changes kSmoothRadius voxels around every changed label.
-  upload_sub_box(occupancy_, box.grown(VolumeData::kSmoothRadius).clipped(n), n, GL_RED,
-                 GL_UNSIGNED_BYTE, data_->smoothed_occupancy().data());
-}
-
-void GpuVolume::upload_colors() {
+void GpuVolume::stage_colors(Pending& pending) {
   const LabelTable& table = data_->label_table();
-  if (table.labels().size() == uploaded_table_.size() &&
+  if (table.labels().size() == staged_table_.size() &&
       std::equal(
-          uploaded_table_.begin(), uploaded_table_.end(), table.labels().begin(),
+          staged_table_.begin(), staged_table_.end(), table.labels().begin(),
           [](const Label& a, const Label& b) { return a.id == b.id && a.color == b.color; })) {
     return;
   }
-  const int rows = table.max_id() / 256 + 1;
-  std::vector<std::uint8_t> rgba(static_cast<std::size_t>(rows) * 256 * 4, 255);
+  pending.color_rows = table.max_id() / 256 + 1;
+  pending.colors.assign(static_cast<std::size_t>(pending.color_rows) * 256 * 4, 255);
   for (const Label& l : table.labels()) {
-    for (int c = 0; c < 3; ++c) rgba[l.id * 4 + c] = l.color[c];
+    for (int c = 0; c < 3; ++c) pending.colors[l.id * 4 + c] = l.color[c];
   }
-  glBindTexture(GL_TEXTURE_2D, colors_);
-  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, 256, rows, 0, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
-  uploaded_table_ = table.labels();
+  staged_table_ = table.labels();
 }
 
-void GpuVolume::update_distances(const VoxelBox& changed, double level, bool full) {
+void GpuVolume::stage_distances(const VoxelBox& changed, double level, bool full,
+                                Pending& pending) {
   const std::vector<std::uint8_t>& max = data_->brick_max();
   const auto b = data_->brick_shape();
   constexpr int B = VolumeData::kBrickSize;
@@ -188,13 +191,14 @@ void GpuVolume::update_distances(const VoxelBox& changed, double level, bool ful
     distances_ = brick_distances(max, b, level);
     bricks = VoxelBox{{0, 0, 0}, b};
   }
-  upload_sub_box(bricks_, bricks, b, GL_RED_INTEGER, GL_UNSIGNED_BYTE, distances_.data());
+  pending.bricks = {bricks, pack_box(distances_.data(), b, bricks, 1)};
   brick_level_ = level;
 }
 
-void GpuVolume::sync(double iso) {
+void GpuVolume::stage(double iso) {
   const auto start = std::chrono::steady_clock::now();
-  upload_colors();
+  Pending pending;
+  stage_colors(pending);
   VoxelBox box;
   const bool first = revision_ < 0;
   const bool changed = first ? true : data_->dirty_since(revision_, &box);
@@ -202,26 +206,67 @@ void GpuVolume::sync(double iso) {
   // Bricks that may hold the surface: those whose largest value can reach the level (one step
   // of 8-bit filtering below it, so rounding never hides a surface).
   const double level = std::max(0.0, iso * 255.0 - 1.0);
-  if (changed && !box.empty()) upload_box(box);
-  if (level != brick_level_ || (changed && !box.empty())) {
-    update_distances(box, level, first || level != brick_level_);
+  const auto& n = data_->shape();
+  if (changed && !box.empty()) {
+    const int bytes = data_->label_type() == LabelType::kUInt16 ? 2 : 1;
+    pending.labels = {box, pack_box(data_->label_data(), n, box, bytes)};
+    // The smoothed field changes kSmoothRadius voxels around every changed label.
+    const VoxelBox grown = box.grown(VolumeData::kSmoothRadius).clipped(n);
+    pending.occupancy = {grown, pack_box(data_->smoothed_occupancy().data(), n, grown, 1)};
   }
-  check_gl("uploading a volume");
-  if (changed) {
-    last_upload_.full = first;
-    last_upload_.voxels = box.count();
-    last_upload_.seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (level != brick_level_ || (changed && !box.empty())) {
+    stage_distances(box, level, first || level != brick_level_, pending);
   }
   revision_ = data_->revision();
+  if (!changed && pending.colors.empty() && pending.bricks.box.empty()) return;
+  pending.full = first;
+  pending.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::lock_guard<std::mutex> lock(mutex_);
+  pending_.push_back(std::move(pending));
 }
 
-void GpuVolume::draw(const Volume& volume, const Camera& camera,
-                     const Eigen::Isometry3d& camera_from_world, const LightSet& lights,
-                     unsigned passes) {
+void GpuVolume::upload() {
+  std::vector<Pending> pending;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    pending.swap(pending_);
+  }
+  if (pending.empty()) return;
+  const auto start = std::chrono::steady_clock::now();
+  if (vao_ == 0) create_textures();
+  const bool wide = data_->label_type() == LabelType::kUInt16;
+  VolumeUpload stats;
+  for (const Pending& p : pending) {
+    if (!p.colors.empty()) {
+      glBindTexture(GL_TEXTURE_2D, colors_);
+      glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+      glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, 256, p.color_rows, 0, GL_RGBA, GL_UNSIGNED_BYTE,
+                   p.colors.data());
+    }
+    upload_box(labels_, p.labels.box, GL_RED_INTEGER, wide ? GL_UNSIGNED_SHORT : GL_UNSIGNED_BYTE,
+               p.labels.bytes);
+    upload_box(occupancy_, p.occupancy.box, GL_RED, GL_UNSIGNED_BYTE, p.occupancy.bytes);
+    upload_box(bricks_, p.bricks.box, GL_RED_INTEGER, GL_UNSIGNED_BYTE, p.bricks.bytes);
+    stats.full = stats.full || p.full;
+    stats.voxels += p.labels.box.count();
+    stats.seconds += p.seconds;
+  }
+  check_gl("uploading a volume");
+  stats.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::lock_guard<std::mutex> lock(mutex_);
+  last_upload_ = stats;
+}
+
+VolumeUpload GpuVolume::last_upload() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return last_upload_;
+}
+
+void GpuVolume::draw(const Snapshot::Volume& volume, const Snapshot& snapshot) {
+  const unsigned passes = snapshot.passes;
+  const LightSet& lights = *snapshot.lights;
   const std::string defines =
-      lights.defines() + "#define EMPTY_SPACE_SKIPPING " +
-      (volume.empty_space_skipping() ? "1" : "0") + "\n" +
+      lights.defines() + "#define EMPTY_SPACE_SKIPPING " + (volume.skipping ? "1" : "0") + "\n" +
       ((passes & kPassRgb) ? "#define SHADE 1\n" : "#define SHADE 0\n") +
       (std::getenv("AMBFPLUS_DEBUG_VOLUME_STEPS") ? "#define DEBUG_STEPS 1\n" : "");
   Program& program = Context::get().program("volume.vert", "volume.frag", defines);
@@ -231,8 +276,8 @@ void GpuVolume::draw(const Volume& volume, const Camera& camera,
   volume_from_voxel.topLeftCorner<3, 3>() = s.asDiagonal();
   volume_from_voxel.topRightCorner<3, 1>() = -data_->dimensions() / 2;
   const Eigen::Matrix4d camera_from_voxel =
-      camera_from_world.matrix() * volume.pose().matrix() * volume_from_voxel;
-  const Eigen::Matrix4d clip_from_voxel = camera.projection() * camera_from_voxel;
+      snapshot.camera_pose.inverse().matrix() * volume.pose.matrix() * volume_from_voxel;
+  const Eigen::Matrix4d clip_from_voxel = snapshot.projection * camera_from_voxel;
   const Eigen::Vector3d eye = (camera_from_voxel.inverse() * Eigen::Vector4d(0, 0, 0, 1)).head<3>();
   const Eigen::Matrix3d normal_from_voxel =
       camera_from_voxel.topLeftCorner<3, 3>().inverse().transpose();
@@ -245,12 +290,12 @@ void GpuVolume::draw(const Volume& volume, const Camera& camera,
   glUniformMatrix4fv(program.uniform("u_clip_from_voxel"), 1, GL_FALSE, clip_f.data());
   glUniformMatrix4fv(program.uniform("u_camera_from_voxel"), 1, GL_FALSE, camera_f.data());
   glUniformMatrix3fv(program.uniform("u_normal_from_voxel"), 1, GL_FALSE, normal_f.data());
-  glUniform1f(program.uniform("u_level"), static_cast<float>(volume.iso()));
+  glUniform1f(program.uniform("u_level"), static_cast<float>(volume.iso));
   glUniform1i(program.uniform("u_brick_size"), VolumeData::kBrickSize);
   glUniform1f(program.uniform("u_ambient"), 0.2f);
-  glUniform1f(program.uniform("u_specular"), volume.specular());
-  glUniform1f(program.uniform("u_shininess"), volume.shininess());
-  glUniform1i(program.uniform("u_instance"), volume.id());
+  glUniform1f(program.uniform("u_specular"), volume.specular);
+  glUniform1f(program.uniform("u_shininess"), volume.shininess);
+  glUniform1i(program.uniform("u_instance"), volume.id);
   lights.upload(program);
   const struct {
     const char* name;
@@ -282,8 +327,8 @@ namespace ambfplus {
 
 VolumeUploadStats last_volume_upload(const Volume& volume) {
   VolumeUploadStats stats;
-  const auto* upload = volume.world().renderer().last_upload(volume.data().get());
-  if (upload == nullptr) return stats;
+  const auto upload = volume.world().renderer().last_upload(volume.data().get());
+  if (!upload) return stats;
   stats.rendered = true;
   stats.full = upload->full;
   stats.voxels = upload->voxels;

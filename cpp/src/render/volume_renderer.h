@@ -5,12 +5,13 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <vector>
 
-#include "ambfplus/scene/camera.h"
 #include "ambfplus/scene/volume.h"
 #include "render/gl_program.h"
 #include "render/light_set.h"
+#include "render/scene_renderer.h"
 
 namespace ambfplus::render {
 
@@ -19,16 +20,18 @@ namespace ambfplus::render {
 std::vector<std::uint8_t> brick_distances(const std::vector<std::uint8_t>& brick_max,
                                           const std::array<int, 3>& shape, double level);
 
-/// What the last sync of a volume sent to the GPU.
+/// What the last upload of a volume sent to the GPU.
 struct VolumeUpload {
   bool full = false;
   std::int64_t voxels = 0;  ///< label voxels uploaded
-  double seconds = 0.0;     ///< wall time of the sync, derived fields included
+  double seconds = 0.0;     ///< wall time of staging and upload, derived fields included
 };
 
 /// The GPU copies of one VolumeData (smoothed occupancy, labels, brick distances, label colours),
-/// brought up to date by uploading only the box edited since the last sync. Needs a current
-/// context in every call.
+/// brought up to date with only the box edited since the last update. Updating has two halves:
+/// stage() copies what changed out of the data while the world's state lock is held (no GL),
+/// upload() sends everything staged so far (needs a current context), so a physics thread may
+/// edit the data while the GPU works. draw() too needs a current context.
 class GpuVolume {
  public:
   explicit GpuVolume(std::shared_ptr<VolumeData> data);
@@ -36,25 +39,42 @@ class GpuVolume {
   GpuVolume(const GpuVolume&) = delete;
   GpuVolume& operator=(const GpuVolume&) = delete;
 
-  /// Uploads what changed since the last sync (everything the first time).
-  void sync(double iso);
-  /// Ray casts the volume into the bound framebuffer (after the meshes, depth-tested).
-  /// Ray casts the volume for the CapturePass bits asked for (shading only with rgb).
-  void draw(const Volume& volume, const Camera& camera, const Eigen::Isometry3d& camera_from_world,
-            const LightSet& lights, unsigned passes);
-  const VolumeUpload& last_upload() const { return last_upload_; }
+  /// Copies what changed since the last stage (everything the first time) for upload().
+  void stage(double iso);
+  /// Sends what was staged to the GPU (creating the textures the first time).
+  void upload();
+  /// Ray casts a snapshot's volume into the bound framebuffer, after the meshes and
+  /// depth-tested, for the snapshot's passes (shading only with rgb).
+  void draw(const Snapshot::Volume& volume, const Snapshot& snapshot);
+  VolumeUpload last_upload() const;
 
  private:
-  void upload_box(const VoxelBox& box);
-  void update_distances(const VoxelBox& changed, double level, bool full);
-  void upload_colors();
+  // A box of a grid, packed (i fastest), waiting for upload().
+  struct Box {
+    VoxelBox box;
+    std::vector<std::uint8_t> bytes;
+  };
+  struct Pending {
+    Box labels, occupancy, bricks;
+    std::vector<std::uint8_t> colors;  // RGBA rows of 256 label ids; empty: unchanged
+    int color_rows = 0;
+    bool full = false;
+    double seconds = 0.0;  // staging time
+  };
+  void stage_distances(const VoxelBox& changed, double level, bool full, Pending& pending);
+  void stage_colors(Pending& pending);
+  void create_textures();
 
   std::shared_ptr<VolumeData> data_;
   GLuint occupancy_ = 0, labels_ = 0, bricks_ = 0, colors_ = 0, vao_ = 0, vbo_ = 0;
+  // Staging state (touched under the world's state lock only).
   std::int64_t revision_ = -1;
   double brick_level_ = -1;
-  std::vector<std::uint8_t> distances_;  // what the brick texture holds
-  std::vector<Label> uploaded_table_;
+  std::vector<std::uint8_t> distances_;  // the brick distances last staged
+  std::vector<Label> staged_table_;
+  // Handed from stage() to upload(), which may run on different threads.
+  mutable std::mutex mutex_;
+  std::vector<Pending> pending_;
   VolumeUpload last_upload_;
 };
 

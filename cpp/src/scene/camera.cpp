@@ -146,15 +146,7 @@ void Camera::capture(Frame& frame) {
 }
 
 void Camera::capture(const CaptureBuffers& buffers, Frame& frame) {
-  World& w = world();
-  w.renderer().render(*this, buffers);
-  frame.width = width_;
-  frame.height = height_;
-  frame.time = w.time();
-  frame.step = w.step_index();
-  frame.camera = name();
-  frame.intrinsics = intrinsics();
-  frame.pose = pose().matrix();
+  world().renderer().render(*this, buffers, frame);
 }
 
 }  // namespace ambfplus

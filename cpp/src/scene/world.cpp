@@ -158,11 +158,14 @@ void World::register_object(Object* object) {
 
 void World::step(std::int64_t n) {
   if (n < 0) throw std::invalid_argument("step count must be >= 0, got " + std::to_string(n));
+  auto lock = lock_state();  // the lists below, then one step at a time
   std::vector<Drill*> drills = objects_of_kind<Drill>();
   std::vector<ProximitySensor*> sensors = objects_of_kind<ProximitySensor>();
   std::vector<ConstraintActuator*> actuators = objects_of_kind<ConstraintActuator>();
   std::uint64_t listed = objects_revision_;
+  lock.unlock();
   for (std::int64_t s = 0; s < n; ++s) {
+    auto lock = lock_state();
     ++step_index_;
     physics_->step(time_step_);
     for (Drill* d : drills) d->tick(time_step_, step_index_);
@@ -186,12 +189,17 @@ PluginRegistry& World::plugins() { return *plugins_; }
 void World::reset_plugins() { plugins_->reset(); }
 
 render::SceneRenderer& World::renderer() {
+  auto lock = lock_state();
+  if (!renderer_) renderer_ = std::make_unique<render::SceneRenderer>(*this);
+  return *renderer_;
+}
+
+void World::graphics_update() {
+  auto lock = lock_state();
   if (graphics_step_ != step_index_) {
     graphics_step_ = step_index_;
     plugins_->graphics_update();
   }
-  if (!renderer_) renderer_ = std::make_unique<render::SceneRenderer>(*this);
-  return *renderer_;
 }
 
 }  // namespace ambfplus

@@ -93,6 +93,8 @@ struct AMBFPLUS_API Material {
   std::optional<std::array<float, 3>> ambient;
   /// The shader drawing this surface; unset: the model's, else the world's, else the engine's.
   std::optional<ShaderSpec> shader;
+  /// Drawn by cameras (AMBF's `visible`); hidden surfaces still collide.
+  bool visible = true;
 
   /// ambient, or half the colour when unset.
   std::array<float, 3> ambient_color() const {

@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -86,9 +87,18 @@ class AMBFPLUS_API World {
   /// Calls every plugin's reset(). There is no scene reset yet: only plugins are reset.
   void reset_plugins();
 
-  /// The world's renderer (created on first use; internal to the engine). Every camera render
-  /// starts here, so it also gives plugins their graphics update (once per step).
+  /// Serialises changes to the scene with reads of it from other threads: each step runs under
+  /// it (a real-time loop's physics thread steps while cameras capture from others), and a
+  /// capture copies what it draws under it. Recursive; hold it briefly.
+  std::unique_lock<std::recursive_mutex> lock_state() const {
+    return std::unique_lock<std::recursive_mutex>(state_mutex_);
+  }
+
+  /// The world's renderer (created on first use; internal to the engine).
   render::SceneRenderer& renderer();
+  /// Gives plugins their graphics update, once per step; every render calls it first, under
+  /// lock_state() (internal to the engine).
+  void graphics_update();
   /// The world's physics (internal to the engine).
   physics::PhysicsWorld& physics() { return *physics_; }
 
@@ -119,6 +129,7 @@ class AMBFPLUS_API World {
   std::int64_t graphics_step_ = -1;     // the step of the last graphics update
   std::uint64_t objects_revision_ = 0;  // counts objects added and models removed
   std::optional<ShaderSpec> shader_;
+  mutable std::recursive_mutex state_mutex_;
 };
 
 template <typename T>

@@ -27,7 +27,9 @@ void register_plugin(pybind11::module_& m);
 namespace ambfplus {
 class Camera;
 class ConstraintActuator;
+class Device;
 class Drill;
+class InputDevice;
 class Joint;
 class RigidBody;
 struct RigidBodySpec;
@@ -76,6 +78,16 @@ void apply_body_options(RigidBodySpec& spec, const pybind11::kwargs& kw);
 /// add_joint(name, parent, child, type, **options) for World and Model.
 Joint& add_joint(Model& model, const std::string& name, RigidBody& parent, RigidBody& child,
                  const std::string& type, const pybind11::kwargs& kw);
+
+/// add_input_device(name, device, drill, **options) for World and Model.
+InputDevice& add_input_device(Model& model, const std::string& name,
+                              const std::shared_ptr<Device>& device, Drill& drill,
+                              const pybind11::kwargs& kw);
+/// The devices, InputDevice's methods and the real-time loop.
+void register_devices(pybind11::module_& m,
+                      pybind11::class_<InputDevice, Object, std::shared_ptr<InputDevice>>& input);
+/// A context manager holding the world's state lock for a `with` block.
+pybind11::object state_lock(World& world);
 
 /// add_drill(name, volume, **options) for World and Model.
 Drill& add_drill(Model& model, const std::string& name, Volume& volume, const pybind11::kwargs& kw);

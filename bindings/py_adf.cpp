@@ -193,10 +193,12 @@ void register_adf(py::module_& m) {
           [load_launch_into](const Path& path, std::optional<std::vector<int>> models,
                              const std::vector<Path>& extra, const std::vector<int>& devices,
                              bool strict, bool load_world, const std::string& prefix,
-                             double time_step, const std::vector<std::string>& plugins) {
+                             double time_step, const std::vector<std::string>& plugins,
+                             const std::vector<std::string>& arguments) {
             SimulatorOptions options;
             options.time_step = time_step;
             auto sim = Simulator::create(options);
+            sim->set_arguments(arguments);
             auto report = load_launch_into(sim->world(), path, std::move(models), extra, devices,
                                            strict, load_world, prefix, plugins);
             sim->set_load_report(report);
@@ -206,7 +208,15 @@ void register_adf(py::module_& m) {
           py::arg("devices") = std::vector<int>{}, py::arg("strict") = false,
           py::arg("load_world") = true, py::arg("namespace_prefix") = "",
           py::arg("time_step") = 0.001, py::arg("plugins") = std::vector<std::string>{},
-          (std::string(launch_doc) + " Returns a new simulator; see its load_report.").c_str())
+          py::arg("arguments") = std::vector<std::string>{},
+          (std::string(launch_doc) +
+           " arguments: command-line arguments for simulator plugins (AMBF forwards those it "
+           "does not know; Simulator.arguments). Returns a new simulator; see its load_report.")
+              .c_str())
+      .def_property(
+          "arguments", [](Simulator& s) { return s.arguments(); },
+          [](Simulator& s, std::vector<std::string> a) { s.set_arguments(std::move(a)); },
+          "command-line arguments for simulator plugins (set before they load)")
       .def_property_readonly(
           "load_report",
           [](Simulator& s) -> py::object {

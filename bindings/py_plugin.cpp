@@ -241,7 +241,7 @@ py::object load(World& world, const py::object& plugin, const PluginSite& site,
       // Defined where Python keeps no file (an interactive session).
     }
     py::gil_scoped_release release;
-    loaded = world.plugins().attach(adapter, name.value_or(type), file, site);
+    loaded = world.plugins().attach(adapter, name.value_or(type), file, site, /*native=*/false);
   }
   if (loaded == nullptr) return py::none();
   return py::cast(info(world, *loaded));

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "ambfplus/adf/volume_adf.h"
+#include "ambfplus/haptics/device.h"
 #include "ambfplus/render/render_stats.h"
 #include "ambfplus/scene/simulator.h"
 #include "bindings.h"
@@ -37,6 +38,8 @@ py::object to_python(Object* o) {
       return py::cast(handle(static_cast<ProximitySensor*>(o), w));
     case ObjectKind::kActuator:
       return py::cast(handle(static_cast<ConstraintActuator*>(o), w));
+    case ObjectKind::kInputDevice:
+      return py::cast(handle(static_cast<InputDevice*>(o), w));
   }
   return py::cast(handle(o, w));
 }
@@ -293,6 +296,18 @@ void def_adders(Class& cls, GetModel get_model) {
           "static_friction, dynamic_friction, removal ('physical' or 'compatible'), "
           "cutting_rate (m^3/(s N)), voxels_per_step, pose (initial goal, 4x4).")
       .def(
+          "add_input_device",
+          [get_model](typename Class::type& self, const std::string& name,
+                      const std::shared_ptr<Device>& device, Drill& drill, const py::kwargs& kw) {
+            Model& model = get_model(self);
+            return handle(&add_input_device(model, name, device, drill, kw), model.world());
+          },
+          py::arg("name"), py::arg("device"), py::arg("drill"),
+          "Binds a device to a drill. Options: workspace_scale (world m per device m), reference "
+          "(an object, e.g. a camera, whose axes device motion follows: x right, y up, z towards "
+          "the viewer), drill_button (0), clutch_button (1), burr_button (-1: none), max_force "
+          "(N), force_scale.")
+      .def(
           "add_soft_body",
           [get_model](typename Class::type& self, const std::string& name,
                       const std::filesystem::path& mesh, const py::kwargs& kw) {
@@ -365,6 +380,12 @@ void register_scene(py::module_& m) {
   py::class_<Drill, Object, std::shared_ptr<Drill>> drill(
       m, "Drill", "A burr and shaft of finger-proxy cursors that drills a volume.");
   register_haptics(m, drill);
+  py::class_<InputDevice, Object, std::shared_ptr<InputDevice>> input(
+      m, "InputDevice",
+      "A device bound to a drill: its motion moves the drill's goal (workspace scale, clutch, "
+      "the reference's axes), its buttons turn and change the burr, the drill's force goes back; "
+      "every reading is logged with its step.");
+  register_devices(m, input);
   register_physics(m, body, joint);
   py::class_<SoftBody, Object, std::shared_ptr<SoftBody>> soft_body(
       m, "SoftBody",
@@ -462,6 +483,12 @@ void register_scene(py::module_& m) {
                              [](World& w) { return to_python_list(w.objects_of_kind<Joint>()); })
       .def_property_readonly("drills",
                              [](World& w) { return to_python_list(w.objects_of_kind<Drill>()); })
+      .def_property_readonly(
+          "input_devices",
+          [](World& w) { return to_python_list(w.objects_of_kind<InputDevice>()); })
+      .def("lock", &state_lock,
+           "A context manager holding the world's state lock: a real-time loop's steps and "
+           "captures from other threads wait meanwhile.")
       .def(
           "load_volumes",
           [](World& w, const std::filesystem::path& path,

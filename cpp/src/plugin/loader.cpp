@@ -5,11 +5,14 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <mutex>
+#include <sstream>
 #include <system_error>
 
 #include "ambfplus/errors.h"
+#include "ambfplus/log.h"
 #include "ambfplus/version.h"
 
 namespace ambfplus {
@@ -114,6 +117,33 @@ void register_plugin_language(PluginLanguage language) {
   languages().by_name[language.name] = std::move(language);
 }
 
+std::map<std::string, std::string> plugin_aliases() {
+  std::map<std::string, std::string> out;
+  auto add = [&](const std::string& entry) {
+    const std::size_t eq = entry.find('=');
+    if (eq == std::string::npos) return;
+    auto trim = [](std::string s) {
+      const std::size_t a = s.find_first_not_of(" \t"), b = s.find_last_not_of(" \t\r");
+      return a == std::string::npos ? std::string() : s.substr(a, b - a + 1);
+    };
+    const std::string from = trim(entry.substr(0, eq)), to = trim(entry.substr(eq + 1));
+    if (!from.empty() && !to.empty()) out.emplace(from, to);  // the first wins
+  };
+  if (const char* env = std::getenv("AMBFPLUS_PLUGIN_ALIASES")) {
+    std::istringstream items(env);
+    for (std::string item; std::getline(items, item, ',');) add(item);
+  }
+  const std::vector<std::string> dirs = plugin_search_path();
+  if (!dirs.empty()) {
+    std::ifstream file(fs::path(dirs.back()) / "aliases.txt");
+    for (std::string line; std::getline(file, line);) {
+      if (line.empty() || line[0] == '#') continue;
+      add(line);
+    }
+  }
+  return out;
+}
+
 std::vector<std::string> plugin_search_path() {
   std::vector<std::string> out;
   if (const char* env = std::getenv("AMBFPLUS_PLUGIN_PATH")) {
@@ -138,9 +168,17 @@ std::vector<std::string> plugin_search_path() {
 
 namespace plugin {
 
-std::shared_ptr<Plugin> make(const PluginSpec& spec, const std::string& name, std::string& file) {
-  const std::string& f = spec.filename;
-  if (f.empty()) throw PluginError("plugin '" + name + "': no filename given");
+std::shared_ptr<Plugin> make(const PluginSpec& spec, const std::string& name, std::string& file,
+                             bool& native) {
+  if (spec.filename.empty()) throw PluginError("plugin '" + name + "': no filename given");
+  // An AMBF plugin ambfplus re-implements is replaced by its own (AMBF's cannot load here).
+  const auto aliases = plugin_aliases();
+  const auto alias = aliases.find(spec.filename);
+  const std::string& f = alias != aliases.end() ? alias->second : spec.filename;
+  if (alias != aliases.end()) {
+    log(LogLevel::kInfo, "plugin '" + name + "': " + spec.filename + " is an AMBF plugin; " +
+                             "using its ambfplus counterpart " + f + " (plugin aliases)");
+  }
   const std::vector<PluginLanguage> others = registered_languages();
   const PluginLanguage* language = nullptr;
   for (const PluginLanguage& l : others) {
@@ -163,6 +201,7 @@ std::shared_ptr<Plugin> make(const PluginSpec& spec, const std::string& name, st
     tried.push_back(p.string());
     return fs::is_regular_file(p, ec);
   };
+  native = language == nullptr;
   auto load_file = [&](const fs::path& p) {
     file = fs::absolute(p, ec).lexically_normal().string();
     return language != nullptr ? language->from_file(file) : open_library(file, name);
@@ -191,6 +230,7 @@ std::shared_ptr<Plugin> make(const PluginSpec& spec, const std::string& name, st
           if (!l.from_name) continue;
           if (std::shared_ptr<Plugin> p = l.from_name(f)) {
             file = l.name + " entry point '" + f + "'";
+            native = false;
             return p;
           }
           tried.push_back(l.name + " entry point '" + f + "'");

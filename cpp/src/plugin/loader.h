@@ -13,8 +13,9 @@ namespace ambfplus::plugin {
 /// A new plugin for spec (called `name` in messages), found in the documented order: a path
 /// (a filename with '/', relative to spec.path or else the working directory) is taken as
 /// given; otherwise spec.path, plugin_search_path(), then another language's bare names (entry
-/// points), then the dynamic linker's own search by name. Sets file to what was loaded.
-/// Throws PluginError listing every place tried.
-std::shared_ptr<Plugin> make(const PluginSpec& spec, const std::string& name, std::string& file);
+/// points), then the dynamic linker's own search by name. Sets file to what was loaded, and
+/// native to false when another language made it. Throws PluginError listing every place tried.
+std::shared_ptr<Plugin> make(const PluginSpec& spec, const std::string& name, std::string& file,
+                             bool& native);
 
 }  // namespace ambfplus::plugin

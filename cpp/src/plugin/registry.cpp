@@ -15,6 +15,7 @@ struct PluginRegistry::Entry {
   std::shared_ptr<Plugin> plugin;
   bool enabled = true;   // false once a hook threw
   bool attached = true;  // false once closed
+  bool native = true;    // C++ (not another language's adapter)
 };
 
 namespace {
@@ -75,12 +76,13 @@ Plugin* PluginRegistry::load(const PluginSpec& spec, const PluginSite& site) {
   const std::string name =
       spec.name.empty() ? std::filesystem::path(spec.filename).stem().string() : spec.name;
   std::string file;
-  std::shared_ptr<Plugin> plugin = plugin::make(spec, name, file);
-  return attach(std::move(plugin), name, file, site);
+  bool native = true;
+  std::shared_ptr<Plugin> plugin = plugin::make(spec, name, file, native);
+  return attach(std::move(plugin), name, file, site, native);
 }
 
 Plugin* PluginRegistry::attach(std::shared_ptr<Plugin> plugin, const std::string& name,
-                               const std::string& file, const PluginSite& site) {
+                               const std::string& file, const PluginSite& site, bool native) {
   if (!plugin) throw std::invalid_argument("no plugin to attach");
   const bool complete = site.simulator != nullptr && site.world == world_ &&
                         (site.scope < PluginScope::kModel || site.model != nullptr) &&
@@ -107,6 +109,7 @@ Plugin* PluginRegistry::attach(std::shared_ptr<Plugin> plugin, const std::string
   }
   auto entry = std::make_shared<Entry>();
   entry->plugin = std::move(plugin);
+  entry->native = native;
   entries_[static_cast<int>(site.scope)].push_back(entry);
   return entry->plugin.get();
 }
@@ -139,12 +142,13 @@ bool PluginRegistry::empty() const {
 // is given, object plugins then left out). Plugins attached or removed by a hook take part from
 // the next call on.
 template <typename Call>
-void PluginRegistry::each(const char* hook, const Call& call, const Model* model_scope_of) {
+void PluginRegistry::each(const char* hook, const Call& call, const Model* model_scope_of,
+                          const std::function<bool(const Entry&)>& which) {
   if (empty()) return;
   std::vector<std::shared_ptr<Entry>> snapshot;
   for (const auto& scope : entries_) snapshot.insert(snapshot.end(), scope.begin(), scope.end());
   for (const auto& e : snapshot) {
-    if (!e->enabled || !e->attached) continue;
+    if (!e->enabled || !e->attached || (which && !which(*e))) continue;
     Plugin& p = *e->plugin;
     if (model_scope_of != nullptr &&
         (p.scope() == PluginScope::kObject ||
@@ -166,8 +170,20 @@ void PluginRegistry::each(const char* hook, const Call& call, const Model* model
   }
 }
 
-void PluginRegistry::physics_update(double dt) {
-  each("physics_update", [dt](Plugin& p) { p.physics_update(dt); });
+void PluginRegistry::physics_update(double dt, bool native_only) {
+  if (!native_only) {
+    each("physics_update", [dt](Plugin& p) { p.physics_update(dt); });
+    return;
+  }
+  each(
+      "physics_update", [dt](Plugin& p) { p.physics_update(dt); }, nullptr,
+      [](const Entry& e) { return e.native; });
+}
+
+void PluginRegistry::foreign_physics_update(double dt) {
+  each(
+      "physics_update", [dt](Plugin& p) { p.physics_update(dt); }, nullptr,
+      [](const Entry& e) { return !e.native; });
 }
 
 void PluginRegistry::graphics_update() {

@@ -64,6 +64,14 @@ Drill& Model::add_drill(const DrillSpec& spec) {
   return adopt(std::unique_ptr<Drill>(new Drill(*this, spec, id)));
 }
 
+InputDevice& Model::add_input_device(const InputDeviceSpec& spec) {
+  if (spec.drill != nullptr && &spec.drill->world() != world_) {
+    throw std::invalid_argument("input device '" + spec.name + "': its drill is in another world");
+  }
+  const int id = world_->claim_name(spec.name, "input device");
+  return adopt(std::unique_ptr<InputDevice>(new InputDevice(*this, spec, id)));
+}
+
 SoftBody& Model::add_soft_body(const SoftBodySpec& spec) {
   const int id = world_->claim_name(spec.name, "soft body");
   // The constructor reads the mesh and may throw; nothing is registered before physics succeeds.

@@ -29,6 +29,8 @@ const char* object_kind_name(ObjectKind kind) {
       return "sensor";
     case ObjectKind::kActuator:
       return "actuator";
+    case ObjectKind::kInputDevice:
+      return "input device";
   }
   return "object";
 }

@@ -18,4 +18,10 @@ Simulator::Simulator(const SimulatorOptions& options)
 
 Simulator::~Simulator() = default;
 
+const std::vector<std::string>& Simulator::arguments() const { return arguments_; }
+
+void Simulator::set_arguments(std::vector<std::string> arguments) {
+  arguments_ = std::move(arguments);
+}
+
 }  // namespace ambfplus

@@ -159,28 +159,45 @@ void World::register_object(Object* object) {
 void World::step(std::int64_t n) {
   if (n < 0) throw std::invalid_argument("step count must be >= 0, got " + std::to_string(n));
   auto lock = lock_state();  // the lists below, then one step at a time
+  std::vector<InputDevice*> devices = objects_of_kind<InputDevice>();
   std::vector<Drill*> drills = objects_of_kind<Drill>();
   std::vector<ProximitySensor*> sensors = objects_of_kind<ProximitySensor>();
   std::vector<ConstraintActuator*> actuators = objects_of_kind<ConstraintActuator>();
   std::uint64_t listed = objects_revision_;
   lock.unlock();
   for (std::int64_t s = 0; s < n; ++s) {
-    auto lock = lock_state();
+    lock.lock();
+    const bool realtime = realtime_;
+    // Polled devices sample before anything changes, so a sampler that throws leaves the world
+    // as it was.
+    if (!realtime) {
+      for (InputDevice* d : devices) {
+        Device& device = *d->device();
+        if (device.polled() && step_index_ % device.poll_every() == 0) {
+          device.poll(static_cast<double>(step_index_ + 1) * time_step_);
+        }
+      }
+    }
     ++step_index_;
+    // Devices first: their readings move the drills this step.
+    for (InputDevice* d : devices) d->pre_step(step_index_, time());
     physics_->step(time_step_);
     for (Drill* d : drills) d->tick(time_step_, step_index_);
+    for (InputDevice* d : devices) d->post_step(time_step_);
     for (Object* o : attached_) o->follow_parent();
     // Sensors see where everything ended up.
     for (ConstraintActuator* a : actuators) a->update();
     for (ProximitySensor* p : sensors) p->update();
-    plugins_->physics_update(time_step_);
+    plugins_->physics_update(time_step_, /*native_only=*/realtime);
     // Plugins may add or remove objects.
     if (objects_revision_ != listed) {
+      devices = objects_of_kind<InputDevice>();
       drills = objects_of_kind<Drill>();
       sensors = objects_of_kind<ProximitySensor>();
       actuators = objects_of_kind<ConstraintActuator>();
       listed = objects_revision_;
     }
+    lock.unlock();
   }
 }
 

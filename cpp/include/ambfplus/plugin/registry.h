@@ -4,6 +4,7 @@
 // with the plugins of its simulator, itself, its models and its objects.
 
 #include <functional>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -39,6 +40,11 @@ AMBFPLUS_API void register_plugin_language(PluginLanguage language);
 /// separated), then the package's plugin folder (`plugins` beside libambfplus).
 AMBFPLUS_API std::vector<std::string> plugin_search_path();
 
+/// Plugin file names replaced by others: AMBF plugins that ambfplus re-implements (AMBF's own
+/// libraries cannot load here). From AMBFPLUS_PLUGIN_ALIASES ("from=to,from=to") and then the
+/// package's `plugins/aliases.txt` (lines "from = to", '#' comments); the first entry wins.
+AMBFPLUS_API std::map<std::string, std::string> plugin_aliases();
+
 /// The plugins of one world, in call order: simulator, world, model, then object scope, and
 /// within a scope in the order they were attached. Every hook call goes through it, so a hook
 /// that throws disables its plugin (logged once) without stopping the others.
@@ -54,9 +60,10 @@ class AMBFPLUS_API PluginRegistry {
   /// Throws PluginError naming the file and every path tried, dlerror()'s message, or both ABI
   /// versions; std::invalid_argument for a site of another world.
   Plugin* load(const PluginSpec& spec, const PluginSite& site);
-  /// Attaches a plugin made elsewhere (a Python object's adapter) as load does.
+  /// Attaches a plugin made elsewhere as load does; native is false for plugins of another
+  /// language (a Python object's adapter), whose physics updates a real-time loop decimates.
   Plugin* attach(std::shared_ptr<Plugin> plugin, const std::string& name, const std::string& file,
-                 const PluginSite& site);
+                 const PluginSite& site, bool native = true);
 
   /// Attached plugins in call order, disabled ones included.
   std::vector<Plugin*> plugins() const;
@@ -64,7 +71,12 @@ class AMBFPLUS_API PluginRegistry {
   bool enabled(const Plugin& plugin) const;
   bool empty() const;
 
-  void physics_update(double dt);
+  /// physics_update(dt) of every plugin, or with native_only of C++ plugins alone (a real-time
+  /// loop's physics thread, which never waits on another language's runtime).
+  void physics_update(double dt, bool native_only = false);
+  /// physics_update(dt) of the plugins of other languages alone (a real-time loop calls it at a
+  /// lower rate, with the time since the last call).
+  void foreign_physics_update(double dt);
   void graphics_update();
   void keyboard(int key, int scancode, int action, int mods);
   void mouse_button(int button, int action, int mods);
@@ -81,7 +93,8 @@ class AMBFPLUS_API PluginRegistry {
  private:
   struct Entry;
   template <typename Call>
-  void each(const char* hook, const Call& call, const Model* model_scope_of = nullptr);
+  void each(const char* hook, const Call& call, const Model* model_scope_of = nullptr,
+            const std::function<bool(const Entry&)>& which = nullptr);
   void close_where(const std::function<bool(const Entry&)>& which);
 
   World* world_;

@@ -7,6 +7,7 @@
 
 #include "ambfplus/export.h"
 #include "ambfplus/haptics/drill.h"
+#include "ambfplus/haptics/input_device.h"
 #include "ambfplus/scene/camera.h"
 #include "ambfplus/scene/constraint_actuator.h"
 #include "ambfplus/scene/joint.h"
@@ -52,6 +53,9 @@ class AMBFPLUS_API Model {
   Volume& add_volume(const VolumeSpec& spec);
   /// Creates a drill working on a volume of the same world.
   Drill& add_drill(const DrillSpec& spec);
+  /// Binds a device to a drill of the same world. Throws std::invalid_argument for a bad spec
+  /// or a taken name.
+  InputDevice& add_input_device(const InputDeviceSpec& spec);
   /// Creates a soft body from a mesh file. Throws std::invalid_argument for a bad spec or a taken
   /// name, AssetNotFound or ConfigError for a mesh that cannot be read.
   SoftBody& add_soft_body(const SoftBodySpec& spec);

@@ -22,10 +22,11 @@ enum class ObjectKind {
   kSoftBody,
   kSensor,
   kActuator,
+  kInputDevice,
 };
 
 /// Name of an ObjectKind as users see it ("body", "joint", "camera", "light", "volume", "drill",
-/// "soft body", "sensor", "actuator").
+/// "soft body", "sensor", "actuator", "input device").
 AMBFPLUS_API const char* object_kind_name(ObjectKind kind);
 
 /// Anything that lives in a world under a name unique within that world.

@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "ambfplus/export.h"
 #include "ambfplus/scene/world.h"
@@ -37,10 +38,16 @@ class AMBFPLUS_API Simulator : public std::enable_shared_from_this<Simulator> {
     load_report_ = std::move(report);
   }
 
+  /// Command-line arguments meant for simulator plugins (AMBF forwards the ones it does not
+  /// know), e.g. {"--removal", "compatible"}; set before a launch file's plugins load.
+  const std::vector<std::string>& arguments() const;
+  void set_arguments(std::vector<std::string> arguments);
+
  private:
   explicit Simulator(const SimulatorOptions& options);
   std::unique_ptr<World> world_;
   std::shared_ptr<const AdfReport> load_report_;
+  std::vector<std::string> arguments_;
 };
 
 }  // namespace ambfplus

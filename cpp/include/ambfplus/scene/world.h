@@ -1,5 +1,6 @@
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -94,6 +95,13 @@ class AMBFPLUS_API World {
     return std::unique_lock<std::recursive_mutex>(state_mutex_);
   }
 
+  /// True while a RealTimeLoop steps this world: steps then leave polled devices and plugins of
+  /// other languages to the loop's low-rate thread.
+  bool realtime() const { return realtime_; }
+  /// Marks the world as stepped by a real-time loop; false if one already is (for RealTimeLoop).
+  bool enter_realtime() { return !realtime_.exchange(true); }
+  void leave_realtime() { realtime_ = false; }
+
   /// The world's renderer (created on first use; internal to the engine).
   render::SceneRenderer& renderer();
   /// Gives plugins their graphics update, once per step; every render calls it first, under
@@ -130,6 +138,7 @@ class AMBFPLUS_API World {
   std::uint64_t objects_revision_ = 0;  // counts objects added and models removed
   std::optional<ShaderSpec> shader_;
   mutable std::recursive_mutex state_mutex_;
+  std::atomic<bool> realtime_{false};
 };
 
 template <typename T>

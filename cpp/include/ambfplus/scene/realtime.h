@@ -1,0 +1,101 @@
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "ambfplus/export.h"
+
+namespace ambfplus {
+
+class World;
+
+/// How a real-time loop runs.
+struct AMBFPLUS_API RealTimeOptions {
+  double rate = 1000.0;  ///< steps per wall-clock second (each advances the world's time step)
+  /// Ask for SCHED_FIFO at this priority (1..99; 0: do not ask). Refused without the right
+  /// (CAP_SYS_NICE or an rtprio limit), which the loop reports and survives.
+  int fifo_priority = 80;
+  /// Pin the loop's thread to this CPU; -1: the last CPU, but only when SCHED_FIFO was refused
+  /// and there is more than one; -2: never.
+  int cpu = -1;
+  double poll_rate = 100.0;  ///< Hz of the polling thread (devices and plugins of Python)
+};
+
+/// Periods of a real-time loop, seconds between consecutive step starts.
+struct AMBFPLUS_API RealTimeStats {
+  std::int64_t steps = 0;
+  double seconds = 0.0;         ///< wall time from the first step to the last
+  std::vector<double> periods;  ///< every period (steps - 1 of them)
+  double mean_rate = 0.0;       ///< steps per second
+  double p99 = 0.0, max = 0.0;  ///< s
+  std::int64_t over_2ms = 0;    ///< periods longer than 2 ms
+  double step_p99 = 0.0;        ///< s of thread CPU time per step, 99th percentile
+  double step_cpu_max = 0.0;    ///< s of thread CPU time of the costliest step
+  double step_wall_max = 0.0;   ///< s of wall time of the longest step (lock waits included)
+  /// Periods over 2 ms: their index, the wall and CPU time of the step that began them.
+  std::vector<std::int64_t> late;
+  std::vector<double> late_step_wall, late_step_cpu;
+};
+
+/// Steps a world in real time on a thread of its own: one world step per period at absolute
+/// deadlines (clock_nanosleep on CLOCK_MONOTONIC, so lateness does not accumulate; a loop more
+/// than 50 periods behind gives up catching up). Each step takes the world's state lock, so
+/// cameras may capture from other threads meanwhile. Devices and plugins that call into Python
+/// are served by a second, low-rate thread (poll_rate), never by the loop's: polled devices are
+/// polled there, and other-language plugins get their physics update there with the time since
+/// the last one. Everything else about a step is what World::step does, so a session's logged
+/// device readings replay exactly in scripted mode.
+class AMBFPLUS_API RealTimeLoop {
+ public:
+  explicit RealTimeLoop(World& world, const RealTimeOptions& options = {});
+  /// Stops the loop.
+  ~RealTimeLoop();
+  RealTimeLoop(const RealTimeLoop&) = delete;
+  RealTimeLoop& operator=(const RealTimeLoop&) = delete;
+
+  /// Starts the threads; throws std::logic_error if running or if the world has another loop.
+  void start();
+  /// Stops after the step in progress and joins the threads. A step that threw ends the loop;
+  /// stop() then throws its error again.
+  void stop();
+  bool running() const { return running_; }
+  World& world() const { return world_; }
+
+  /// How the loop's thread was scheduled: "SCHED_FIFO priority 80", or "SCHED_OTHER (SCHED_FIFO
+  /// refused: ...), pinned to CPU 1", and so on.
+  std::string scheduling() const;
+  /// Periods so far (also after stop()).
+  RealTimeStats stats() const;
+  /// Called on the polling thread at poll_rate after devices were polled (the Python bindings
+  /// use it to run Python plugins); runs without the world's lock unless it takes it.
+  void set_poll_hook(std::function<void(double dt)> hook);
+
+ private:
+  void run_steps();
+  void run_polls();
+
+  World& world_;
+  RealTimeOptions options_;
+  std::atomic<bool> running_{false};
+  std::atomic<bool> stopping_{false};
+  std::thread steps_thread_, polls_thread_;
+  mutable std::mutex mutex_;  // guards what follows
+  std::condition_variable wake_;
+  std::string scheduling_;
+  std::vector<double> periods_;
+  std::vector<double> step_cpu_;
+  std::vector<double> step_wall_;
+  std::int64_t steps_ = 0;
+  double first_ = 0.0, last_ = 0.0;
+  std::string error_;
+  std::function<void(double)> poll_hook_;
+};
+
+}  // namespace ambfplus

@@ -1,0 +1,141 @@
+#include "ambfplus/haptics/device.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace ambfplus {
+
+Device::~Device() = default;
+
+NullDevice::NullDevice() : Device({"null", 0.1, 0.1, 0.0, 0.1}) {}
+
+// A Phantom Omni's limits: a hand of that size, with the drill's default stiffness felt 1:1.
+SimulatedDevice::SimulatedDevice(const Hand& hand, const Eigen::Vector3d& position)
+    : Device({"simulated", 10.0, 1000.0, 5.0, 0.1}), hand_(hand), x_(position), target_(position) {
+  if (!(hand.mass > 0) || !(hand.stiffness >= 0) || !(hand.damping >= 0)) {
+    throw std::invalid_argument(
+        "simulated device: the hand needs mass > 0, stiffness >= 0 and "
+        "damping >= 0");
+  }
+}
+
+void SimulatedDevice::set_target(const Eigen::Vector3d& position,
+                                 const Eigen::Quaterniond& orientation, std::uint32_t buttons) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  target_ = position;
+  orientation_ = orientation.normalized();
+  buttons_ = buttons;
+}
+
+DeviceState SimulatedDevice::read(std::int64_t, double) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return {x_, orientation_, buttons_};
+}
+
+void SimulatedDevice::write(const Eigen::Vector3d& force, double dt) {
+  last_force_ = force;
+  std::lock_guard<std::mutex> lock(mutex_);
+  // Semi-implicit Euler: velocity from this step's forces, then position from that velocity.
+  const Eigen::Vector3d a =
+      (hand_.stiffness * (target_ - x_) - hand_.damping * v_ + force) / hand_.mass;
+  v_ += a * dt;
+  x_ += v_ * dt;
+}
+
+Eigen::Vector3d SimulatedDevice::position() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return x_;
+}
+
+Eigen::Vector3d SimulatedDevice::velocity() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return v_;
+}
+
+double SimulatedDevice::energy() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return 0.5 * hand_.mass * v_.squaredNorm() + 0.5 * hand_.stiffness * (target_ - x_).squaredNorm();
+}
+
+ScriptedDevice::ScriptedDevice() : Device({"scripted", 10.0, 1000.0, 5.0, 0.1}) {}
+
+void ScriptedDevice::set_waypoints(std::vector<Waypoint> waypoints) {
+  for (std::size_t i = 1; i < waypoints.size(); ++i) {
+    if (!(waypoints[i].time >= waypoints[i - 1].time)) {
+      throw std::invalid_argument("scripted device: waypoint times must not decrease");
+    }
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  waypoints_ = std::move(waypoints);
+  for (Waypoint& w : waypoints_) w.state.orientation.normalize();
+  start_ = std::numeric_limits<double>::quiet_NaN();
+  sampler_ = nullptr;
+}
+
+void ScriptedDevice::set_sampler(Sampler sampler, int every) {
+  if (every < 1) throw std::invalid_argument("scripted device: every must be >= 1");
+  std::lock_guard<std::mutex> lock(mutex_);
+  sampler_ = std::move(sampler);
+  every_ = every;
+  waypoints_.clear();
+}
+
+bool ScriptedDevice::polled() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return static_cast<bool>(sampler_);
+}
+
+void ScriptedDevice::poll(double time) {
+  Sampler sampler;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    sampler = sampler_;
+  }
+  if (!sampler) return;
+  DeviceState s = sampler(time);  // may take a while (Python): outside the lock
+  s.orientation.normalize();
+  std::lock_guard<std::mutex> lock(mutex_);
+  sample_ = s;
+}
+
+DeviceState ScriptedDevice::read(std::int64_t, double time) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (sampler_ || waypoints_.empty()) return sample_;
+  if (std::isnan(start_)) start_ = time;
+  const double t = time - start_;
+  auto after = std::upper_bound(waypoints_.begin(), waypoints_.end(), t,
+                                [](double v, const Waypoint& w) { return v < w.time; });
+  if (after == waypoints_.begin()) return sample_ = after->state;
+  if (after == waypoints_.end()) return sample_ = waypoints_.back().state;
+  const Waypoint& a = *(after - 1);
+  const Waypoint& b = *after;
+  const double f = b.time > a.time ? (t - a.time) / (b.time - a.time) : 1.0;
+  sample_.position = a.state.position + f * (b.state.position - a.state.position);
+  sample_.orientation = a.state.orientation.slerp(f, b.state.orientation);
+  sample_.buttons = a.state.buttons;
+  return sample_;
+}
+
+ReplayDevice::ReplayDevice(std::vector<DeviceRecord> records, DeviceSpec spec)
+    : Device(std::move(spec)), records_(std::move(records)) {
+  for (std::size_t i = 1; i < records_.size(); ++i) {
+    if (records_[i].step <= records_[i - 1].step) {
+      throw std::invalid_argument("replay device: record " + std::to_string(i) + " has step " +
+                                  std::to_string(records_[i].step) + ", not after " +
+                                  std::to_string(records_[i - 1].step));
+    }
+  }
+}
+
+DeviceState ReplayDevice::read(std::int64_t step, double) {
+  if (records_.empty()) return {};
+  if (step > records_.back().step) ++past_end_;
+  const auto after =
+      std::upper_bound(records_.begin(), records_.end(), step,
+                       [](std::int64_t s, const DeviceRecord& r) { return s < r.step; });
+  return after == records_.begin() ? records_.front().state : (after - 1)->state;
+}
+
+}  // namespace ambfplus

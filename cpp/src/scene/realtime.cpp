@@ -1,0 +1,253 @@
+#include "ambfplus/scene/realtime.h"
+
+#include <pthread.h>
+#include <sched.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+
+#include "ambfplus/haptics/input_device.h"
+#include "ambfplus/log.h"
+#include "ambfplus/plugin/registry.h"
+#include "ambfplus/scene/world.h"
+
+namespace ambfplus {
+namespace {
+
+double seconds(const timespec& t) { return static_cast<double>(t.tv_sec) + 1e-9 * t.tv_nsec; }
+
+double now() {
+  timespec t{};
+  clock_gettime(CLOCK_MONOTONIC, &t);
+  return seconds(t);
+}
+
+double thread_cpu() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return seconds(t);
+}
+
+void advance(timespec& t, long nanoseconds) {
+  t.tv_nsec += nanoseconds;
+  while (t.tv_nsec >= 1000000000L) {
+    t.tv_nsec -= 1000000000L;
+    ++t.tv_sec;
+  }
+}
+
+// Asks for the scheduling the options want and says what the thread got.
+std::string schedule_this_thread(const RealTimeOptions& options) {
+  std::string how = "SCHED_OTHER";
+  bool fifo = false;
+  if (options.fifo_priority > 0) {
+    sched_param p{};
+    p.sched_priority = std::clamp(options.fifo_priority, sched_get_priority_min(SCHED_FIFO),
+                                  sched_get_priority_max(SCHED_FIFO));
+    const int rc = pthread_setschedparam(pthread_self(), SCHED_FIFO, &p);
+    if (rc == 0) {
+      fifo = true;
+      how = "SCHED_FIFO priority " + std::to_string(p.sched_priority);
+    } else {
+      how += std::string(" (SCHED_FIFO refused: ") + std::strerror(rc) + ")";
+    }
+  }
+  const long cpus = sysconf(_SC_NPROCESSORS_ONLN);
+  int cpu = options.cpu;
+  if (cpu == -1) cpu = (!fifo && cpus > 1) ? static_cast<int>(cpus - 1) : -2;
+  if (cpu >= 0) {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    CPU_SET(cpu, &set);
+    const int rc = pthread_setaffinity_np(pthread_self(), sizeof(set), &set);
+    how += rc == 0 ? ", pinned to CPU " + std::to_string(cpu)
+                   : std::string(", pinning to CPU ") + std::to_string(cpu) +
+                         " refused: " + std::strerror(rc);
+  }
+  return how;
+}
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  const std::size_t k =
+      std::min(v.size() - 1, static_cast<std::size_t>(std::ceil(q * v.size())) - 1);
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+  return v[k];
+}
+
+}  // namespace
+
+RealTimeLoop::RealTimeLoop(World& world, const RealTimeOptions& options)
+    : world_(world), options_(options) {
+  if (!(options.rate > 0 && options.rate <= 100000)) {
+    throw std::invalid_argument("real-time loop: rate must be in (0, 100000] steps/s");
+  }
+  if (!(options.poll_rate > 0 && options.poll_rate <= options.rate)) {
+    throw std::invalid_argument("real-time loop: poll_rate must be in (0, rate]");
+  }
+}
+
+RealTimeLoop::~RealTimeLoop() {
+  try {
+    stop();
+  } catch (const std::exception& e) {
+    log(LogLevel::kError, std::string("real-time loop: ") + e.what());
+  }
+}
+
+void RealTimeLoop::start() {
+  if (running_) throw std::logic_error("the real-time loop is already running");
+  if (!world_.enter_realtime()) {
+    throw std::logic_error("world '" + world_.name() + "' already has a running real-time loop");
+  }
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    periods_.clear();
+    step_cpu_.clear();
+    step_wall_.clear();
+    steps_ = 0;
+    error_.clear();
+    scheduling_.clear();
+  }
+  stopping_ = false;
+  running_ = true;
+  steps_thread_ = std::thread([this] { run_steps(); });
+  polls_thread_ = std::thread([this] { run_polls(); });
+  // Report the scheduling once the thread has it.
+  std::unique_lock<std::mutex> lock(mutex_);
+  wake_.wait(lock, [this] { return !scheduling_.empty(); });
+}
+
+void RealTimeLoop::stop() {
+  if (!running_) return;
+  stopping_ = true;
+  wake_.notify_all();
+  if (steps_thread_.joinable()) steps_thread_.join();
+  if (polls_thread_.joinable()) polls_thread_.join();
+  running_ = false;
+  world_.leave_realtime();
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!error_.empty()) {
+    const std::string error = error_;
+    error_.clear();
+    throw std::runtime_error("real-time loop stopped by an error in a step: " + error);
+  }
+}
+
+std::string RealTimeLoop::scheduling() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return scheduling_;
+}
+
+void RealTimeLoop::set_poll_hook(std::function<void(double)> hook) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  poll_hook_ = std::move(hook);
+}
+
+void RealTimeLoop::run_steps() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    scheduling_ = schedule_this_thread(options_);
+  }
+  wake_.notify_all();
+  const long period_ns = std::lround(1e9 / options_.rate);
+  const double period = 1e-9 * static_cast<double>(period_ns);
+  timespec deadline{};
+  clock_gettime(CLOCK_MONOTONIC, &deadline);
+  double previous = -1.0;
+  while (!stopping_) {
+    advance(deadline, period_ns);
+    while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &deadline, nullptr) == EINTR) {
+    }
+    const double start = now();
+    const double cpu = thread_cpu();
+    try {
+      world_.step(1);
+    } catch (const std::exception& e) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      error_ = e.what();
+      stopping_ = true;
+      break;
+    }
+    const double used = thread_cpu() - cpu;
+    const double wall = now() - start;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (previous >= 0) periods_.push_back(start - previous);
+      if (steps_ == 0) first_ = start;
+      last_ = start;
+      ++steps_;
+      step_cpu_.push_back(used);
+      step_wall_.push_back(wall);
+    }
+    previous = start;
+    // Far behind (a stall): start afresh from now rather than racing to catch up.
+    if (start > seconds(deadline) + 50 * period) clock_gettime(CLOCK_MONOTONIC, &deadline);
+  }
+  wake_.notify_all();
+}
+
+void RealTimeLoop::run_polls() {
+  const auto period = std::chrono::duration<double>(1.0 / options_.poll_rate);
+  double previous = 0.0;
+  {
+    auto state = world_.lock_state();
+    previous = world_.time();
+  }
+  std::unique_lock<std::mutex> lock(mutex_);
+  while (!stopping_) {
+    wake_.wait_for(lock, period, [this] { return stopping_.load(); });
+    if (stopping_) break;
+    std::function<void(double)> hook = poll_hook_;
+    lock.unlock();
+    // Polled devices' samplers run without the world's lock: they compute a reading.
+    std::vector<InputDevice*> devices;
+    double time = 0.0;
+    {
+      auto state = world_.lock_state();
+      devices = world_.objects_of_kind<InputDevice>();
+      time = world_.time();
+    }
+    for (InputDevice* d : devices) {
+      if (d->device()->polled()) d->device()->poll(time);
+    }
+    if (hook) hook(time - previous);
+    previous = time;
+    lock.lock();
+  }
+}
+
+RealTimeStats RealTimeLoop::stats() const {
+  RealTimeStats s;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    s.steps = steps_;
+    s.periods = periods_;
+    s.seconds = last_ - first_;
+    s.step_p99 = percentile(step_cpu_, 0.99);
+    if (!step_cpu_.empty()) {
+      s.step_cpu_max = *std::max_element(step_cpu_.begin(), step_cpu_.end());
+      s.step_wall_max = *std::max_element(step_wall_.begin(), step_wall_.end());
+    }
+    // Period i ends at step i + 1: the step before it ran late, or the wait for it did.
+    for (std::size_t i = 0; i < periods_.size(); ++i) {
+      if (periods_[i] <= 2e-3) continue;
+      s.late.push_back(static_cast<std::int64_t>(i));
+      s.late_step_wall.push_back(step_wall_[i]);
+      s.late_step_cpu.push_back(step_cpu_[i]);
+    }
+  }
+  if (s.periods.empty()) return s;
+  s.mean_rate = s.seconds > 0 ? static_cast<double>(s.steps - 1) / s.seconds : 0.0;
+  s.max = *std::max_element(s.periods.begin(), s.periods.end());
+  s.p99 = percentile(s.periods, 0.99);
+  s.over_2ms = std::count_if(s.periods.begin(), s.periods.end(), [](double p) { return p > 2e-3; });
+  return s;
+}
+
+}  // namespace ambfplus

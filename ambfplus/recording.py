@@ -35,7 +35,9 @@ which writes them.
 Layout of a part (and of a complete head)
 -----------------------------------------
 Every dataset is chunked and resizable along axis 0 (``maxshape`` None); images are stored one
-frame per chunk with lzf compression, small columns in chunks of about 64 KiB (lzf as well).
+frame per chunk, small columns in chunks of about 64 KiB, all lzf-compressed (``compression``
+picks gzip or none instead); float datasets (depth, points) add the shuffle filter, which halves
+their size. Both filters are built into h5py; gzip and shuffle into every HDF5 library.
 All datasets of a group have the same length N (their rows belong together).
 
 ``cameras/<stream>/`` (attribute ``camera``: the camera's name), one row per frame:
@@ -148,6 +150,7 @@ MiB = 1024 * 1024
 # Passes recorded when add_frame is not told which: everything a frame holds except points,
 # which follow from depth and the intrinsics and would double the size.
 DEFAULT_PASSES = ("rgb", "depth", "instance", "label", "voxel")
+COMPRESSIONS = ("lzf", "gzip", None)
 # Gathered small columns are written out once they reach this size.
 BUFFER_BYTES = 8 * MiB
 
@@ -204,7 +207,8 @@ _CLOSE = object()
 class Recorder:
     """Records frames, stereo pairs, steps, removed voxels and events into ``path`` (see the
     module docstring for the layout). All HDF5 work happens on a background thread; ``add_*``
-    copies its arrays and returns, or blocks while ``max_pending_bytes`` are waiting."""
+    copies its arrays and returns, or blocks while ``max_pending_bytes`` are waiting. Parts
+    close every ``flush_interval_s``; ``compression`` is "lzf", "gzip" or None."""
 
     def __init__(
         self,
@@ -213,15 +217,19 @@ class Recorder:
         *,
         max_pending_bytes: int = 512 * MiB,
         flush_interval_s: float = 1.0,
+        compression: str | None = "lzf",
         overwrite: bool = False,
     ) -> None:
         if not max_pending_bytes > 0:
             raise ValueError(f"max_pending_bytes must be > 0, got {max_pending_bytes}")
         if not flush_interval_s > 0:
             raise ValueError(f"flush_interval_s must be > 0 s, got {flush_interval_s}")
+        if compression not in COMPRESSIONS:
+            raise ValueError(f"compression must be one of {COMPRESSIONS}, got {compression!r}")
         self.path = Path(path)
         self.max_pending_bytes = int(max_pending_bytes)
         self.flush_interval_s = float(flush_interval_s)
+        self.compression = compression
         self._head = _HeadInfo(
             recording_id=uuid.uuid4().hex,
             created=datetime.now(timezone.utc).isoformat(),
@@ -452,7 +460,8 @@ class Recorder:
         """Writes one queued item (runs on the writer thread)."""
         if isinstance(item, _Rows):
             if self._part is None:
-                self._part = _PartFile(part_name(self.path, len(self._parts) + 1), self._head)
+                number = len(self._parts) + 1
+                self._part = _PartFile(part_name(self.path, number), self._head, self.compression)
             self._part.append(item)
         elif isinstance(item, _Legend):
             self._head.legend = item.text
@@ -550,8 +559,8 @@ def _frame_rows(stream: str, frame, passes) -> _Rows:
 def _rig_rows(rig, stereo, left: str, right: str, left_index: int, right_index: int) -> _Rows:
     _check_name(rig, "rig")
     values = {
-        "time": stereo.left.time,
-        "step": stereo.left.step,
+        "time": _field(stereo.left, "time"),
+        "step": _field(stereo.left, "step"),
         "baseline": stereo.baseline,
         "dcx": stereo.dcx,
         "left_index": left_index,
@@ -701,8 +710,9 @@ class _HeadInfo:
 class _PartFile:
     """The segment being written, as ``<part>.tmp`` until ``close`` renames it into place."""
 
-    def __init__(self, path: Path, head: _HeadInfo) -> None:
+    def __init__(self, path: Path, head: _HeadInfo, compression: str | None) -> None:
         self.path = path
+        self.compression = compression
         self.tmp = temporary_name(path)
         self.file = h5py.File(self.tmp, "w")
         self.file.attrs.update(
@@ -716,15 +726,18 @@ class _PartFile:
         self.summary = PartSummary(path)
         self._buffers: dict[tuple[str, str], list[np.ndarray]] = {}
         self._buffered_bytes: dict[tuple[str, str], int] = {}
+        # Open datasets stay open: reopening one per write costs as much as compressing it.
+        self._datasets: dict[tuple[str, str], h5py.Dataset] = {}
 
     def append(self, rows: _Rows) -> None:
         group = self.summary.groups.get(rows.group)
         if group is None:
             group = self.summary.groups[rows.group] = _new_group_summary(rows)
             self.file.require_group(rows.group).attrs.update(rows.attrs)
+        is_camera = rows.group.startswith("cameras/")
         for name, data in rows.columns.items():
-            if data.nbytes // len(data) >= IMAGE_ROW_BYTES:
-                _append(self.file[rows.group], name, data, chunk_rows=1)
+            if (is_camera and name in IMAGE_PASSES) or data.nbytes // len(data) >= IMAGE_ROW_BYTES:
+                self._append(rows.group, name, data, chunk_rows=1)
             else:
                 self._buffer(rows.group, name, data)
         group.rows += len(next(iter(rows.columns.values())))
@@ -743,11 +756,24 @@ class _PartFile:
             data = np.concatenate(pieces)
             row_bytes = max(data.nbytes // len(data), 1)
             chunk_rows = max(1, min(len(data), SMALL_CHUNK_BYTES // row_bytes))
-            _append(self.file[group], name, data, chunk_rows)
+            self._append(group, name, data, chunk_rows)
+
+    def _append(self, group: str, name: str, data: np.ndarray, chunk_rows: int) -> None:
+        """Appends rows to a chunked dataset resizable along axis 0, creating it if needed."""
+        dataset = self._datasets.get((group, name))
+        if dataset is None:
+            self._datasets[group, name] = _create(
+                self.file[group], name, data, chunk_rows, self.compression
+            )
+            return
+        start = dataset.shape[0]
+        dataset.resize(start + len(data), axis=0)
+        dataset[start:] = data
 
     def close(self) -> PartSummary:
         for group, name in list(self._buffers):
             self._write_buffer(group, name)
+        self._datasets.clear()
         self.file.close()
         os.replace(self.tmp, self.path)
         return self.summary
@@ -758,23 +784,21 @@ def _new_group_summary(rows: _Rows) -> GroupSummary:
     return GroupSummary(0, datasets, dict(rows.attrs))
 
 
-def _append(group: h5py.Group, name: str, data: np.ndarray, chunk_rows: int) -> None:
-    """Appends rows to a chunked dataset resizable along axis 0, creating it if needed."""
-    if name not in group:
-        is_text = data.dtype.kind == "O"
-        group.create_dataset(
-            name,
-            data=data,
-            dtype=string_dtype() if is_text else data.dtype,
-            maxshape=(None,) + data.shape[1:],
-            chunks=(chunk_rows,) + data.shape[1:],
-            compression=None if is_text else "lzf",
-        )
-        return
-    dataset = group[name]
-    start = dataset.shape[0]
-    dataset.resize(start + len(data), axis=0)
-    dataset[start:] = data
+def _create(
+    group: h5py.Group, name: str, data: np.ndarray, chunk_rows: int, compression: str | None
+) -> h5py.Dataset:
+    is_text = data.dtype.kind == "O"
+    compression = None if is_text else compression
+    return group.create_dataset(
+        name,
+        data=data,
+        dtype=string_dtype() if is_text else data.dtype,
+        maxshape=(None,) + data.shape[1:],
+        chunks=(chunk_rows,) + data.shape[1:],
+        compression=compression,
+        # Grouping the bytes of floats by significance makes depth compress twice as well.
+        shuffle=bool(compression) and data.dtype.kind == "f",
+    )
 
 
 def _number_of(path: Path) -> int:

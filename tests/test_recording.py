@@ -584,6 +584,48 @@ def test_steps_events_and_removed_inputs_are_checked(tmp_path):
         assert read.events == [{"step": 4, "kind": "burr", "label": 0, "voxel": (1, 2, 3)}]
 
 
+def test_stereo_pairs_of_mappings_and_rig_indices_after_single_frames(tmp_path):
+    path = tmp_path / "pairs.h5"
+    with Recorder(path) as rec:
+        rec.add_frame("left", synthetic_frame(0) | {"camera": "left"})  # an unpaired frame first
+        for i in (1, 2):
+            left = synthetic_frame(i) | {"camera": "left"}
+            right = synthetic_frame(i + 10) | {"camera": "right", "step": left["step"]}
+            right["time"] = left["time"]
+            rec.add_stereo("rig", ambfplus.stereo.StereoFrame(left, right, 0.01, 2.5))
+    with open_recording(path) as read:
+        rig = read.rigs["rig"]
+        assert len(rig) == 2 and len(read.cameras["left"]) == 3
+        assert np.array_equal(rig.left_index[:], [1, 2]) and np.array_equal(
+            rig.right_index[:], [0, 1]
+        )
+        assert_synthetic(rig[1].left, 2)
+        assert np.array_equal(rig[1].right.rgb, synthetic_frame(12)["rgb"])
+        assert rig[0].baseline == 0.01 and rig[0].dcx == 2.5
+
+
+@pytest.mark.parametrize("compression", ["lzf", "gzip", None])
+def test_layout_chunks_one_frame_and_compresses_as_asked(tmp_path, compression):
+    path = tmp_path / "c.h5"
+    frame = synthetic_frame(0) | {"depth": np.full((24, 32), 0.25, np.float32)}
+    with Recorder(path, compression=compression) as rec:
+        for _ in range(2):
+            rec.add_frame("cam", frame)
+        rec.add_steps({"step": np.arange(3), "time": np.arange(3) * 1e-3})
+    with h5py.File(f"{path}.part0001", "r") as f:
+        depth, rgb, time_ = (f[f"cameras/cam/{n}"] for n in ("depth", "rgb", "time"))
+        assert depth.chunks == (1, 24, 32) and rgb.chunks == (1, 24, 32, 3)
+        assert depth.maxshape == (None, 24, 32) and time_.maxshape == (None,)
+        assert f["steps/step"].maxshape == (None,) and f["steps/step"].chunks == (3,)
+        assert depth.compression == rgb.compression == time_.compression == compression
+        assert depth.shuffle == (compression is not None) and not rgb.shuffle
+        if compression:
+            assert depth.id.get_storage_size() < depth.size * 4 / 10  # a constant compresses
+        assert np.array_equal(depth[1], frame["depth"]) and np.array_equal(rgb[1], frame["rgb"])
+    with pytest.raises(ValueError, match="compression must be one of"):
+        Recorder(tmp_path / "x.h5", compression="zstd")
+
+
 def test_an_existing_recording_is_not_overwritten_unless_asked(tmp_path):
     path = tmp_path / "o.h5"
     small_recording(path)

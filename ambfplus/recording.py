@@ -69,6 +69,17 @@ Attributes of the head's root (parts carry the first four):
     up), camera frame (OpenCV), pixel centres at (c + 0.5, r + 0.5) in the intrinsics, depth,
     points, ids, voxel index order, stereo.
 
+Reading
+-------
+``open_recording(path)`` checks the head and every part (format, version, numbering, equal
+lengths) and raises ``RecordingError`` (a ``ConfigError``, so a ``ValueError``) naming the file
+and dataset otherwise. ``rec.cameras[name]`` has ``len``, ``[i]`` (a ``RecordedFrame``: arrays,
+time, step, intrinsics, pose) and lazy columns ``.rgb``, ``.depth``, ... that read only what is
+indexed; ``rec.rigs[name][i]`` is an ``ambfplus.stereo.StereoFrame`` of two recorded frames;
+``rec.steps`` (dict of arrays), ``rec.removed``, ``rec.events``, ``rec.metadata``,
+``rec.legend`` (integer ids again), ``rec.version``. ``validate(path)`` (``ambfplus validate
+PATH``) checks the recording against itself and the conventions.
+
 Unlike the original system's recordings: depth stays float32 and poses float64, with no scale
 factors; every frame carries its own intrinsics and pose; voxel indices are global; nothing is
 dropped: a full queue blocks the producer instead.
@@ -107,7 +118,15 @@ import h5py
 import numpy as np
 
 from . import __version__
-from .recording_reader import Recording, open_recording, scan_parts
+from .recording_reader import (
+    CameraStream,
+    Column,
+    RecordedFrame,
+    Recording,
+    RigStream,
+    open_recording,
+    scan_parts,
+)
 from .recording_schema import (
     CONVENTIONS,
     EVENT_COLUMNS,
@@ -134,11 +153,15 @@ from .recording_validate import Check, ValidationReport, validate
 from .stereo import legend as object_legend
 
 __all__ = [
+    "CameraStream",
     "Check",
+    "Column",
+    "RecordedFrame",
     "Recorder",
     "RecorderStats",
     "Recording",
     "RecordingError",
+    "RigStream",
     "ValidationReport",
     "open_recording",
     "repair",
@@ -207,8 +230,9 @@ _CLOSE = object()
 class Recorder:
     """Records frames, stereo pairs, steps, removed voxels and events into ``path`` (see the
     module docstring for the layout). All HDF5 work happens on a background thread; ``add_*``
-    copies its arrays and returns, or blocks while ``max_pending_bytes`` are waiting. Parts
-    close every ``flush_interval_s``; ``compression`` is "lzf", "gzip" or None."""
+    copies its arrays and returns, or blocks while ``max_pending_bytes`` are waiting (HDF5's
+    chunk cache, up to 8 MiB per image dataset, comes on top). Parts close every
+    ``flush_interval_s``; ``compression`` is "lzf", "gzip" or None."""
 
     def __init__(
         self,

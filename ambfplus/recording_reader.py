@@ -112,9 +112,6 @@ class Recording:
     def parts(self) -> list[Path]:
         return [p.path for p in self.part_summaries]
 
-    def group_names(self) -> list[str]:
-        return list(self._groups)
-
     def _columns(self, group: str) -> dict[str, Column]:
         pieces, _ = self._groups[group]
         datasets = next(g for _, g in pieces).datasets
@@ -164,13 +161,17 @@ class Recording:
     def __exit__(self, *exc_info) -> None:
         self.close()
 
+    def rows(self, group: str) -> int:
+        """Rows of a group (``cameras/left``, ``steps``, ...) across parts, 0 if absent."""
+        pieces, _ = self._groups.get(group, ([], {}))
+        return sum(summary.rows for _, summary in pieces)
+
     def __repr__(self) -> str:
         cameras = ", ".join(f"{n}: {len(s)}" for n, s in self.cameras.items())
-        steps = len(self.steps.get("step", ()))
         return (
             f"<Recording {self.path} v{self.version}, {len(self.parts)} parts, cameras "
-            f"{{{cameras}}}, rigs {list(self.rigs)}, {steps} steps, "
-            f"{len(self.removed['step'])} removed voxels, {len(self.events)} events"
+            f"{{{cameras}}}, rigs {list(self.rigs)}, {self.rows('steps')} steps, "
+            f"{self.rows('removed')} removed voxels, {self.rows('events')} events"
             f"{'' if self.complete else ', not closed (interrupted)'}>"
         )
 

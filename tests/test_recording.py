@@ -166,6 +166,8 @@ def test_round_trip_of_real_stereo_captures_is_exact(drilled_recording):
             assert np.array_equal(rec.removed[name], removed[name]), name
         assert rec.removed["voxel"].dtype == np.int32 and rec.removed["label"].dtype == np.uint16
         assert rec.events == [{"step": 10, "kind": "critical", "label": 3, "voxel": (-1, -1, -1)}]
+        assert rec.rows("steps") == 20 and rec.rows("removed") == len(removed["step"])
+        assert "cameras {rig_left: 4, rig_right: 4}" in repr(rec)
 
 
 def test_plain_h5py_reads_the_closed_head_as_one_file(drilled_recording, tmp_path, monkeypatch):
@@ -533,6 +535,8 @@ def test_reader_names_a_dataset_of_inconsistent_length(tmp_path):
         f["cameras/cam/time"].resize(2, axis=0)
     with pytest.raises(RecordingError, match=r"l\.h5\.part0002: inconsistent lengths.*cam/time"):
         open_recording(path)
+    (check,) = validate(path).checks
+    assert check.status == "fail" and "cameras/cam/time" in check.detail
 
 
 def test_reader_refuses_a_part_opened_as_a_head(tmp_path):

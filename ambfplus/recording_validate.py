@@ -192,9 +192,10 @@ def _rig_checks(name: str, rig: RigStream) -> list[Check]:
     return checks
 
 
+# Small per-frame columns are read whole and indexed in memory (one read per part).
 def _pair_steps_check(name: str, rig: RigStream, left, right) -> Check:
     steps = rig.step[:]
-    same = (rig.left.step[list(left)] == steps) & (rig.right.step[list(right)] == steps)
+    same = (rig.left.step[:][left] == steps) & (rig.right.step[:][right] == steps)
     if len(steps) == 0 or same.all():
         return Check(f"{name}: views share the pair's step", "pass", "", {"pairs": len(steps)})
     i = int(np.flatnonzero(~same)[0])
@@ -205,12 +206,10 @@ def _rig_geometry_checks(name: str, rig: RigStream, left, right) -> list[Check]:
     """Baseline = distance between the poses; dcx = cx_right - cx_left."""
     if len(left) == 0:
         return []
-    left_t = rig.left.pose[list(left)][:, :3, 3]
-    right_t = rig.right.pose[list(right)][:, :3, 3]
+    left_t = rig.left.pose[:][left][:, :3, 3]
+    right_t = rig.right.pose[:][right][:, :3, 3]
     baseline_error = np.abs(np.linalg.norm(right_t - left_t, axis=1) - rig.baseline[:])
-    cx_difference = (
-        rig.right.intrinsics[list(right)][:, 0, 2] - rig.left.intrinsics[list(left)][:, 0, 2]
-    )
+    cx_difference = rig.right.intrinsics[:][right][:, 0, 2] - rig.left.intrinsics[:][left][:, 0, 2]
     dcx_error = np.abs(cx_difference - rig.dcx[:])
     return [
         _tolerance_check(

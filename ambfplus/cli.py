@@ -1,4 +1,4 @@
-"""The ``ambfplus`` command line: ``demo``, ``convert``, ``launch``, ``info`` (and
+"""The ``ambfplus`` command line: ``demo``, ``convert``, ``launch``, ``validate``, ``info`` (and
 ``--cmake-dir``, the folder of the CMake package C++ plugins build against)."""
 
 from __future__ import annotations
@@ -138,6 +138,15 @@ def run_launch(args: argparse.Namespace) -> int:
     return 1 if report.errors else 0
 
 
+def run_validate(args: argparse.Namespace) -> int:
+    """Checks a recording; exit code 0 only when every check passes."""
+    from .recording import validate  # h5py is needed only here
+
+    report = validate(args.recording)
+    print(json.dumps(report.to_dict(), indent=2) if args.json else report)
+    return 0 if report.ok else 1
+
+
 class _PrintCmakeDir(argparse.Action):
     """--cmake-dir: prints the folder and exits, as --version does."""
 
@@ -211,8 +220,15 @@ def main(argv: list[str] | None = None) -> int:
         help="simulator plugins to load after the launch file's, comma separated "
         "(libx.so, x.py, a path, or a name searched in AMBFPLUS_PLUGIN_PATH)",
     )
+    validate = commands.add_parser(
+        "validate", help="check a recording (ambfplus.recording); exit 1 if any check fails"
+    )
+    validate.add_argument("recording", type=Path, help="the recording's head file (name.h5)")
+    validate.add_argument("--json", action="store_true", help="print the report as JSON")
     commands.add_parser("info", help="print the version and the OpenGL device")
     args = parser.parse_args(argv)
+    if args.command == "validate":
+        return run_validate(args)
     if args.command == "launch":
         return run_launch(args)
     if args.command == "demo":

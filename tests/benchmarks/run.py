@@ -466,6 +466,133 @@ def realtime(args) -> Iterator[dict]:
         yield line
 
 
+@benchmark
+def recording(args) -> Iterator[dict]:
+    """640x480 stereo rgb + depth + label + instance of the phantom (128^3) in a capture loop,
+    without recording, recording every pair (lzf, the default) and recording uncompressed, in
+    alternating rounds; a recorded round ends when its pairs are flushed to closed parts.
+    Capture rate (wall) and process CPU (all threads: rendering, copies, compression), data
+    rate in frames/s and MB/s, and the recorder alone replaying captured pairs."""
+    import tempfile
+
+    from ambfplus.recording import Recorder
+    from ambfplus.stereo import StereoRig
+
+    world = ambfplus.World()
+    world.add_volume("ear", ambfplus.phantom(128))
+    # The paper's optics (f = 1135 px at 640x480, 65 mm baseline), 120 mm from the 48 mm phantom
+    # so that anatomy covers about 40 % of each view.
+    rig = StereoRig(
+        world, "rig", baseline=0.065, width=640, height=480,
+        fov_y=2 * np.arctan(240 / 1135), working_distance=0.12,
+    )  # fmt: skip
+    rig.look_at((0.0155, -0.072, 0.084), (-0.0325, 0.0, 0.0))
+    passes = ("rgb", "depth", "label", "instance")
+    rounds, per_round = (3, 12) if args.quick else (5, 30)
+
+    def capture_round(recorder=None) -> tuple[float, float]:
+        w0, c0 = time.perf_counter(), time.process_time()
+        for _ in range(per_round):
+            world.step(1)
+            pair = rig.capture(passes)
+            if recorder is not None:
+                recorder.add_stereo("rig", pair)
+        if recorder is not None:
+            recorder.flush()
+        return time.perf_counter() - w0, time.process_time() - c0
+
+    with tempfile.TemporaryDirectory() as folder:
+        rig.capture(passes)  # warm-up: programs, targets
+        times = {"plain": [], "lzf": [], None: []}
+        recorders = {
+            kind: Recorder(Path(folder) / f"{kind}.h5", compression=kind) for kind in ("lzf", None)
+        }
+        for recorder in recorders.values():
+            recorder.set_legend(world)
+        for _ in range(rounds):
+            times["plain"].append(capture_round())
+            for kind, recorder in recorders.items():
+                times[kind].append(capture_round(recorder))
+        sizes = {}
+        for kind, recorder in recorders.items():
+            recorder.close()
+            sizes[kind] = sum(p.stat().st_size for p in Path(folder).glob(f"{kind}.h5*"))
+        stats = recorders["lzf"].stats
+        replay = _replay_throughput(Path(folder) / "replay.h5", rig.capture(passes), 2 * per_round)
+
+    pairs = rounds * per_round
+    pair_bytes = stats.bytes_written / pairs
+
+    def median(kind, which) -> float:
+        return statistics.median(t[which] for t in times[kind]) / per_round
+
+    plain_wall, plain_cpu = median("plain", 0), median("plain", 1)
+    common = {"frame": "640x480 stereo pair, rgb+depth+label+instance", "quick": args.quick}
+    for kind, suffix in (("lzf", ""), (None, "_uncompressed")):
+        wall, cpu = median(kind, 0), median(kind, 1)
+        yield {
+            "bench": f"recording_capture_rate{suffix}",
+            "value": round(1 / wall, 2),
+            "unit": "pairs/s (wall)",
+            "baseline": round(1 / plain_wall, 2),
+            "ratio": round(plain_wall / wall, 4),
+            "target_ratio": 0.9,
+            "cpu_s_per_pair": round(cpu, 4),
+            "baseline_cpu_s_per_pair": round(plain_cpu, 4),
+            "cpu_ratio": round(cpu / plain_cpu, 4),
+            "frames_per_s": round(2 / wall, 2),
+            "mb_per_s": round(pair_bytes / wall / 1e6, 1),
+            "file_mb_per_pair": round(sizes[kind] / pairs / 1e6, 3),
+            "compression": kind or "none",
+            "what": "capture loop recording every pair (flushed each round) vs not recording",
+            **common,
+        }
+    yield {
+        "bench": "recording_writer_throughput",
+        "value": round(replay["bytes"] / replay["wall"] / 1e6, 1),
+        "unit": "MB/s (uncompressed)",
+        "baseline": round(pair_bytes / plain_wall / 1e6, 1),
+        "ratio": round(replay["bytes"] / replay["wall"] / (pair_bytes / plain_wall), 3),
+        "frames_per_s": round(2 * replay["pairs"] / replay["wall"], 1),
+        "cpu_s_per_pair": round(replay["cpu"] / replay["pairs"], 4),
+        "pair_mb": round(pair_bytes / 1e6, 3),
+        "compression_ratio": round(stats.bytes_written / sizes["lzf"], 2),
+        "seconds_blocked": round(stats.seconds_blocked, 3),
+        "queue_high_water_mb": round(stats.pending_high_water_bytes / 1e6, 1),
+        "what": "the recorder alone (copy, queue, lzf, HDF5, until closed) replaying a captured "
+        "pair; baseline: the data rate of the capture loop without recording",
+        **common,
+    }
+
+
+def _replay_throughput(path: Path, pair, pairs: int) -> dict:
+    """Wall and CPU seconds to record ``pairs`` copies of one captured pair, until closed."""
+    from ambfplus.recording import Recorder
+    from ambfplus.stereo import StereoFrame
+
+    w0, c0 = time.perf_counter(), time.process_time()
+    with Recorder(path) as recorder:
+        for i in range(pairs):
+            views = [_with_step(view, i + 1) for view in (pair.left, pair.right)]
+            recorder.add_stereo("rig", StereoFrame(*views, pair.baseline, pair.dcx))
+    return {
+        "wall": time.perf_counter() - w0,
+        "cpu": time.process_time() - c0,
+        "bytes": recorder.stats.bytes_written,
+        "pairs": pairs,
+    }
+
+
+def _with_step(frame, step: int) -> dict:
+    """A captured view as a mapping with its own step (streams need increasing steps)."""
+    out = {name: getattr(frame, name) for name in ("rgb", "depth", "label", "instance")}
+    out.update(
+        camera=frame.camera, time=step * 1e-3, step=step, intrinsics=frame.intrinsics,
+        pose=frame.pose,
+    )  # fmt: skip
+    return out
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--only", choices=sorted(BENCHMARKS), help="run one benchmark")

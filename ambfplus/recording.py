@@ -1,0 +1,924 @@
+"""Lossless, self-describing HDF5 recordings of a session: camera streams, stereo rigs, physics
+steps, removed voxels and events, written by a background thread and safe against a crash.
+
+    from ambfplus.recording import Recorder, open_recording, validate
+
+    with Recorder("session.h5", metadata={"scene": "ear.yaml", "seed": 0}) as rec:
+        rec.set_legend(world)                       # or ambfplus.stereo.legend(world)
+        for _ in range(100):
+            world.step(10)
+            rec.add_stereo("rig", rig.capture(passes=["rgb", "depth", "label", "voxel"]))
+            rec.add_steps({"step": [world.step_index], "time": [world.time]})
+            rec.add_removed(drill.take_removed(), volume="ear")
+            rec.add_events(drill.take_events())
+    rec = open_recording("session.h5")
+    rec.cameras["rig_left"][5].depth, rec.rigs["rig"][5].baseline, rec.steps["time"]
+
+Files
+-----
+A recording named ``session.h5`` is a *head* file ``session.h5`` plus closed *parts*
+``session.h5.part0001``, ``session.h5.part0002``, ... in the same folder. Each part is a complete
+HDF5 file holding the rows written during one flush interval, in the layout below. The head holds
+the description (attributes below) and, once the recorder has closed, one virtual dataset
+(HDF5 VDS) per dataset that concatenates the parts, so that plain h5py reads the whole session
+from the head alone::
+
+    import h5py, json
+    with h5py.File("session.h5") as f:          # keep the parts beside it
+        depth = f["cameras/rig_left/depth"][5]  # float32 (H, W), metres
+        legend = json.loads(f.attrs["legend"])
+
+After a crash the head has no virtual datasets yet (``complete`` is False): read the parts in
+order and concatenate along axis 0 (``open_recording`` does this), or call ``repair(path)``,
+which writes them.
+
+Layout of a part (and of a complete head)
+-----------------------------------------
+Every dataset is chunked and resizable along axis 0 (``maxshape`` None); images are stored one
+frame per chunk, small columns in chunks of about 64 KiB, all lzf-compressed (``compression``
+picks gzip or none instead); float datasets (depth, points) add the shuffle filter, which halves
+their size. Both filters are built into h5py; gzip and shuffle into every HDF5 library.
+All datasets of a group have the same length N (their rows belong together).
+
+``cameras/<stream>/`` (attribute ``camera``: the camera's name), one row per frame:
+    ``rgb`` uint8 (N, H, W, 3) RGB; ``depth`` float32 (N, H, W) metric z, 0 = no hit;
+    ``instance`` int32 (N, H, W) object ids (0 = background); ``label`` uint16 (N, H, W) volume
+    label ids (0 = none); ``voxel`` int32 (N, H, W) voxel index i + nx (j + ny k), -1 = none;
+    ``points`` float32 (N, H, W, 3) camera frame, only when asked for (it follows from depth);
+    ``time`` float64 (N,) s; ``step`` int64 (N,); ``intrinsics`` float64 (N, 3, 3);
+    ``pose`` float64 (N, 4, 4) world-from-camera (OpenCV camera frame).
+    A stream holds the same image passes in every frame.
+``rigs/<rig>/`` (attributes ``left``, ``right``: the two streams), one row per stereo pair:
+    ``time`` float64, ``step`` int64, ``baseline`` float64 (m), ``dcx`` float64 (px,
+    cx_right - cx_left), ``left_index``, ``right_index`` int64 (the pair's rows in the streams).
+``steps/``: columns at the physics rate, whatever the producer gives (leading dimension = number
+    of steps), always with ``step`` int64 and ``time`` float64.
+``removed/`` (attribute ``volume``: the volume's name): ``step`` int64 (M,), ``voxel`` int32
+    (M, 3) global (i, j, k), never restarting; ``label`` uint16 (M,) the label it had.
+``events/``: ``step`` int64, ``kind`` UTF-8 string, ``label`` uint16, ``voxel`` int32 (K, 3)
+    (-1, -1, -1 when an event has no voxel).
+
+Attributes of the head's root (parts carry the first four):
+    ``format`` = "ambfplus.recording", ``ambfplus_recording_version`` = 1, ``recording_id`` (a
+    UUID every part repeats), ``part`` (in parts: its number), ``created`` (ISO 8601 UTC),
+    ``software_version`` (ambfplus), ``h5py_version``, ``hdf5_version``, ``metadata`` (JSON: the
+    user's dict), ``legend`` (JSON: object id -> {name, kind, model, color}; volumes add
+    ``labels`` {id -> {name, color}}, ``shape`` (nx, ny, nz), ``dimensions`` and ``voxel_size``
+    in metres), ``complete`` (True once closed), ``parts`` (JSON list of part file names).
+    Group ``conventions`` has one string attribute per convention: units (SI), world frame (z
+    up), camera frame (OpenCV), pixel centres at (c + 0.5, r + 0.5) in the intrinsics, depth,
+    points, ids, voxel index order, stereo.
+
+Reading
+-------
+``open_recording(path)`` checks the head and every part (format, version, numbering, equal
+lengths) and raises ``RecordingError`` (a ``ConfigError``, so a ``ValueError``) naming the file
+and dataset otherwise. ``rec.cameras[name]`` has ``len``, ``[i]`` (a ``RecordedFrame``: arrays,
+time, step, intrinsics, pose) and lazy columns ``.rgb``, ``.depth``, ... that read only what is
+indexed; ``rec.rigs[name][i]`` is an ``ambfplus.stereo.StereoFrame`` of two recorded frames;
+``rec.steps`` (dict of arrays), ``rec.removed``, ``rec.events``, ``rec.metadata``,
+``rec.legend`` (integer ids again), ``rec.version``. ``validate(path)`` (``ambfplus validate
+PATH``) checks the recording against itself and the conventions.
+
+Unlike the original system's recordings: depth stays float32 and poses float64, with no scale
+factors; every frame carries its own intrinsics and pose; voxel indices are global; nothing is
+dropped: a full queue blocks the producer instead.
+
+Crash safety: why closed parts and not SWMR
+-------------------------------------------
+HDF5's single-writer/multiple-reader mode cannot create datasets once it is switched on, but
+streams, step columns and event logs appear while a session runs; and a file whose writer died
+stays marked as open for writing, so ordinary readers refuse it until ``h5clear`` is run. A file
+that is open for writing is not consistent on disk between flushes in any other mode either.
+So the writer never lets an open file matter: every ``flush_interval_s`` (and on ``flush()`` and
+``close()``) it closes the current part, written as ``<part>.tmp``, and renames it into place,
+which is atomic. A process killed at any moment (SIGKILL included) leaves the head (written at
+start, replaced atomically), every renamed part, and at most one ``.tmp`` file that readers
+ignore: every frame up to the last flush survives with its exact bytes. The price is one file per
+flush interval; raise ``flush_interval_s`` for long sessions if that matters more than the
+seconds at risk. Surviving power loss as well would need fsync, which this does not do.
+"""
+
+from __future__ import annotations
+
+import atexit
+import os
+import sys
+import threading
+import time
+import uuid
+import weakref
+from collections import deque
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
+from datetime import datetime, timezone
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+from . import __version__
+from .recording_reader import (
+    CameraStream,
+    Column,
+    RecordedFrame,
+    Recording,
+    RigStream,
+    open_recording,
+    scan_parts,
+)
+from .recording_schema import (
+    CONVENTIONS,
+    EVENT_COLUMNS,
+    FORMAT,
+    FRAME_COLUMNS,
+    IMAGE_PASSES,
+    IMAGE_ROW_BYTES,
+    REMOVED_COLUMNS,
+    RIG_COLUMNS,
+    SMALL_CHUNK_BYTES,
+    STEP_REQUIRED,
+    VERSION,
+    VERSION_ATTR,
+    GroupSummary,
+    PartSummary,
+    RecordingError,
+    find_parts,
+    part_name,
+    string_dtype,
+    temporary_name,
+    to_json,
+)
+from .recording_validate import Check, ValidationReport, validate
+from .stereo import legend as object_legend
+
+__all__ = [
+    "CameraStream",
+    "Check",
+    "Column",
+    "RecordedFrame",
+    "Recorder",
+    "RecorderStats",
+    "Recording",
+    "RecordingError",
+    "RigStream",
+    "ValidationReport",
+    "open_recording",
+    "repair",
+    "validate",
+    "world_legend",
+]
+
+MiB = 1024 * 1024
+# Passes recorded when add_frame is not told which: everything a frame holds except points,
+# which follow from depth and the intrinsics and would double the size.
+DEFAULT_PASSES = ("rgb", "depth", "instance", "label", "voxel")
+COMPRESSIONS = ("lzf", "gzip", None)
+# Gathered small columns are written out once they reach this size.
+BUFFER_BYTES = 8 * MiB
+
+
+@dataclass
+class RecorderStats:
+    """Counters of a recorder (a snapshot; ``Recorder.stats`` returns a fresh one)."""
+
+    frames_queued: int = 0
+    frames_written: int = 0  #: handed to HDF5 by the writer thread
+    frames_flushed: int = 0  #: in closed parts: these survive a crash
+    bytes_queued: int = 0  #: uncompressed bytes handed to the recorder
+    bytes_written: int = 0
+    seconds_blocked: float = 0.0  #: producer time spent waiting for queue space
+    blocked_calls: int = 0
+    pending_bytes: int = 0
+    pending_high_water_bytes: int = 0
+    parts: int = 0
+
+
+@dataclass
+class _Rows:
+    """Rows appended to one group; ``frames`` counts camera frames among them."""
+
+    group: str
+    columns: dict[str, np.ndarray]
+    attrs: dict = field(default_factory=dict)
+    frames: int = 0
+    nbytes: int = 0
+
+    def __post_init__(self) -> None:
+        self.nbytes = sum(column.nbytes for column in self.columns.values())
+
+    @property
+    def count(self) -> int:
+        return len(next(iter(self.columns.values())))
+
+
+@dataclass
+class _Legend:
+    text: str
+    nbytes: int = 0
+
+
+@dataclass
+class _Flush:
+    done: threading.Event = field(default_factory=threading.Event)
+    nbytes: int = 0
+
+
+_CLOSE = object()
+
+
+class Recorder:
+    """Records frames, stereo pairs, steps, removed voxels and events into ``path`` (see the
+    module docstring for the layout). All HDF5 work happens on a background thread; ``add_*``
+    copies its arrays and returns, or blocks while ``max_pending_bytes`` are waiting (HDF5's
+    chunk cache, up to 8 MiB per image dataset, comes on top). Parts close every
+    ``flush_interval_s``; ``compression`` is "lzf", "gzip" or None."""
+
+    def __init__(
+        self,
+        path,
+        metadata: dict | None = None,
+        *,
+        max_pending_bytes: int = 512 * MiB,
+        flush_interval_s: float = 1.0,
+        compression: str | None = "lzf",
+        overwrite: bool = False,
+    ) -> None:
+        if not max_pending_bytes > 0:
+            raise ValueError(f"max_pending_bytes must be > 0, got {max_pending_bytes}")
+        if not flush_interval_s > 0:
+            raise ValueError(f"flush_interval_s must be > 0 s, got {flush_interval_s}")
+        if compression not in COMPRESSIONS:
+            raise ValueError(f"compression must be one of {COMPRESSIONS}, got {compression!r}")
+        self.path = Path(path)
+        self.max_pending_bytes = int(max_pending_bytes)
+        self.flush_interval_s = float(flush_interval_s)
+        self.compression = compression
+        self._head = _HeadInfo(
+            recording_id=uuid.uuid4().hex,
+            created=datetime.now(timezone.utc).isoformat(),
+            metadata=to_json(metadata or {}, "metadata"),
+        )
+        # Producer side: what each group holds, so that a mismatch fails in the caller.
+        self._producer_lock = threading.RLock()
+        self._schemas: dict[str, dict[str, tuple[np.dtype, tuple]]] = {}
+        self._group_attrs: dict[str, dict] = {}
+        self._rows_queued: dict[str, int] = {}
+        # Queue shared with the writer thread.
+        self._cond = threading.Condition()
+        self._queue: deque = deque()
+        self._stats = RecorderStats()
+        self._pending = 0  # bytes queued or being written
+        self._error: BaseException | None = None
+        self._closing = False
+        # Writer side.
+        self._part: _PartFile | None = None
+        self._parts: list[PartSummary] = []
+        self._head_dirty = False
+
+        _prepare_path(self.path, overwrite)
+        write_head(self.path, self._head, [], complete=False)
+        self._thread = threading.Thread(target=self._run, name=f"recorder {self.path.name}")
+        self._thread.daemon = True
+        self._thread.start()
+        _OPEN_RECORDERS.add(self)
+
+    # Producer API -----------------------------------------------------------------------
+
+    def add_frame(self, stream_name: str, frame, *, passes=None) -> None:
+        """Appends one camera frame (an ``ambfplus.Frame``, or any object or mapping with its
+        attributes) to ``cameras/<stream_name>``. ``passes`` picks image passes (default: all
+        the frame holds but ``points``)."""
+        with self._producer_lock:
+            rows = _frame_rows(stream_name, frame, passes)
+            self._submit([rows])
+
+    def add_stereo(self, rig_name: str, stereo_frame, *, passes=None) -> None:
+        """Appends both views of a ``StereoFrame`` (streams named after the two cameras) and a
+        row of ``rigs/<rig_name>`` (baseline, dcx and the views' row indices)."""
+        left_name = _camera_name(stereo_frame.left, f"{rig_name}_left")
+        right_name = _camera_name(stereo_frame.right, f"{rig_name}_right")
+        if left_name == right_name:
+            raise ValueError(f"rig {rig_name}: both views come from camera '{left_name}'")
+        with self._producer_lock:
+            left = _frame_rows(left_name, stereo_frame.left, passes)
+            right = _frame_rows(right_name, stereo_frame.right, passes)
+            rig = _rig_rows(
+                rig_name,
+                stereo_frame,
+                left_name,
+                right_name,
+                self._rows_queued.get(left.group, 0),
+                self._rows_queued.get(right.group, 0),
+            )
+            self._submit([left, right, rig])
+
+    def add_steps(self, columns: Mapping) -> None:
+        """Appends rows at the physics rate: equal-length columns, ``step`` and ``time``
+        included. Scalars make one row. Every call must give the same columns."""
+        with self._producer_lock:
+            self._submit([_step_rows(columns)])
+
+    def add_removed(self, removed: Mapping, volume: str | None = None) -> None:
+        """Appends removed voxels: ``step`` (M,) or one step, ``voxel`` (M, 3) global indices,
+        ``label`` (M,), as ``Drill.removed`` gives them; ``volume`` (a name or a Volume) says
+        whose voxels they are."""
+        volume = getattr(volume, "name", volume) or removed.get("volume")
+        with self._producer_lock:
+            # Later calls may leave the volume out: it stays the first call's.
+            volume = volume or self._group_attrs.get("removed", {}).get("volume")
+            rows = _removed_rows(removed, volume)
+            if rows is not None:
+                self._submit([rows])
+
+    def add_events(self, events) -> None:
+        """Appends events: dicts with ``step`` and ``kind``, optional ``label`` and ``voxel``
+        (``Drill.events`` gives them)."""
+        with self._producer_lock:
+            rows = _event_rows(list(events))
+            if rows is not None:
+                self._submit([rows])
+
+    def set_legend(self, legend) -> None:
+        """Stores the id legend: a dict as ``ambfplus.stereo.legend(world)`` gives it, or a
+        ``World`` (then volumes also record their shape, which the voxel checks need)."""
+        if hasattr(legend, "objects"):
+            legend = world_legend(legend)
+        self._enqueue([_Legend(to_json(legend, "legend"))])
+
+    def flush(self) -> None:
+        """Returns once everything added so far is in a closed part (safe from a crash)."""
+        marker = _Flush()
+        self._enqueue([marker])
+        while not marker.done.wait(0.05):
+            self._raise_if_failed()
+        self._raise_if_failed()
+
+    def close(self) -> None:
+        """Writes what is queued, closes the last part and completes the head. Raises the
+        writer thread's error, if it had one."""
+        with self._cond:
+            if not self._closing:
+                self._closing = True
+                self._queue.append(_CLOSE)
+                self._cond.notify_all()
+        self._thread.join()
+        _OPEN_RECORDERS.discard(self)
+        self._raise_if_failed()
+
+    @property
+    def stats(self) -> RecorderStats:
+        with self._cond:
+            return replace(self._stats, pending_bytes=self._pending)
+
+    def __enter__(self) -> Recorder:
+        return self
+
+    def __exit__(self, *exc_info) -> None:
+        self.close()
+
+    # Queue ---------------------------------------------------------------------------------
+
+    def _submit(self, rows: list[_Rows]) -> None:
+        """Checks rows against their groups' schemas, then queues them (caller holds the
+        producer lock, so that a stereo pair's row indices stay right)."""
+        for item in rows:
+            self._register(item)
+        self._enqueue(rows)
+        for item in rows:
+            self._rows_queued[item.group] = self._rows_queued.get(item.group, 0) + item.count
+
+    def _register(self, rows: _Rows) -> None:
+        schema = {name: (a.dtype, a.shape[1:]) for name, a in rows.columns.items()}
+        known = self._schemas.setdefault(rows.group, schema)
+        if known != schema:
+            raise ValueError(f"{self.path}: {rows.group}: {_schema_difference(known, schema)}")
+        attrs = self._group_attrs.setdefault(rows.group, rows.attrs)
+        if attrs != rows.attrs:
+            raise ValueError(
+                f"{self.path}: {rows.group}: attributes {rows.attrs} differ from {attrs}"
+            )
+
+    def _enqueue(self, items: list) -> None:
+        size = sum(item.nbytes for item in items)
+        with self._cond:
+            self._raise_if_failed()
+            if self._closing:
+                raise RecordingError(f"{self.path}: the recorder is closed")
+            self._wait_for_space(size)
+            self._queue.extend(items)
+            self._pending += size
+            stats = self._stats
+            stats.bytes_queued += size
+            stats.frames_queued += sum(getattr(item, "frames", 0) for item in items)
+            stats.pending_high_water_bytes = max(stats.pending_high_water_bytes, self._pending)
+            self._cond.notify_all()
+
+    def _wait_for_space(self, size: int) -> None:
+        """Backpressure: blocks while the queue is full (an item larger than the whole budget
+        still goes through once the queue is empty)."""
+        start = None
+        while 0 < self._pending and self._pending + size > self.max_pending_bytes:
+            if start is None:
+                start = time.perf_counter()
+                self._stats.blocked_calls += 1
+            self._cond.wait()
+            self._raise_if_failed()
+        if start is not None:
+            self._stats.seconds_blocked += time.perf_counter() - start
+
+    def _raise_if_failed(self) -> None:
+        if self._error is not None:
+            raise RecordingError(
+                f"{self.path}: the recording's writer thread failed ({self._error!r}); data "
+                "up to its last flush is intact, nothing after it was written"
+            ) from self._error
+
+    # Writer thread -------------------------------------------------------------------------
+
+    def _run(self) -> None:
+        try:
+            self._write_until_closed()
+        except BaseException as error:  # surfaced in the producer
+            self._abandon_part()
+            with self._cond:
+                self._error = error
+                self._queue.clear()
+                self._pending = 0
+                self._cond.notify_all()
+
+    def _write_until_closed(self) -> None:
+        deadline = time.monotonic() + self.flush_interval_s
+        while True:
+            item = self._next_item(deadline)
+            if item is _CLOSE:
+                self._finish()
+                return
+            if item is not None:
+                self._write(item)
+                self._done_with(item)
+            if item is None or time.monotonic() >= deadline or isinstance(item, _Flush):
+                self._rotate()
+                if isinstance(item, _Flush):
+                    item.done.set()
+                deadline = time.monotonic() + self.flush_interval_s
+
+    def _next_item(self, deadline: float):
+        """The next queued item, or None when the flush deadline passes first."""
+        with self._cond:
+            while not self._queue:
+                remaining = deadline - time.monotonic()
+                if remaining <= 0:
+                    return None
+                self._cond.wait(remaining)
+            return self._queue.popleft()
+
+    def _done_with(self, item) -> None:
+        with self._cond:
+            self._pending -= item.nbytes
+            self._stats.bytes_written += item.nbytes
+            self._stats.frames_written += getattr(item, "frames", 0)
+            self._cond.notify_all()
+
+    def _write(self, item) -> None:
+        """Writes one queued item (runs on the writer thread)."""
+        if isinstance(item, _Rows):
+            if self._part is None:
+                number = len(self._parts) + 1
+                self._part = _PartFile(part_name(self.path, number), self._head, self.compression)
+            self._part.append(item)
+        elif isinstance(item, _Legend):
+            self._head.legend = item.text
+            self._head_dirty = True
+
+    def _rotate(self) -> None:
+        """Closes the current part and renames it into place; rewrites the head if needed."""
+        if self._part is not None:
+            summary = self._part.close()
+            self._part = None
+            self._parts.append(summary)
+            frames = sum(
+                group.rows for name, group in summary.groups.items() if name.startswith("cameras/")
+            )
+            with self._cond:
+                self._stats.frames_flushed += frames
+                self._stats.parts += 1
+        if self._head_dirty:
+            write_head(self.path, self._head, self._parts, complete=False)
+            self._head_dirty = False
+
+    def _finish(self) -> None:
+        self._rotate()
+        write_head(self.path, self._head, self._parts, complete=True)
+
+    def _abandon_part(self) -> None:
+        """After a failure the open part is left as its .tmp file, which readers ignore."""
+        if self._part is not None:
+            try:
+                self._part.file.close()
+            except Exception:
+                pass  # the original error is the one to report
+            self._part = None
+
+
+# Recorders a script forgot to close still finish their files when the interpreter exits (the
+# writer is a daemon thread, so that it never keeps a process alive by itself).
+_OPEN_RECORDERS: weakref.WeakSet = weakref.WeakSet()
+
+
+@atexit.register
+def _close_open_recorders() -> None:
+    for recorder in list(_OPEN_RECORDERS):
+        try:
+            recorder.close()
+        except Exception as error:  # at exit there is no caller left to raise to
+            print(f"ambfplus: {error}", file=sys.stderr)
+
+
+# Rows from frames, steps, removals and events ----------------------------------------------
+
+
+def _camera_name(frame, default: str) -> str:
+    name = frame.get("camera") if isinstance(frame, Mapping) else getattr(frame, "camera", None)
+    return str(name) if name else default
+
+
+def _field(frame, name: str):
+    return frame.get(name) if isinstance(frame, Mapping) else getattr(frame, name, None)
+
+
+def _frame_rows(stream: str, frame, passes) -> _Rows:
+    """One frame as a row of ``cameras/<stream>``, every array copied (frames are views of
+    engine buffers that the next capture overwrites)."""
+    _check_name(stream, "stream")
+    group = f"cameras/{stream}"
+    wanted = DEFAULT_PASSES if passes is None else tuple(passes)
+    unknown = set(wanted) - set(IMAGE_PASSES)
+    if unknown:
+        raise ValueError(
+            f"{group}: unknown passes {sorted(unknown)}: expected {list(IMAGE_PASSES)}"
+        )
+    columns = {}
+    for name in wanted:
+        image = _field(frame, name)
+        if image is None:
+            if passes is not None:
+                raise ValueError(f"{group}: the frame has no '{name}' image")
+            continue
+        dtype, trailing = IMAGE_PASSES[name]
+        _check_image(np.asarray(image), trailing, f"{group}/{name}")
+        columns[name] = _copy_as(image, dtype, f"{group}/{name}")[None]
+    if not columns:
+        raise ValueError(f"{group}: the frame holds none of the passes {list(wanted)}")
+    _check_same_size(columns, group)
+    for name, (dtype, trailing) in FRAME_COLUMNS.items():
+        value = _field(frame, name)
+        if value is None:
+            raise ValueError(f"{group}: the frame has no '{name}'")
+        columns[name] = _copy_as(value, dtype, f"{group}/{name}")[None]
+        _check_row(columns[name][0], trailing, f"{group}/{name}")
+    return _Rows(group, columns, {"camera": _camera_name(frame, stream)}, frames=1)
+
+
+def _rig_rows(rig, stereo, left: str, right: str, left_index: int, right_index: int) -> _Rows:
+    _check_name(rig, "rig")
+    values = {
+        "time": _field(stereo.left, "time"),
+        "step": _field(stereo.left, "step"),
+        "baseline": stereo.baseline,
+        "dcx": stereo.dcx,
+        "left_index": left_index,
+        "right_index": right_index,
+    }
+    columns = {
+        name: _copy_as(values[name], dtype, f"rigs/{rig}/{name}")[None]
+        for name, (dtype, _) in RIG_COLUMNS.items()
+    }
+    return _Rows(f"rigs/{rig}", columns, {"left": left, "right": right})
+
+
+def _step_rows(columns: Mapping) -> _Rows:
+    missing = [name for name in STEP_REQUIRED if name not in columns]
+    if missing:
+        raise ValueError(f"steps: columns {missing} are required (got {sorted(columns)})")
+    one_row = np.ndim(columns["step"]) == 0
+    out = {}
+    for name, value in columns.items():
+        _check_name(name, "steps column")
+        array = np.asarray(value)
+        array = array[None] if one_row else array
+        if name in STEP_REQUIRED:
+            out[name] = _copy_as(array, STEP_REQUIRED[name], f"steps/{name}")
+        else:
+            out[name] = _copy_column(array, f"steps/{name}")
+    _check_lengths(out, "steps")
+    return _Rows("steps", out)
+
+
+def _removed_rows(removed: Mapping, volume: str | None) -> _Rows | None:
+    voxel = np.asarray(removed["voxel"])
+    if voxel.size == 0:
+        return None
+    step = np.asarray(removed["step"])
+    count = len(voxel)
+    columns = {
+        "step": np.broadcast_to(step, (count,)) if step.ndim == 0 else step,
+        "voxel": voxel,
+        "label": np.asarray(removed["label"]),
+    }
+    for name, (dtype, trailing) in REMOVED_COLUMNS.items():
+        columns[name] = _copy_as(columns[name], dtype, f"removed/{name}")
+        if columns[name].ndim != 1 + len(trailing):
+            raise ValueError(f"removed/{name}: expected shape (M,) + {trailing}")
+        _check_row(columns[name][0], trailing, f"removed/{name}")
+    _check_lengths(columns, "removed")
+    return _Rows("removed", columns, {"volume": volume} if volume else {})
+
+
+def _event_rows(events: list) -> _Rows | None:
+    if not events:
+        return None
+    allowed = set(EVENT_COLUMNS)
+    for event in events:
+        unknown = set(event) - allowed
+        if unknown or "step" not in event or "kind" not in event:
+            raise ValueError(
+                f"events: each event needs 'step' and 'kind' and may have 'label' and 'voxel'; "
+                f"got keys {sorted(event)}"
+            )
+    columns = {
+        "step": np.array([e["step"] for e in events]),
+        "kind": np.array([str(e["kind"]) for e in events], dtype=object),
+        "label": np.array([e.get("label", 0) for e in events]),
+        "voxel": np.array([tuple(e.get("voxel", (-1, -1, -1))) for e in events]).reshape(-1, 3),
+    }
+    for name, (dtype, _) in EVENT_COLUMNS.items():
+        if dtype is not None:
+            columns[name] = _copy_as(columns[name], dtype, f"events/{name}")
+    return _Rows("events", columns)
+
+
+def _copy_as(value, dtype: np.dtype, where: str) -> np.ndarray:
+    """A C-contiguous copy in ``dtype``, refusing conversions that would lose information."""
+    array = np.asarray(value)
+    if array.dtype == dtype or np.can_cast(array.dtype, dtype, casting="safe"):
+        return np.array(array, dtype=dtype, order="C", copy=True)
+    if array.dtype.kind in "iub" and dtype.kind in "iu":
+        info = np.iinfo(dtype)
+        if array.size == 0 or (array.min() >= info.min and array.max() <= info.max):
+            return np.array(array, dtype=dtype, order="C", copy=True)
+    raise ValueError(f"{where}: cannot store {array.dtype} as {dtype} without loss")
+
+
+def _copy_column(array: np.ndarray, where: str) -> np.ndarray:
+    """A producer's step column: numbers and booleans as they are, text as UTF-8 strings."""
+    if array.dtype.kind == "U" or (
+        array.dtype.kind == "O" and all(isinstance(v, str) for v in array.ravel())
+    ):
+        return np.array(array.tolist(), dtype=object)
+    if array.dtype.kind not in "biufcS":
+        raise ValueError(f"{where}: cannot record values of dtype {array.dtype}")
+    if array.ndim == 0:
+        raise ValueError(f"{where}: expected one value per step, got a scalar")
+    return np.array(array, order="C", copy=True)
+
+
+def _check_image(image: np.ndarray, trailing: tuple, where: str) -> None:
+    if image.ndim != 2 + len(trailing) or image.shape[2:] != trailing:
+        expected = ("H", "W") + trailing
+        raise ValueError(f"{where}: expected an image of shape {expected}, got {image.shape}")
+
+
+def _check_row(row: np.ndarray, trailing: tuple, where: str) -> None:
+    if row.shape != trailing:
+        raise ValueError(f"{where}: expected rows of shape {trailing}, got {row.shape}")
+
+
+def _check_same_size(columns: dict, group: str) -> None:
+    sizes = {name: a.shape[1:3] for name, a in columns.items()}
+    if len(set(sizes.values())) > 1:
+        raise ValueError(f"{group}: images of different sizes {sizes}")
+
+
+def _check_lengths(columns: dict, group: str) -> None:
+    lengths = {name: len(a) for name, a in columns.items()}
+    if len(set(lengths.values())) > 1:
+        raise ValueError(f"{group}: columns of different lengths {lengths}")
+
+
+def _check_name(name: str, what: str) -> None:
+    if not name or "/" in name or name in (".", ".."):
+        raise ValueError(f"invalid {what} name '{name}' (non-empty, no '/')")
+
+
+def _schema_difference(known: dict, got: dict) -> str:
+    if set(known) != set(got):
+        return f"datasets {sorted(got)} differ from the first rows' {sorted(known)}"
+    for name in known:
+        if known[name] != got[name]:
+            return f"{name}: {got[name]} differs from the first rows' {known[name]}"
+    return "schema differs"
+
+
+# Files -------------------------------------------------------------------------------------
+
+
+@dataclass
+class _HeadInfo:
+    recording_id: str
+    created: str
+    metadata: str
+    legend: str = "{}"
+
+
+class _PartFile:
+    """The segment being written, as ``<part>.tmp`` until ``close`` renames it into place."""
+
+    def __init__(self, path: Path, head: _HeadInfo, compression: str | None) -> None:
+        self.path = path
+        self.compression = compression
+        self.tmp = temporary_name(path)
+        self.file = h5py.File(self.tmp, "w")
+        self.file.attrs.update(
+            {
+                "format": FORMAT,
+                VERSION_ATTR: VERSION,
+                "recording_id": head.recording_id,
+                "part": _number_of(path),
+            }
+        )
+        self.summary = PartSummary(path)
+        self._buffers: dict[tuple[str, str], list[np.ndarray]] = {}
+        self._buffered_bytes: dict[tuple[str, str], int] = {}
+        # Open datasets stay open: reopening one per write costs as much as compressing it.
+        self._datasets: dict[tuple[str, str], h5py.Dataset] = {}
+
+    def append(self, rows: _Rows) -> None:
+        group = self.summary.groups.get(rows.group)
+        if group is None:
+            group = self.summary.groups[rows.group] = _new_group_summary(rows)
+            self.file.require_group(rows.group).attrs.update(rows.attrs)
+        is_camera = rows.group.startswith("cameras/")
+        for name, data in rows.columns.items():
+            if (is_camera and name in IMAGE_PASSES) or data.nbytes // len(data) >= IMAGE_ROW_BYTES:
+                self._append(rows.group, name, data, chunk_rows=1)
+            else:
+                self._buffer(rows.group, name, data)
+        group.rows += len(next(iter(rows.columns.values())))
+
+    def _buffer(self, group: str, name: str, data: np.ndarray) -> None:
+        key = (group, name)
+        self._buffers.setdefault(key, []).append(data)
+        self._buffered_bytes[key] = self._buffered_bytes.get(key, 0) + data.nbytes
+        if self._buffered_bytes[key] >= BUFFER_BYTES:
+            self._write_buffer(group, name)
+
+    def _write_buffer(self, group: str, name: str) -> None:
+        self._buffered_bytes.pop((group, name), None)
+        pieces = self._buffers.pop((group, name), [])
+        if pieces:
+            data = np.concatenate(pieces)
+            row_bytes = max(data.nbytes // len(data), 1)
+            chunk_rows = max(1, min(len(data), SMALL_CHUNK_BYTES // row_bytes))
+            self._append(group, name, data, chunk_rows)
+
+    def _append(self, group: str, name: str, data: np.ndarray, chunk_rows: int) -> None:
+        """Appends rows to a chunked dataset resizable along axis 0, creating it if needed."""
+        dataset = self._datasets.get((group, name))
+        if dataset is None:
+            self._datasets[group, name] = _create(
+                self.file[group], name, data, chunk_rows, self.compression
+            )
+            return
+        start = dataset.shape[0]
+        dataset.resize(start + len(data), axis=0)
+        dataset[start:] = data
+
+    def close(self) -> PartSummary:
+        for group, name in list(self._buffers):
+            self._write_buffer(group, name)
+        self._datasets.clear()
+        self.file.close()
+        os.replace(self.tmp, self.path)
+        return self.summary
+
+
+def _new_group_summary(rows: _Rows) -> GroupSummary:
+    datasets = {name: (a.dtype, a.shape[1:]) for name, a in rows.columns.items()}
+    return GroupSummary(0, datasets, dict(rows.attrs))
+
+
+def _create(
+    group: h5py.Group, name: str, data: np.ndarray, chunk_rows: int, compression: str | None
+) -> h5py.Dataset:
+    is_text = data.dtype.kind == "O"
+    compression = None if is_text else compression
+    return group.create_dataset(
+        name,
+        data=data,
+        dtype=string_dtype() if is_text else data.dtype,
+        maxshape=(None,) + data.shape[1:],
+        chunks=(chunk_rows,) + data.shape[1:],
+        compression=compression,
+        # Grouping the bytes of floats by significance makes depth compress twice as well.
+        shuffle=bool(compression) and data.dtype.kind == "f",
+    )
+
+
+def _number_of(path: Path) -> int:
+    return int(path.name.rsplit(".part", 1)[1])
+
+
+def _prepare_path(path: Path, overwrite: bool) -> None:
+    """Refuses to mix a new recording into an old one unless told to replace it."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    old = [p for _, p in find_parts(path)]
+    old += [p for p in [path, temporary_name(path)] if p.exists()]
+    old += list(path.parent.glob(path.name + ".part*.tmp"))
+    if old and not overwrite:
+        raise FileExistsError(f"{path}: a recording is already there (pass overwrite=True)")
+    for stale in old:
+        stale.unlink()
+
+
+def write_head(path: Path, head: _HeadInfo, parts: list[PartSummary], complete: bool) -> None:
+    """Writes the head file atomically: description, and when complete, virtual datasets that
+    concatenate the parts."""
+    tmp = temporary_name(path)
+    with h5py.File(tmp, "w", libver=("v110", "latest")) as f:
+        f.attrs.update(
+            {
+                "format": FORMAT,
+                VERSION_ATTR: VERSION,
+                "recording_id": head.recording_id,
+                "created": head.created,
+                "software_version": __version__,
+                "h5py_version": h5py.version.version,
+                "hdf5_version": h5py.version.hdf5_version,
+                "metadata": head.metadata,
+                "legend": head.legend,
+                "complete": complete,
+                "parts": to_json([p.path.name for p in parts], "parts"),
+            }
+        )
+        f.create_group("conventions").attrs.update(CONVENTIONS)
+        if complete:
+            _write_virtual_datasets(f, parts)
+    os.replace(tmp, path)
+
+
+def _write_virtual_datasets(f: h5py.File, parts: list[PartSummary]) -> None:
+    groups: dict[str, list[tuple[PartSummary, object]]] = {}
+    for part in parts:
+        for name, group in part.groups.items():
+            groups.setdefault(name, []).append((part, group))
+    for name, pieces in groups.items():
+        first = pieces[0][1]
+        f.require_group(name).attrs.update(first.attrs)
+        total = sum(group.rows for _, group in pieces)
+        for column, (dtype, trailing) in first.datasets.items():
+            dtype = string_dtype() if np.dtype(dtype).kind == "O" else dtype
+            layout = h5py.VirtualLayout(shape=(total,) + tuple(trailing), dtype=dtype)
+            start = 0
+            for part, group in pieces:
+                shape = (group.rows,) + tuple(trailing)
+                source = h5py.VirtualSource(part.path.name, f"{name}/{column}", shape=shape)
+                layout[start : start + group.rows] = source
+                start += group.rows
+            f[name].create_virtual_dataset(column, layout)
+
+
+def repair(path) -> Recording:
+    """Completes the head of a recording whose recorder did not close (a crash): virtual
+    datasets over every closed part, so that plain h5py reads it as one file. Returns it
+    opened."""
+    path = Path(path)
+    with open_recording(path) as recording:
+        parts = scan_parts(path, recording.recording_id)
+        with h5py.File(path, "r") as f:
+            head = _HeadInfo(
+                recording.recording_id,
+                recording.created,
+                _attr_text(f.attrs["metadata"]),
+                _attr_text(f.attrs["legend"]),
+            )
+    write_head(path, head, parts, complete=True)
+    return open_recording(path)
+
+
+def _attr_text(value) -> str:
+    return value.decode() if isinstance(value, bytes) else str(value)
+
+
+def world_legend(world) -> dict:
+    """``ambfplus.stereo.legend(world)`` plus each volume's grid shape, dimensions and voxel
+    size, which map a ``voxel`` image's index to (i, j, k)."""
+    out = object_legend(world)
+    for volume in world.volumes:
+        data = volume.data
+        out[volume.id].update(
+            shape=tuple(int(n) for n in data.shape),
+            dimensions=[float(d) for d in data.dimensions],
+            voxel_size=[float(d) for d in data.voxel_size],
+        )
+    return out

@@ -10,13 +10,13 @@ from pathlib import Path
 
 import numpy as np
 
-from . import Simulator, __version__, gl_info, write_image
+from . import ScriptedDevice, Simulator, __version__, gl_info, write_image
 from .plugins import cmake_dir
-from .scenes import demo_scene
 from .volumes import convert_volume
 
-# The demo fails when the scene covers less than this share of the image.
-MIN_COVERAGE = 0.25
+# The demo fails when the anatomy covers less than this share of the view (at the paper's
+# 250 mm and f = 1135 px, the 48 mm phantom covers about 15 %).
+MIN_COVERAGE = 0.05
 # depth.png holds depth in units of 0.1 mm (uint16, so up to 6.5535 m); 0 means no hit.
 DEPTH_PNG_SCALE = 10000.0
 
@@ -36,30 +36,40 @@ def colorize_depth(depth: np.ndarray) -> np.ndarray:
     return rgb
 
 
-def run_demo(out: Path, width: int, height: int) -> int:
-    out.mkdir(parents=True, exist_ok=True)
-    world, camera = demo_scene(width, height)
-    world.step(10)
-    frame = camera.capture()
-    covered = frame.depth > 0
-    coverage = float(covered.mean())
-    background = np.asarray(frame.rgb[~covered]).reshape(-1, 3)
-    lit = frame.rgb[covered]
-    contrast = float(lit.std()) if lit.size else 0.0
+def plunge_script(volume, sites, start, burr_radius, depth=0.003):
+    """Waypoints of a scripted hand (device frame = world axes from the drill's start) that
+    plunges the burr `depth` into the bone at each (x, y) site: over it with the burr off, down
+    spinning, a hold, and back up."""
+    waypoints, t = [{"time": 0.0, "position": (0.0, 0.0, 0.0), "buttons": 0}], 0.0
+    start = np.asarray(start, float)
+    for x, y in sites:
+        surface = volume.raycast((x, y, 0.05), (0.0, 0.0, -1.0))["position"]
+        above = np.array([x, y, surface[2] + burr_radius + 0.003]) - start
+        down = np.array([x, y, surface[2] + burr_radius - depth]) - start
+        for dt, where, on in ((0.6, above, 0), (0.4, above, 1), (2.0, down, 1), (0.5, down, 1),
+                              (0.4, above, 1)):  # fmt: skip
+            t += dt
+            waypoints.append({"time": t, "position": tuple(where), "buttons": on})
+    return waypoints, t
 
-    world_volumes = world.volumes
+
+def write_previews(out: Path, frame, world) -> dict:
+    """PNGs of one captured view: rgb, depth (uint16 in 0.1 mm, and a colour preview), labels
+    (uint16 ids, and their colours), segmentation; returns the frame's description."""
+    volume = world.volumes[0] if world.volumes else None
     colours = np.zeros((65536, 3), np.uint8)
-    if world_volumes:
-        for label in world_volumes[0].data.label_table:
+    if volume is not None:
+        for label in volume.data.label_table:
             colours[label.id] = label.color
-    depth_units = np.round(frame.depth * DEPTH_PNG_SCALE)
-    depth_png = np.clip(depth_units, 0, 65535).astype(np.uint16)
+    depth_png = np.clip(np.round(frame.depth * DEPTH_PNG_SCALE), 0, 65535).astype(np.uint16)
     write_image(str(out / "rgb.png"), frame.rgb)
     write_image(str(out / "depth.png"), depth_png)
     write_image(str(out / "depth_preview.png"), colorize_depth(frame.depth))
     write_image(str(out / "label.png"), frame.label)
     write_image(str(out / "label_preview.png"), colours[frame.label])
-    meta = {
+    if frame.segmentation is not None:
+        write_image(str(out / "segmentation.png"), frame.segmentation)
+    return {
         "ambfplus_version": __version__,
         "camera": frame.camera,
         "width": frame.width,
@@ -74,30 +84,105 @@ def run_demo(out: Path, width: int, height: int) -> int:
         "label_png": "uint16 volume label ids (0 = none); label_preview.png shows their colours",
         "labels": [
             {"id": label.id, "name": label.name, "color": list(label.color)}
-            for label in (world_volumes[0].data.label_table if world_volumes else [])
+            for label in (volume.data.label_table if volume is not None else [])
         ],
-        "coverage": coverage,
         "gl": gl_info(),
     }
-    (out / "frame.json").write_text(json.dumps(meta, indent=2))
 
-    valid = frame.depth[covered]
-    print(f"ambfplus {__version__}: {gl_info()['renderer']}")
+
+def run_demo(out: Path, width: int, height: int, resolution: int, every: int) -> int:
+    """A headless drilling session on the built-in phantom: scripted plunges at three sites
+    while the stereo rig circles, recorded, validated, and previewed as PNG files."""
+    from .recording import open_recording, validate
+    from .scenes import drilling_phantom, orbit_view
+    from .session import record_session
+
+    out.mkdir(parents=True, exist_ok=True)
+    path = out / "session.h5"
+    for old in out.glob("session.h5*"):
+        old.unlink()
+    print(f"ambfplus {__version__}: {gl_info()['renderer']}", flush=True)
+    scene = drilling_phantom(resolution=resolution, width=width, height=height)
+    device = ScriptedDevice()
+    sites = [(0.0, 0.0), (0.006, 0.004), (-0.006, 0.004)]
+    start = scene.drill.goal[:3, 3]
+    waypoints, seconds = plunge_script(scene.drill.volume, sites, start, scene.drill.burr_radius)
+    device.set_waypoints(waypoints)
     print(
-        f"wrote {out}/rgb.png, depth.png, depth_preview.png, label.png, label_preview.png, "
-        f"frame.json ({width}x{height}): "
-        f"scene covers {coverage:.1%} of pixels, depth {valid.min():.4f}..{valid.max():.4f} m"
-        if valid.size
-        else f"wrote {out}: the scene covers no pixel"
+        f"recording {seconds:.1f} s of drilling ({len(sites)} plunges, a {width}x{height} "
+        f"stereo pair every {every} ms) to {path}",
+        flush=True,
     )
-    if coverage < MIN_COVERAGE or contrast < 5.0 or background.size == lit.size == 0:
-        print(
-            f"error: the scene covers {coverage:.1%} of the image (need >= {MIN_COVERAGE:.0%}) "
-            f"with colour contrast {contrast:.1f} (need >= 5): the render is empty or flat",
-            file=sys.stderr,
+    summary = record_session(
+        scene, path, device, seconds, capture_every=every, camera_motion=orbit_view,
+        metadata={"demo": {"sites": sites, "waypoints": waypoints}},
+        progress=lambda line: print("  " + line, flush=True),
+    )  # fmt: skip
+    report = validate(path)
+    (out / "validation.txt").write_text(str(report) + "\n")
+    print(f"validation: {sum(c.status == 'pass' for c in report.checks)} checks passed, "
+          f"{len(report.failed)} failed (validation.txt)")  # fmt: skip
+    with open_recording(path) as rec:
+        pairs = rec.rigs["rig"]
+        last = pairs[len(pairs) - 1]
+        lefts = [pairs[i].left.rgb for i in (0, len(pairs) // 2, len(pairs) - 1)]
+        write_image(str(out / "montage.png"), np.concatenate(lefts, axis=1))
+        write_image(str(out / "right_rgb.png"), last.right.rgb)
+        meta = write_previews(out, last.left, scene.world)
+    meta["recording"] = {"path": str(path), **summary}
+    (out / "frame.json").write_text(json.dumps(meta, indent=2))
+    covered = last.left.depth > 0
+    coverage = float(covered.mean())
+    contrast = float(last.left.rgb[covered].std()) if covered.any() else 0.0
+    print(
+        f"wrote {out}: session.h5 ({summary['frames']} stereo frames, {summary['steps']} steps, "
+        f"{summary['voxels_removed']} voxels removed), montage.png, rgb.png, right_rgb.png, "
+        f"depth.png, depth_preview.png, label.png, label_preview.png, segmentation.png, "
+        f"frame.json; the anatomy covers {coverage:.1%} of the last view"
+    )
+    problems = []
+    if not report.ok:
+        problems.append("the recording does not validate (see validation.txt)")
+    if summary["voxels_removed"] == 0:
+        problems.append("the drill removed no voxel")
+    if coverage < MIN_COVERAGE or contrast < 5.0:
+        problems.append(
+            f"the scene covers {coverage:.1%} of the view (need >= {MIN_COVERAGE:.0%}) with "
+            f"colour contrast {contrast:.1f} (need >= 5): the render is empty or flat"
         )
-        return 1
-    return 0
+    for problem in problems:
+        print(f"error: {problem}", file=sys.stderr)
+    return 1 if problems else 0
+
+
+def run_replay(args: argparse.Namespace) -> int:
+    """Re-simulates a recording from its device readings, optionally re-rendering it."""
+    from .session import replay
+
+    report = replay(
+        args.recording,
+        out=args.out,
+        baseline=args.baseline,
+        width=args.width,
+        height=args.height,
+        progress=lambda line: print("  " + line, flush=True),
+    )
+    print(
+        json.dumps(
+            {
+                "steps": report.steps,
+                "frames": report.frames,
+                "voxels_removed": report.voxels_removed,
+                "removal_identical": report.removal_identical,
+                "forces_identical": report.forces_identical,
+                "images_identical": report.images_identical,
+                "output": str(report.output) if report.output else None,
+            },
+            indent=2,
+        )
+    )
+    same = report.removal_identical and report.forces_identical
+    return 0 if same and report.images_identical in (None, report.frames) else 1
 
 
 def indices(text: str) -> list[int]:
@@ -167,10 +252,26 @@ def main(argv: list[str] | None = None) -> int:
         help="print the folder of ambfplusConfig.cmake (for -Dambfplus_DIR=...) and exit",
     )
     commands = parser.add_subparsers(dest="command", required=True)
-    demo = commands.add_parser("demo", help="render the built-in scene headless to PNG files")
+    demo = commands.add_parser(
+        "demo",
+        help="a headless drilling session on the built-in phantom: record it, validate it, "
+        "write preview PNGs",
+    )
     demo.add_argument("--out", type=Path, default=Path("demo_out"), help="output folder")
     demo.add_argument("--width", type=int, default=640)
     demo.add_argument("--height", type=int, default=480)
+    demo.add_argument("--resolution", type=int, default=128, help="phantom voxels per side")
+    demo.add_argument("--every", type=int, default=50, help="steps (ms) between stereo frames")
+    replay = commands.add_parser(
+        "replay",
+        help="re-simulate a recording from its device readings (same removal log?) and "
+        "optionally re-render it with another rig",
+    )
+    replay.add_argument("recording", type=Path)
+    replay.add_argument("--out", type=Path, help="write the re-rendered session here")
+    replay.add_argument("--baseline", type=float, help="another stereo baseline, metres")
+    replay.add_argument("--width", type=int)
+    replay.add_argument("--height", type=int)
     convert = commands.add_parser(
         "convert",
         help="convert anatomy volumes: NRRD/Slicer segmentation -> slice stack + volume ADF, "
@@ -232,7 +333,9 @@ def main(argv: list[str] | None = None) -> int:
     if args.command == "launch":
         return run_launch(args)
     if args.command == "demo":
-        return run_demo(args.out, args.width, args.height)
+        return run_demo(args.out, args.width, args.height, args.resolution, args.every)
+    if args.command == "replay":
+        return run_replay(args)
     if args.command == "convert":
         print(
             convert_volume(

@@ -35,9 +35,13 @@ which writes them.
 Layout of a part (and of a complete head)
 -----------------------------------------
 Every dataset is chunked and resizable along axis 0 (``maxshape`` None); images are stored one
-frame per chunk, small columns in chunks of about 64 KiB, all lzf-compressed (``compression``
-picks gzip or none instead); float datasets (depth, points) add the shuffle filter, which halves
-their size. Both filters are built into h5py; gzip and shuffle into every HDF5 library.
+frame per chunk, small columns in chunks of about 64 KiB. The default compression is Blosc with
+LZ4 and byte shuffling for multi-byte types (HDF5 filter 32001, from the ``hdf5plugin`` package,
+which the reader imports: ``import hdf5plugin`` before opening a file with plain h5py). It costs
+about what writing uncompressed does (1 ms per 640x480 rgb + depth + label + instance view) and
+compresses at least as well as lzf (4x for rgb and depth, 60-150x for ids), which costs 4 times
+as much CPU; on a machine whose cores render, that CPU is taken from the capture rate.
+``compression`` picks "lzf" or "gzip" (built into h5py, float datasets shuffled) or none.
 All datasets of a group have the same length N (their rows belong together).
 
 ``cameras/<stream>/`` (attribute ``camera``: the camera's name), one row per frame:
@@ -115,6 +119,7 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 import h5py
+import hdf5plugin  # registers the Blosc filter with HDF5
 import numpy as np
 
 from . import __version__
@@ -172,8 +177,8 @@ __all__ = [
 MiB = 1024 * 1024
 # Passes recorded when add_frame is not told which: everything a frame holds except points,
 # which follow from depth and the intrinsics and would double the size.
-DEFAULT_PASSES = ("rgb", "depth", "instance", "label", "voxel")
-COMPRESSIONS = ("lzf", "gzip", None)
+DEFAULT_PASSES = ("rgb", "depth", "instance", "label", "voxel", "segmentation")
+COMPRESSIONS = ("blosc-lz4", "lzf", "gzip", None)
 # Gathered small columns are written out once they reach this size.
 BUFFER_BYTES = 8 * MiB
 
@@ -232,7 +237,7 @@ class Recorder:
     module docstring for the layout). All HDF5 work happens on a background thread; ``add_*``
     copies its arrays and returns, or blocks while ``max_pending_bytes`` are waiting (HDF5's
     chunk cache, up to 8 MiB per image dataset, comes on top). Parts close every
-    ``flush_interval_s``; ``compression`` is "lzf", "gzip" or None."""
+    ``flush_interval_s``; ``compression`` is "blosc-lz4" (the default), "lzf", "gzip" or None."""
 
     def __init__(
         self,
@@ -241,7 +246,7 @@ class Recorder:
         *,
         max_pending_bytes: int = 512 * MiB,
         flush_interval_s: float = 1.0,
-        compression: str | None = "lzf",
+        compression: str | None = "blosc-lz4",
         overwrite: bool = False,
     ) -> None:
         if not max_pending_bytes > 0:
@@ -819,10 +824,17 @@ def _create(
         dtype=string_dtype() if is_text else data.dtype,
         maxshape=(None,) + data.shape[1:],
         chunks=(chunk_rows,) + data.shape[1:],
-        compression=compression,
-        # Grouping the bytes of floats by significance makes depth compress twice as well.
-        shuffle=bool(compression) and data.dtype.kind == "f",
+        **_filters(compression, data.dtype),
     )
+
+
+def _filters(compression: str | None, dtype: np.dtype) -> dict:
+    """create_dataset's filter arguments. Grouping the bytes of multi-byte values by
+    significance (shuffling) makes depth compress twice as well."""
+    if compression == "blosc-lz4":
+        shuffle = hdf5plugin.Blosc.SHUFFLE if dtype.itemsize > 1 else hdf5plugin.Blosc.NOSHUFFLE
+        return dict(hdf5plugin.Blosc(cname="lz4", clevel=5, shuffle=shuffle))
+    return {"compression": compression, "shuffle": bool(compression) and dtype.kind == "f"}
 
 
 def _number_of(path: Path) -> int:

@@ -12,6 +12,7 @@ from functools import cached_property
 from pathlib import Path
 
 import h5py
+import hdf5plugin  # noqa: F401 (registers the Blosc filter recordings use)
 import numpy as np
 
 from .recording_schema import (
@@ -55,6 +56,7 @@ class RecordedFrame:
     label: np.ndarray | None = None
     voxel: np.ndarray | None = None
     points: np.ndarray | None = None
+    segmentation: np.ndarray | None = None
 
     @property
     def height(self) -> int:

@@ -25,6 +25,7 @@ IMAGE_PASSES = {
     "label": (np.dtype(np.uint16), ()),
     "points": (np.dtype(np.float32), (3,)),
     "voxel": (np.dtype(np.int32), ()),
+    "segmentation": (np.dtype(np.uint8), (3,)),
 }
 # Per-frame camera columns: dtype and trailing shape.
 FRAME_COLUMNS = {
@@ -69,6 +70,7 @@ CONVENTIONS = {
     "label": "uint16 (H, W) volume label id (0 = none), names in the legend's volume labels",
     "voxel": "int32 (H, W) index of the volume voxel seen, i + nx * (j + ny * k) (i fastest); "
     "-1 where no voxel is seen",
+    "segmentation": "uint8 (H, W, 3) flat RGB colours as AMBF's preprocessing shaders draw them",
     "removed_voxel": "int32 (i, j, k) global voxel indices of the named volume; never restart",
     "time": "float64 simulation seconds; step: int64 fixed-step index",
     "stereo": "baseline = |t_right - t_left| (m); dcx = cx_right - cx_left (px); "

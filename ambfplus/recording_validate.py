@@ -10,9 +10,15 @@ import numpy as np
 
 from .recording_reader import CameraStream, Recording, RigStream, open_recording
 from .recording_schema import RecordingError
+from .stereo import disparity_agreement
 
 POINTS_RELATIVE_TOLERANCE = 1e-4
 BASELINE_TOLERANCE_M = 1e-6
+# Block matching on rendered bone: textured points needed, the largest median error of a pair
+# (smooth bone gives some wrong matches), and how close the recovered baseline must be.
+DISPARITY_MIN_POINTS = 50
+DISPARITY_MEDIAN_PX = 2.0
+DISPARITY_BASELINE_REL = 0.02
 DCX_TOLERANCE_PX = 1e-6
 
 
@@ -189,7 +195,38 @@ def _rig_checks(name: str, rig: RigStream) -> list[Check]:
     checks.append(Check(f"{name}: frame indices", "pass", "", {"pairs": len(left)}))
     checks.append(_pair_steps_check(name, rig, left, right))
     checks += _rig_geometry_checks(name, rig, left, right)
+    checks.append(_disparity_check(name, rig))
     return checks
+
+
+def _disparity_check(name: str, rig: RigStream) -> Check:
+    """On the first, middle and last pairs: block matching between the images agrees with the
+    disparity their depth and baseline predict, and gives back the baseline."""
+    title = f"{name}: disparity from depth and baseline matches the images"
+    if len(rig) == 0 or not {"rgb", "depth"} <= set(rig.left.passes):
+        return Check(title, "skip", "needs pairs with rgb and depth")
+    pairs = sorted({0, len(rig) // 2, len(rig) - 1})
+    results = [(i, disparity_agreement(rig[i])) for i in pairs]
+    used = [(i, r) for i, r in results if r["points"] >= DISPARITY_MIN_POINTS]
+    if not used:
+        return Check(title, "skip", "too little texture to match")
+    median = max(r["median_error"] for _, r in used)
+    baseline_error = max(abs(r["baseline"] - rig.baseline[i]) / rig.baseline[i] for i, r in used)
+    numbers = {
+        "pairs": len(used),
+        "points": sum(r["points"] for _, r in used),
+        "median_error_px": median,
+        "baseline_error": baseline_error,
+    }
+    if median <= DISPARITY_MEDIAN_PX and baseline_error <= DISPARITY_BASELINE_REL:
+        return Check(title, "pass", f"median within {DISPARITY_MEDIAN_PX} px", numbers)
+    return Check(
+        title,
+        "fail",
+        f"median error {median:.2f} px (<= {DISPARITY_MEDIAN_PX}), baseline off by "
+        f"{baseline_error:.1%} (<= {DISPARITY_BASELINE_REL:.0%})",
+        numbers,
+    )
 
 
 # Small per-frame columns are read whole and indexed in memory (one read per part).

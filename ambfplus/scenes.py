@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._core import World, phantom
+from ._core import Drill, World, phantom
+from .stereo import StereoRig
 from .transforms import make_pose, rotation_between
 
 # The paper's stereo camera: focal length about 1135 px at 640x480, about 250 mm from the anatomy.
@@ -65,3 +67,85 @@ def demo_scene(width: int = 640, height: int = 480, resolution: int = 192):
     camera = world.add_camera("camera", width, height, PAPER_FOV_Y, 0.01, 10.0)
     camera.look_at(eye=(0.035, -0.075, 0.13), target=(0.0, 0.0, 0.004))
     return world, camera
+
+
+@dataclass
+class Scene:
+    """A built scene: its world, the drill a device drives and how to bind one, the stereo rig
+    that films it, and the objects whose state a recording logs every step."""
+
+    world: World
+    drill: Drill
+    rig: StereoRig
+    device_name: str
+    device_options: dict
+    logged: list = field(default_factory=list)
+    spec: dict = field(default_factory=dict)  #: what build_scene rebuilds it from
+
+
+def drilling_phantom(
+    resolution: int = 128,
+    seed: int = 0,
+    width: int = 640,
+    height: int = 480,
+    baseline: float = 0.065,
+    working_distance: float | None = 0.25,
+) -> Scene:
+    """The built-in temporal-bone phantom (48 mm across) under the paper's stereo rig (65 mm
+    baseline, f = 1135 px at 640x480, off-axis with zero disparity at 250 mm), with the 6 mm burr
+    of a drill 10 mm above its lateral face (z = 12 mm) and drill meshes riding on it. A device
+    named "hand" drives the drill in world axes at scale 1: button 0 spins the burr."""
+    world = World()
+    world.add_light("key", "directional", direction=(-0.3, 0.4, -1.0), intensity=0.8)
+    world.add_light("fill", "point", position=(0.15, -0.2, 0.3), intensity=0.3)
+    volume = world.add_volume("anatomy", phantom(resolution, seed), pose=np.eye(4))
+    # The drill frame's +x runs up the shaft from the burr, leaning back towards the surgeon.
+    shaft = np.array([-0.3, 0.45, 1.0]) / np.linalg.norm([-0.3, 0.45, 1.0])
+    start = make_pose((0.0, 0.0, 0.022), rotation=rotation_between((1, 0, 0), shaft))
+    drill = world.add_drill("drill", volume, burr=3, pose=start)
+    burr, stem, handle = add_drill(world, tip=(0.0, 0.0, 0.022), direction=shaft)
+    for body in (burr, stem, handle):
+        drill.attach(body, np.linalg.inv(start) @ body.pose)
+    fov_y = 2.0 * math.atan(height / 2.0 / (PAPER_FOCAL_PX * height / 480.0))
+    rig = StereoRig(
+        world, "rig", baseline=baseline, width=width, height=height, fov_y=fov_y, near=0.01,
+        far=2.0, working_distance=working_distance,
+    )  # fmt: skip
+    rig.aim(*orbit_view(0.0))
+    spec = {
+        "builder": "drilling_phantom",
+        "params": {
+            "resolution": resolution, "seed": seed, "width": width, "height": height,
+            "baseline": baseline, "working_distance": working_distance,
+        },
+    }  # fmt: skip
+    return Scene(world, drill, rig, "hand", {"drill_button": 0}, [drill, rig.left], spec)
+
+
+def orbit_view(t: float, distance: float = 0.25) -> tuple[np.ndarray, np.ndarray]:
+    """(eye, target) of a camera circling above the phantom's lateral face: one turn of 40
+    degrees amplitude every 8 s, looking at its centre from `distance`."""
+    target = np.array([0.0, 0.0, 0.006])
+    azimuth = math.radians(-100.0 + 40.0 * math.sin(2 * math.pi * t / 8.0))
+    elevation = math.radians(55.0 + 10.0 * math.sin(2 * math.pi * t / 5.0))
+    direction = np.array(
+        [
+            math.cos(elevation) * math.cos(azimuth),
+            math.cos(elevation) * math.sin(azimuth),
+            math.sin(elevation),
+        ]
+    )
+    return target + distance * direction, target
+
+
+SCENES = {"drilling_phantom": drilling_phantom}
+
+
+def build_scene(spec: dict) -> Scene:
+    """Rebuilds a scene from its spec (Scene.spec, as recordings store it)."""
+    builder = SCENES.get(spec.get("builder", ""))
+    if builder is None:
+        raise ValueError(
+            f"unknown scene builder {spec.get('builder')!r}; known: {', '.join(sorted(SCENES))}"
+        )
+    return builder(**spec.get("params", {}))

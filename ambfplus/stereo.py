@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._core import Camera, Frame, World
+from .transforms import make_pose
 
 PASSES = ("rgb", "depth", "label", "instance")
 
@@ -157,12 +158,83 @@ class StereoRig:
         self.left.look_at(eye, target, up)
         self.right.pose = self.left.pose @ self._offset
 
+    def aim(self, eye, target, up=(0.0, 0.0, 1.0)) -> None:
+        """Places the rig's midpoint at eye, both cameras looking along target - eye (an
+        off-axis rig then sees a target at its working distance at both images' centres)."""
+        self.look_at(eye, target, up)
+        self.pose = self.left.pose @ make_pose((-self.baseline / 2, 0.0, 0.0))
+
     def capture(self, passes=PASSES, poses=None) -> StereoFrame:
         """Both views at the same simulation time."""
         self.right.pose = self.left.pose @ self._offset
         left = self.left.capture(passes=list(passes), poses=poses)
         right = self.right.capture(passes=list(passes), poses=poses)
         return StereoFrame(left, right, self.baseline, self.dcx)
+
+
+def block_match(left, right, rows, cols, dmin, dmax, half=10) -> np.ndarray:
+    """Disparity at each (row, col) of the left image: zero-mean normalised correlation of a
+    (2 half + 1)^2 window along the same row of the right image, refined to sub-pixel by a
+    parabola. NaN where the window has no texture or the best match is at the search's edge."""
+    gray_l = left.astype(np.float64).mean(axis=2)
+    gray_r = right.astype(np.float64).mean(axis=2)
+    side = 2 * half + 1
+    out = np.full(len(rows), np.nan)
+    for k, (r, c) in enumerate(zip(rows, cols)):
+        patch = gray_l[r - half : r + half + 1, c - half : c + half + 1]
+        if patch.std() < 5:
+            continue
+        lo, hi = max(c - dmax, half), min(c - dmin, gray_r.shape[1] - half - 1)
+        if hi - lo < 3:
+            continue
+        strip = gray_r[r - half : r + half + 1, lo - half : hi + half + 1]
+        windows = np.lib.stride_tricks.sliding_window_view(strip, (side, side))[0]
+        z = (patch - patch.mean()) / patch.std()
+        mean = windows.mean(axis=(1, 2), keepdims=True)
+        std = windows.std(axis=(1, 2), keepdims=True) + 1e-9
+        cost = -(((windows - mean) / std) * z).sum(axis=(1, 2))
+        i = int(np.argmin(cost))
+        if i == 0 or i == len(cost) - 1:
+            continue
+        a, b, e = cost[i - 1], cost[i], cost[i + 1]
+        out[k] = c - (lo + i + 0.5 * (a - e) / (a - 2 * b + e))
+    return out
+
+
+def disparity_agreement(stereo: StereoFrame, step: int = 8, margin: int = 20) -> dict:
+    """Block matching on a grid of the left image (every `step` pixels, `margin` from the
+    border) against the disparity the left depth and the rig predict. Returns the textured,
+    non-occluded points used, the median and 95th percentile of |measured - predicted| (px), and
+    the baseline recovered from the measured disparities, B = (d + dcx) Z / f (m)."""
+    left, right = stereo.left, stereo.right
+    height, width = left.depth.shape
+    predicted = stereo.disparity()
+    rows, cols = (
+        g.ravel()
+        for g in np.meshgrid(
+            np.arange(margin, height - margin, step), np.arange(margin, width - margin, step)
+        )
+    )
+    keep = ~np.isnan(predicted[rows, cols])
+    rows, cols = rows[keep], cols[keep]
+    out = {"points": 0, "median_error": np.nan, "p95_error": np.nan, "baseline": np.nan}
+    if len(rows) == 0:
+        return out
+    d = predicted[rows, cols]
+    measured = block_match(
+        left.rgb, right.rgb, rows, cols, int(d.min()) - 20, int(d.max()) + 20, half=margin // 2
+    )
+    ok = ~np.isnan(measured) & (cols - d > margin - 5) & (cols - d < width - margin + 5)
+    if not ok.any():
+        return out
+    error = np.abs(measured[ok] - d[ok])
+    z = np.asarray(left.depth)[rows[ok], cols[ok]]
+    return {
+        "points": int(ok.sum()),
+        "median_error": float(np.median(error)),
+        "p95_error": float(np.percentile(error, 95)),
+        "baseline": float(np.median((measured[ok] + stereo.dcx) * z / stereo.focal)),
+    }
 
 
 def legend(world: World) -> dict[int, dict]:

@@ -16,6 +16,7 @@
 #include "ambfplus/plugin/registry.h"
 #include "ambfplus/scene/realtime.h"
 #include "ambfplus/scene/simulator.h"
+#include "ambfplus/scene/step_log.h"
 #include "bindings.h"
 
 namespace py = pybind11;
@@ -211,7 +212,67 @@ py::dict stats_dict(const RealTimeStats& s) {
   return d;
 }
 
+// A step log's rows as NumPy columns: step (int64), time, and each "<object>.<field>" (N, width)
+// or (N,) for one value; flags bool, indices int32, buttons uint32, the rest float64.
+py::dict step_log_arrays(const StepLog& log) {
+  const auto n = static_cast<py::ssize_t>(log.rows());
+  py::dict d;
+  d["step"] = py::array_t<std::int64_t>(n, log.steps().data());
+  d["time"] = py::array_t<double>(n, log.times().data());
+  auto ends_with = [](const std::string& s, const char* end) {
+    const std::string e(end);
+    return s.size() >= e.size() && s.compare(s.size() - e.size(), e.size(), e) == 0;
+  };
+  for (const StepLog::Column& c : log.columns()) {
+    py::array_t<double> values =
+        c.width == 1 ? py::array_t<double>(n, c.values.data())
+                     : py::array_t<double>({n, static_cast<py::ssize_t>(c.width)}, c.values.data());
+    py::object column = values;
+    if (ends_with(c.name, ".on")) {
+      column = values.attr("astype")("bool");
+    } else if (ends_with(c.name, ".burr") || ends_with(c.name, ".leading")) {
+      column = values.attr("astype")("int32");
+    } else if (ends_with(c.name, ".buttons")) {
+      column = values.attr("astype")("uint32");
+    }
+    d[py::str(c.name)] = column;
+  }
+  return d;
+}
+
 }  // namespace
+
+void register_step_log(py::class_<World, std::shared_ptr<World>>& world) {
+  world
+      .def(
+          "start_step_log",
+          [](World& w, const std::vector<Object*>& objects) {
+            std::vector<const Object*> logged(objects.begin(), objects.end());
+            py::gil_scoped_release release;
+            w.start_step_log(logged);
+          },
+          py::arg("objects"),
+          "Logs every step's state of these objects from now on (poses; drills: goal, force, "
+          "on, burr; input devices: readings and force); take_step_log() drains it.")
+      .def(
+          "stop_step_log",
+          [](World& w) {
+            py::gil_scoped_release release;
+            w.stop_step_log();
+          },
+          "Stops logging steps (rows not taken are dropped).")
+      .def(
+          "take_step_log",
+          [](World& w) {
+            StepLog log(std::vector<const Object*>{});
+            {
+              py::gil_scoped_release release;
+              log = w.take_step_log();
+            }
+            return step_log_arrays(log);
+          },
+          "The steps logged since the last call: {'step', 'time', '<object>.<field>': ...}.");
+}
 
 py::object state_lock(World& world) { return py::cast(StateLock{handle(&world, world), {}}); }
 

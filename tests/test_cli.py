@@ -65,21 +65,31 @@ def read_png(path) -> np.ndarray:
     return out.reshape(height, width, channels).squeeze()
 
 
-def test_demo_writes_checked_images(tmp_path):
+def test_demo_records_a_checked_drilling_session(tmp_path):
     out = tmp_path / "demo"
-    assert main(["demo", "--out", str(out), "--width", "64", "--height", "48"]) == 0
+    args = ["demo", "--out", str(out), "--width", "160", "--height", "120"]
+    assert main(args + ["--resolution", "64", "--every", "200"]) == 0
     rgb = read_png(out / "rgb.png")
     depth = read_png(out / "depth.png")
     meta = json.loads((out / "frame.json").read_text())
-    assert rgb.shape == (48, 64, 3) and rgb.dtype == np.uint8
-    assert depth.shape == (48, 64) and depth.dtype == np.uint16
+    assert rgb.shape == (120, 160, 3) and rgb.dtype == np.uint8
+    assert depth.shape == (120, 160) and depth.dtype == np.uint16
     assert rgb.std() > 5
-    # The scene sits about 0.25 m from the camera, as in the paper.
+    # The rig circles 250 mm from the phantom's centre, as the paper's rig.
     metres = depth[depth > 0] / DEPTH_PNG_SCALE
-    assert 0.1 < np.median(metres) < 0.4
-    assert meta["coverage"] >= 0.25
-    assert meta["width"] == 64 and len(meta["intrinsics"]) == 3
+    assert 0.2 < np.median(metres) < 0.3
+    assert meta["width"] == 160 and len(meta["intrinsics"]) == 3
     assert (out / "depth_preview.png").stat().st_size > 100
+    assert read_png(out / "montage.png").shape == (120, 480, 3)
+    recording = meta["recording"]
+    assert recording["voxels_removed"] > 0 and recording["frames"] == -(-recording["steps"] // 200)
+    assert (out / "validation.txt").read_text().startswith(str(out / "session.h5"))
+    from ambfplus.recording import open_recording, validate
+
+    assert validate(out / "session.h5").ok
+    with open_recording(out / "session.h5") as rec:
+        assert len(rec.removed["step"]) == recording["voxels_removed"]
+        assert len(rec.rigs["rig"]) == recording["frames"]
 
 
 def test_demo_runs_as_a_module(tmp_path):
@@ -95,6 +105,10 @@ def test_demo_runs_as_a_module(tmp_path):
             "32",
             "--height",
             "24",
+            "--resolution",
+            "48",
+            "--every",
+            "500",
         ],
         capture_output=True,
         text=True,
@@ -102,19 +116,17 @@ def test_demo_runs_as_a_module(tmp_path):
         cwd=tmp_path,  # away from the source folder, which shadows the installed package
     )
     assert out.returncode == 0, out.stderr
-    assert "covers" in out.stdout
+    assert "covers" in out.stdout and "voxels removed" in out.stdout
 
 
-def test_demo_fails_on_an_empty_render(tmp_path, monkeypatch):
-    import ambfplus
-    import ambfplus.cli as cli
+def test_demo_fails_on_an_empty_render(tmp_path, monkeypatch, capsys):
+    import ambfplus.scenes
 
-    def empty_scene(width, height):
-        world = ambfplus.World()
-        return world, world.add_camera("camera", width, height)
-
-    monkeypatch.setattr(cli, "demo_scene", empty_scene)
-    assert cli.main(["demo", "--out", str(tmp_path), "--width", "32", "--height", "24"]) == 1
+    # The rig looks away from the anatomy.
+    monkeypatch.setattr(ambfplus.scenes, "orbit_view", lambda t: ((0, 0, 0.3), (0, 1.0, 0.3)))
+    args = ["demo", "--out", str(tmp_path), "--width", "32", "--height", "24"]
+    assert main(args + ["--resolution", "48", "--every", "500"]) == 1
+    assert "the render is empty" in capsys.readouterr().err
 
 
 def test_info_prints_version_and_renderer(capsys):

@@ -12,6 +12,7 @@ import ambfplus
 from ambfplus.stereo import (
     StereoRig,
     ambf_to_opencv,
+    block_match,
     depth_to_disparity,
     disparity_to_depth,
     legend,
@@ -61,35 +62,6 @@ def textured_world(tilt: float, seed: int = 0) -> ambfplus.World:
     data = ambfplus.VolumeData(labels, dimensions=(0.3, 0.225, 0.01), label_table=table)
     world.add_volume("plane", data, pose=ambfplus.make_pose((0, 0, 0), rpy=(0, tilt, 0)))
     return world
-
-
-def block_match(left, right, rows, cols, dmin, dmax, half=10) -> np.ndarray:
-    """Disparity at each (row, col) of the left image: zero-mean normalised correlation of a
-    (2 half + 1)^2 window along the same row of the right image, refined to sub-pixel by a
-    parabola. NaN where the window has no texture or the best match is at the search's edge."""
-    gray_l = left.astype(np.float64).mean(axis=2)
-    gray_r = right.astype(np.float64).mean(axis=2)
-    side = 2 * half + 1
-    out = np.full(len(rows), np.nan)
-    for k, (r, c) in enumerate(zip(rows, cols)):
-        patch = gray_l[r - half : r + half + 1, c - half : c + half + 1]
-        if patch.std() < 5:
-            continue
-        lo, hi = max(c - dmax, half), min(c - dmin, gray_r.shape[1] - half - 1)
-        if hi - lo < 3:
-            continue
-        strip = gray_r[r - half : r + half + 1, lo - half : hi + half + 1]
-        windows = np.lib.stride_tricks.sliding_window_view(strip, (side, side))[0]
-        z = (patch - patch.mean()) / patch.std()
-        mean = windows.mean(axis=(1, 2), keepdims=True)
-        std = windows.std(axis=(1, 2), keepdims=True) + 1e-9
-        cost = -(((windows - mean) / std) * z).sum(axis=(1, 2))
-        i = int(np.argmin(cost))
-        if i == 0 or i == len(cost) - 1:
-            continue
-        a, b, e = cost[i - 1], cost[i], cost[i + 1]
-        out[k] = c - (lo + i + 0.5 * (a - e) / (a - 2 * b + e))
-    return out
 
 
 @pytest.mark.parametrize("working_distance", [None, 0.25], ids=["parallel", "off-axis"])

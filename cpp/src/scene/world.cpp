@@ -108,7 +108,10 @@ void World::remove_model(Model& model) {
                                [&](const auto& m) { return m.get() == &model; });
   if (it == models_.end()) throw std::invalid_argument("the model is not in this world");
   plugins_->close_model(model);
-  for (Object* object : model.objects()) plugins_->object_removed(*object);
+  for (Object* object : model.objects()) {
+    plugins_->object_removed(*object);
+    if (step_log_ && step_log_->logs(*object)) step_log_.reset();
+  }
   ++objects_revision_;
   // Newest first: joints go before the bodies they hold.
   for (auto o = model.owned_.rbegin(); o != model.owned_.rend(); ++o) {
@@ -189,6 +192,7 @@ void World::step(std::int64_t n) {
     for (ConstraintActuator* a : actuators) a->update();
     for (ProximitySensor* p : sensors) p->update();
     plugins_->physics_update(time_step_, /*native_only=*/realtime);
+    if (step_log_) step_log_->record(step_index_, time());
     // Plugins may add or remove objects.
     if (objects_revision_ != listed) {
       devices = objects_of_kind<InputDevice>();
@@ -199,6 +203,26 @@ void World::step(std::int64_t n) {
     }
     lock.unlock();
   }
+}
+
+void World::start_step_log(const std::vector<const Object*>& objects) {
+  for (const Object* o : objects) {
+    if (o == nullptr || &o->world() != this) {
+      throw std::invalid_argument("a step log can only log objects of its world");
+    }
+  }
+  auto lock = lock_state();
+  step_log_ = std::make_unique<StepLog>(objects);
+}
+
+void World::stop_step_log() {
+  auto lock = lock_state();
+  step_log_.reset();
+}
+
+StepLog World::take_step_log() {
+  auto lock = lock_state();
+  return step_log_ ? step_log_->take() : StepLog(std::vector<const Object*>{});
 }
 
 PluginRegistry& World::plugins() { return *plugins_; }

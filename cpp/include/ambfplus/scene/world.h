@@ -13,6 +13,7 @@
 
 #include "ambfplus/export.h"
 #include "ambfplus/scene/model.h"
+#include "ambfplus/scene/step_log.h"
 
 namespace ambfplus {
 
@@ -83,6 +84,16 @@ class AMBFPLUS_API World {
   const std::optional<ShaderSpec>& shader() const { return shader_; }
   void set_shader(std::optional<ShaderSpec> shader) { shader_ = std::move(shader); }
 
+  /// Starts logging every step's state of these objects (replacing a log in progress); the
+  /// log's rows are taken with take_step_log(). Throws std::invalid_argument for an object of
+  /// another world.
+  void start_step_log(const std::vector<const Object*>& objects);
+  /// Stops logging; rows not taken are dropped.
+  void stop_step_log();
+  /// The rows since the last take (empty without a log). Takes the state lock.
+  StepLog take_step_log();
+  bool logging_steps() const { return static_cast<bool>(step_log_); }
+
   /// The plugins of this world, its simulator, models and objects (cpp/README.md, "Plugins").
   PluginRegistry& plugins();
   /// Calls every plugin's reset(). There is no scene reset yet: only plugins are reset.
@@ -137,6 +148,7 @@ class AMBFPLUS_API World {
   std::int64_t graphics_step_ = -1;     // the step of the last graphics update
   std::uint64_t objects_revision_ = 0;  // counts objects added and models removed
   std::optional<ShaderSpec> shader_;
+  std::unique_ptr<StepLog> step_log_;
   mutable std::recursive_mutex state_mutex_;
   std::atomic<bool> realtime_{false};
 };

@@ -1,0 +1,50 @@
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "ambfplus/export.h"
+
+namespace ambfplus {
+
+class Object;
+
+/// What a world appends after every step while it logs (World::start_step_log), for
+/// recordings: the step, its time, and for each chosen object but input devices its pose (x, y,
+/// z, qx, qy, qz, qw, world frame), plus for a drill its goal (same layout), the force fed back and
+/// the sum over its cursors (N), whether the burr spins, the burr index and the leading cursor; for
+/// an input device its reading (position, orientation x y z w, buttons) and the force sent to it
+/// (N). Columns are named "<object>.<field>": "drill.pose", "drill.goal", "drill.force",
+/// "drill.total_force", "drill.on", "drill.burr", "drill.leading", "hand.position",
+/// "hand.orientation", "hand.buttons", "hand.force".
+class AMBFPLUS_API StepLog {
+ public:
+  struct Column {
+    std::string name;
+    int width = 1;               ///< values per step
+    std::vector<double> values;  ///< width per step, step after step
+  };
+
+  /// Objects of one world, logged in this order.
+  explicit StepLog(std::vector<const Object*> objects);
+  /// Appends the row of a finished step (the world calls it, under its state lock).
+  void record(std::int64_t step, double time);
+  std::int64_t rows() const { return static_cast<std::int64_t>(steps_.size()); }
+  const std::vector<std::int64_t>& steps() const { return steps_; }
+  const std::vector<double>& times() const { return times_; }
+  const std::vector<Column>& columns() const { return columns_; }
+  /// Moves the rows out (a recorder drains them) and starts afresh with the same columns.
+  StepLog take();
+  /// Whether it logs this object (a removed object must stop being logged first).
+  bool logs(const Object& object) const;
+
+ private:
+  StepLog() = default;
+  std::vector<const Object*> objects_;
+  std::vector<std::int64_t> steps_;
+  std::vector<double> times_;
+  std::vector<Column> columns_;
+};
+
+}  // namespace ambfplus

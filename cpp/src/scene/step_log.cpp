@@ -1,0 +1,86 @@
+#include "ambfplus/scene/step_log.h"
+
+#include <algorithm>
+
+#include <Eigen/Geometry>
+
+#include "ambfplus/haptics/drill.h"
+#include "ambfplus/haptics/input_device.h"
+
+namespace ambfplus {
+namespace {
+
+void push_pose(std::vector<double>& out, const Eigen::Isometry3d& pose) {
+  const Eigen::Quaterniond q(pose.linear());
+  const Eigen::Vector3d& t = pose.translation();
+  out.insert(out.end(), {t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w()});
+}
+
+void push(std::vector<double>& out, const Eigen::Vector3d& v) {
+  out.insert(out.end(), {v.x(), v.y(), v.z()});
+}
+
+}  // namespace
+
+StepLog::StepLog(std::vector<const Object*> objects) : objects_(std::move(objects)) {
+  for (const Object* o : objects_) {
+    const std::string& n = o->name();
+    // An input device has no pose of its own: its reading is its state.
+    if (o->kind() != ObjectKind::kInputDevice) columns_.push_back({n + ".pose", 7, {}});
+    if (o->kind() == ObjectKind::kDrill) {
+      for (const auto& [field, width] : std::vector<std::pair<const char*, int>>{{"goal", 7},
+                                                                                 {"force", 3},
+                                                                                 {"total_force", 3},
+                                                                                 {"on", 1},
+                                                                                 {"burr", 1},
+                                                                                 {"leading", 1}}) {
+        columns_.push_back({n + "." + field, width, {}});
+      }
+    } else if (o->kind() == ObjectKind::kInputDevice) {
+      for (const auto& [field, width] : std::vector<std::pair<const char*, int>>{
+               {"position", 3}, {"orientation", 4}, {"buttons", 1}, {"force", 3}}) {
+        columns_.push_back({n + "." + field, width, {}});
+      }
+    }
+  }
+}
+
+void StepLog::record(std::int64_t step, double time) {
+  steps_.push_back(step);
+  times_.push_back(time);
+  std::size_t c = 0;
+  for (const Object* o : objects_) {
+    if (o->kind() != ObjectKind::kInputDevice) push_pose(columns_[c++].values, o->pose());
+    if (const auto* drill = dynamic_cast<const Drill*>(o)) {
+      push_pose(columns_[c++].values, drill->goal());
+      push(columns_[c++].values, drill->force());
+      push(columns_[c++].values, drill->total_force());
+      columns_[c++].values.push_back(drill->on() ? 1.0 : 0.0);
+      columns_[c++].values.push_back(drill->burr());
+      columns_[c++].values.push_back(drill->leading_cursor());
+    } else if (const auto* device = dynamic_cast<const InputDevice*>(o)) {
+      const DeviceState& s = device->state();
+      push(columns_[c++].values, s.position);
+      const Eigen::Quaterniond& q = s.orientation;
+      columns_[c++].values.insert(columns_[c - 1].values.end(), {q.x(), q.y(), q.z(), q.w()});
+      columns_[c++].values.push_back(s.buttons);
+      push(columns_[c++].values, device->force());
+    }
+  }
+}
+
+StepLog StepLog::take() {
+  StepLog out;
+  out.objects_ = objects_;
+  out.steps_.swap(steps_);
+  out.times_.swap(times_);
+  out.columns_.swap(columns_);
+  for (const Column& c : out.columns_) columns_.push_back({c.name, c.width, {}});
+  return out;
+}
+
+bool StepLog::logs(const Object& object) const {
+  return std::find(objects_.begin(), objects_.end(), &object) != objects_.end();
+}
+
+}  // namespace ambfplus

@@ -76,7 +76,7 @@ class Scene:
 
     world: World
     drill: Drill
-    rig: StereoRig
+    rig: StereoRig | None
     device_name: str
     device_options: dict
     logged: list = field(default_factory=list)
@@ -138,7 +138,48 @@ def orbit_view(t: float, distance: float = 0.25) -> tuple[np.ndarray, np.ndarray
     return target + distance * direction, target
 
 
-SCENES = {"drilling_phantom": drilling_phantom}
+def launch_scene(
+    file: str,
+    models: list | None = None,
+    extra: list | None = None,
+    namespace_prefix: str = "",
+    plugins: list | None = None,
+    arguments: list | None = None,
+    time_step: float = 0.001,
+) -> Scene:
+    """An AMBF launch file loaded as ambfplus-launch loads it, with the drill its plugins make
+    (the first drill) driven by a device named "keyboard"; the stereo rig of its stereoL and
+    stereoR cameras when it has them."""
+    from ._core import Simulator
+
+    sim = Simulator.from_launch(
+        file,
+        models=models,
+        extra=extra or [],
+        namespace_prefix=namespace_prefix,
+        time_step=time_step,
+        plugins=plugins or [],
+        arguments=arguments or [],
+    )
+    world = sim.world
+    if not world.drills:
+        raise ValueError(f"{file}: the loaded scene has no drill to drive")
+    rig = None
+    if "stereoL" in world and "stereoR" in world:
+        rig = StereoRig.from_cameras(world["stereoL"], world["stereoR"])
+    drill = world.drills[0]
+    spec = {
+        "builder": "launch",
+        "params": {
+            "file": file, "models": models, "extra": extra or [],
+            "namespace_prefix": namespace_prefix, "plugins": plugins or [],
+            "arguments": arguments or [], "time_step": time_step,
+        },
+    }  # fmt: skip
+    return Scene(world, drill, rig, "keyboard", {}, [drill], spec)
+
+
+SCENES = {"drilling_phantom": drilling_phantom, "launch": launch_scene}
 
 
 def build_scene(spec: dict) -> Scene:

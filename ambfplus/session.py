@@ -169,10 +169,10 @@ def replay(
         meta = rec.metadata
         steps = rec.steps
         removed = rec.removed
-        rig_frames = rec.rigs[meta.get("rig", RIG)]
+        rig_frames = rec.rigs.get(meta.get("rig", RIG))
         plan = [
             (int(rig_frames.step[i]), np.asarray(rig_frames[i].left.pose), rig_frames.baseline[i])
-            for i in range(len(rig_frames))
+            for i in range(len(rig_frames) if rig_frames is not None else 0)
         ]
         recorded = rig_frames if compare_images else None
         spec = {"builder": meta["scene"]["builder"], "params": dict(meta["scene"]["params"])}
@@ -188,6 +188,7 @@ def replay(
         device = meta["device"]
         binding = _bind(scene, ReplayDevice(device_log(steps, device["name"])), device["options"])
         passes = tuple(passes or meta.get("passes", PASSES))
+        step_to = _stepper(world, steps, device["options"].get("reference"))
         world.start_step_log(list(scene.logged) + [binding])
         recorder = None
         if out is not None:
@@ -197,7 +198,7 @@ def replay(
         started = time.perf_counter()
         try:
             for i, (step, left_pose, recorded_baseline) in enumerate(plan):
-                world.step(step - world.step_index)
+                step_to(step)
                 # Keep the recorded rig's centre; the new baseline spreads the cameras about it.
                 centre = left_pose @ make_pose((recorded_baseline / 2, 0.0, 0.0))
                 rig.pose = centre @ make_pose((-rig.baseline / 2, 0.0, 0.0))
@@ -214,8 +215,7 @@ def replay(
                     _progress(progress, world.step_index, int(plan[-1][0]), started,
                               f"{i + 1}/{len(plan)} frames")  # fmt: skip
             last = int(steps["step"][-1]) if len(steps["step"]) else world.step_index
-            if last > world.step_index:
-                world.step(last - world.step_index)
+            step_to(last)
             s, r, _ = _drain(world, drill, recorder)
             new_forces.append(s[f"{drill.name}.force"])
             new_removed.append(r)
@@ -239,6 +239,31 @@ def replay(
         output=Path(out) if out is not None else None,
         differences=differences,
     )
+
+
+def _stepper(world, steps: dict, reference: str | None) -> Callable[[int], None]:
+    """A function stepping the world to a step. A device moving in a camera's axes needs the
+    camera where it was at every step: then each step first puts it at its logged pose (a step
+    logs the pose its devices read, as nothing moves a parentless camera within a step)."""
+    column = f"{reference}.pose" if reference else None
+    if column is None or column not in steps:
+
+        def step_to(target: int) -> None:
+            if target > world.step_index:
+                world.step(target - world.step_index)
+
+        return step_to
+    camera = world[reference]
+    poses = dict(zip(steps["step"].tolist(), steps[column]))
+
+    def step_to(target: int) -> None:
+        while world.step_index < target:
+            pose = poses.get(world.step_index + 1)
+            if pose is not None:
+                camera.pose = pose
+            world.step(1)
+
+    return step_to
 
 
 def _same_images(pair, recorded, passes) -> bool:

@@ -86,8 +86,8 @@ InputDevice& add_input_device(Model& model, const std::string& name,
 /// The devices, InputDevice's methods and the real-time loop.
 void register_devices(pybind11::module_& m,
                       pybind11::class_<InputDevice, Object, std::shared_ptr<InputDevice>>& input);
-/// World.start_step_log, stop_step_log and take_step_log.
-void register_step_log(pybind11::class_<World, std::shared_ptr<World>>& world);
+/// World.start_step_log, stop_step_log, take_step_log and the input events for plugins.
+void register_world_io(pybind11::class_<World, std::shared_ptr<World>>& world);
 /// A context manager holding the world's state lock for a `with` block.
 pybind11::object state_lock(World& world);
 

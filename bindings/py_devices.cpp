@@ -212,8 +212,9 @@ py::dict stats_dict(const RealTimeStats& s) {
   return d;
 }
 
-// A step log's rows as NumPy columns: step (int64), time, and each "<object>.<field>" (N, width)
-// or (N,) for one value; flags bool, indices int32, buttons uint32, the rest float64.
+// A step log's rows as NumPy columns: step (int64), time, and each "<object>.<field>" (N, width),
+// (N,) for one value or (N, 4, 4) for poses; flags bool, indices int32, buttons uint32, the rest
+// float64.
 py::dict step_log_arrays(const StepLog& log) {
   const auto n = static_cast<py::ssize_t>(log.rows());
   py::dict d;
@@ -228,7 +229,9 @@ py::dict step_log_arrays(const StepLog& log) {
         c.width == 1 ? py::array_t<double>(n, c.values.data())
                      : py::array_t<double>({n, static_cast<py::ssize_t>(c.width)}, c.values.data());
     py::object column = values;
-    if (ends_with(c.name, ".on")) {
+    if (c.width == 16) {
+      column = values.attr("reshape")(n, 4, 4);  // poses: 4x4 row by row
+    } else if (ends_with(c.name, ".on")) {
       column = values.attr("astype")("bool");
     } else if (ends_with(c.name, ".burr") || ends_with(c.name, ".leading")) {
       column = values.attr("astype")("int32");
@@ -242,7 +245,42 @@ py::dict step_log_arrays(const StepLog& log) {
 
 }  // namespace
 
-void register_step_log(py::class_<World, std::shared_ptr<World>>& world) {
+void register_world_io(py::class_<World, std::shared_ptr<World>>& world) {
+  // Input events reach the plugins under the world's lock (a real-time loop may be stepping).
+  world
+      .def(
+          "keyboard",
+          [](World& w, int key, int scancode, int action, int mods) {
+            py::gil_scoped_release release;
+            auto lock = w.lock_state();
+            w.plugins().keyboard(key, scancode, action, mods);
+          },
+          py::arg("key"), py::arg("scancode"), py::arg("action"), py::arg("mods"),
+          "Gives the plugins a key event (GLFW codes).")
+      .def(
+          "mouse_button",
+          [](World& w, int button, int action, int mods) {
+            py::gil_scoped_release release;
+            auto lock = w.lock_state();
+            w.plugins().mouse_button(button, action, mods);
+          },
+          py::arg("button"), py::arg("action"), py::arg("mods"))
+      .def(
+          "mouse_move",
+          [](World& w, double x, double y) {
+            py::gil_scoped_release release;
+            auto lock = w.lock_state();
+            w.plugins().mouse_move(x, y);
+          },
+          py::arg("x"), py::arg("y"))
+      .def(
+          "mouse_scroll",
+          [](World& w, double dx, double dy) {
+            py::gil_scoped_release release;
+            auto lock = w.lock_state();
+            w.plugins().mouse_scroll(dx, dy);
+          },
+          py::arg("dx"), py::arg("dy"));
   world
       .def(
           "start_step_log",
@@ -396,6 +434,22 @@ void register_devices(py::module_& m,
           "callback(time) -> {position, orientation, buttons} or (position[, orientation[, "
           "buttons]]), called every `every` steps (in a real-time loop from its low-rate "
           "thread); the reading is held in between.");
+
+  py::class_<KeyboardDevice, Device, std::shared_ptr<KeyboardDevice>>(
+      m, "KeyboardDevice",
+      "The keyboard as a device, with the original drilling simulator's bindings: Ctrl+W/S/D/A/"
+      "I/K move by `step` (up, down, right, left, into and out of the screen of the reference "
+      "camera), keypad 8/5 and 4/6 turn by `angle`, Space toggles the burr (button 0), C takes "
+      "the next burr (button 2).")
+      .def(py::init<double, double>(), py::arg("step") = 0.001,
+           py::arg("angle") = 0.05235987755982988)
+      .def("key", &KeyboardDevice::key, py::arg("key"), py::arg("action"), py::arg("mods"),
+           "A key event (GLFW key code, action 0 release / 1 press / 2 repeat, modifier bits); "
+           "True when it is one of the device's keys.")
+      .def(
+          "set_state",
+          [](KeyboardDevice& d, const py::object& state) { d.set_state(to_state(state, "state")); },
+          py::arg("state"), "Sets the reading ({position, orientation, buttons}).");
 
   py::class_<ReplayDevice, Device, std::shared_ptr<ReplayDevice>>(
       m, "ReplayDevice", "Plays back the readings of an InputDevice's log, step by step.")

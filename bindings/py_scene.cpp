@@ -386,7 +386,7 @@ void register_scene(py::module_& m) {
       "the reference's axes), its buttons turn and change the burr, the drill's force goes back; "
       "every reading is logged with its step.");
   register_devices(m, input);
-  register_step_log(world);
+  register_world_io(world);
   register_physics(m, body, joint);
   py::class_<SoftBody, Object, std::shared_ptr<SoftBody>> soft_body(
       m, "SoftBody",

@@ -118,6 +118,106 @@ DeviceState ScriptedDevice::read(std::int64_t, double time) {
   return sample_;
 }
 
+namespace {
+// GLFW's key codes and modifier bits, which key events carry.
+constexpr int kKeySpace = 32, kKeyA = 65, kKeyC = 67, kKeyD = 68, kKeyI = 73, kKeyK = 75,
+              kKeyS = 83, kKeyW = 87, kKeyPad4 = 324, kKeyPad5 = 325, kKeyPad6 = 326,
+              kKeyPad8 = 328;
+constexpr int kModControl = 0x2;
+constexpr int kRelease = 0;
+}  // namespace
+
+KeyboardDevice::KeyboardDevice(double step, double angle)
+    : Device({"keyboard", 10.0, 1000.0, 5.0, 0.1}), step_(step), angle_(angle) {
+  if (!(step > 0) || !(angle > 0)) {
+    throw std::invalid_argument("keyboard device: step and angle must be > 0");
+  }
+}
+
+bool KeyboardDevice::key(int key, int action, int mods) {
+  const bool control = (mods & kModControl) != 0;
+  const bool down = action != kRelease;
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (control) {
+    Eigen::Vector3d move = Eigen::Vector3d::Zero();
+    switch (key) {
+      case kKeyW:
+        move.y() = step_;
+        break;
+      case kKeyS:
+        move.y() = -step_;
+        break;
+      case kKeyD:
+        move.x() = step_;
+        break;
+      case kKeyA:
+        move.x() = -step_;
+        break;
+      case kKeyI:
+        move.z() = -step_;
+        break;
+      case kKeyK:
+        move.z() = step_;
+        break;
+      default:
+        return false;
+    }
+    if (down) state_.position += move;
+    return true;
+  }
+  Eigen::Vector3d axis = Eigen::Vector3d::Zero();
+  double turn = angle_;
+  switch (key) {
+    case kKeyPad8:
+      axis = Eigen::Vector3d::UnitX();
+      turn = -angle_;
+      break;
+    case kKeyPad5:
+      axis = Eigen::Vector3d::UnitX();
+      break;
+    case kKeyPad4:
+      axis = Eigen::Vector3d::UnitY();
+      turn = -angle_;
+      break;
+    case kKeyPad6:
+      axis = Eigen::Vector3d::UnitY();
+      break;
+    case kKeySpace:
+      if (action == 1) state_.buttons ^= 1u;  // a toggle: presses only, not repeats
+      return true;
+    case kKeyC: {
+      const std::uint32_t next = 1u << 2;
+      if (action == 1) {
+        state_.buttons |= next;
+        latched_ |= next;
+      } else if (action == kRelease) {
+        state_.buttons &= ~next;
+      }
+      return true;
+    }
+    default:
+      return false;
+  }
+  if (down) {
+    state_.orientation = (Eigen::AngleAxisd(turn, axis) * state_.orientation).normalized();
+  }
+  return true;
+}
+
+DeviceState KeyboardDevice::read(std::int64_t, double) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  DeviceState s = state_;
+  s.buttons |= latched_;
+  latched_ = 0;
+  return s;
+}
+
+void KeyboardDevice::set_state(const DeviceState& state) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  state_ = state;
+  state_.orientation.normalize();
+}
+
 ReplayDevice::ReplayDevice(std::vector<DeviceRecord> records, DeviceSpec spec)
     : Device(std::move(spec)), records_(std::move(records)) {
   for (std::size_t i = 1; i < records_.size(); ++i) {

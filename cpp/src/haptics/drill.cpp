@@ -100,6 +100,15 @@ void Drill::set_burr(int index) {
   if (!cursors_.empty()) cursors_[0].set_radius(burr_radius());
 }
 
+void Drill::set_voxels_per_step(int burr, int count) {
+  if (burr < 0 || burr >= static_cast<int>(spec_.voxels_per_step.size()) || count < 1) {
+    throw std::invalid_argument("voxels per step: burr must be 0.." +
+                                std::to_string(spec_.voxels_per_step.size() - 1) +
+                                " and count >= 1");
+  }
+  spec_.voxels_per_step[burr] = count;
+}
+
 void Drill::set_stiffness(double k) {
   if (!(k > 0) || !std::isfinite(k)) throw std::invalid_argument("stiffness must be > 0 N/m");
   spec_.stiffness = k;
@@ -148,7 +157,7 @@ void Drill::sync_meshes() {
     mesh_bodies_.clear();
     for (Object* o : objects) {
       auto* body = dynamic_cast<RigidBody*>(o);
-      if (body == nullptr || !body->visual_mesh()) continue;
+      if (body == nullptr || !body->visual_mesh() || !body->collision().enabled) continue;
       const bool carried = std::any_of(attached_.begin(), attached_.end(),
                                        [&](const auto& a) { return a.first == body; });
       if (carried) continue;
@@ -216,7 +225,8 @@ void Drill::tick(double dt, std::int64_t step) {
   Eigen::Isometry3d pose = goal_;
   pose.translation() = volume_->pose() * tip;
   set_pose(pose);
-  for (auto& [body, offset] : attached_) body->set_pose(pose * offset);
+  const Eigen::Isometry3d& carrier = meshes_follow_goal_ ? goal_ : pose;
+  for (auto& [body, offset] : attached_) body->set_pose(carrier * offset);
 
   // Forces: stiffness times proxy - goal, damped against the goal's motion while in contact,
   // limited, and ramped in over the soft start.

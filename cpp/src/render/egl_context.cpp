@@ -54,11 +54,13 @@ bool has_extension(const char* list, const char* name) {
 struct Candidate {
   EGLDisplay display = EGL_NO_DISPLAY;
   EGLContext context = EGL_NO_CONTEXT;
+  EGLConfig config = nullptr;
   std::string profile;
   std::string failure;
 };
 
-Candidate open_display(EGLDisplay display) {
+// With `windows`, the config must also draw into window surfaces (a window system's display).
+Candidate open_display(EGLDisplay display, bool windows = false) {
   Candidate c;
   EGLint major = 0, minor = 0;
   if (display == EGL_NO_DISPLAY) {
@@ -81,11 +83,21 @@ Candidate open_display(EGLDisplay display) {
     return c;
   }
   EGLConfig config = nullptr;
-  const EGLint config_attributes[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_SURFACE_TYPE,
-                                      EGL_PBUFFER_BIT, EGL_NONE};
+  const EGLint surfaces = windows ? EGL_WINDOW_BIT | EGL_PBUFFER_BIT : EGL_PBUFFER_BIT;
+  const EGLint config_attributes[] = {EGL_RENDERABLE_TYPE,
+                                      EGL_OPENGL_BIT,
+                                      EGL_SURFACE_TYPE,
+                                      surfaces,
+                                      EGL_RED_SIZE,
+                                      8,
+                                      EGL_GREEN_SIZE,
+                                      8,
+                                      EGL_BLUE_SIZE,
+                                      8,
+                                      EGL_NONE};
   EGLint count = 0;
   if (!eglChooseConfig(display, config_attributes, &config, 1, &count) || count == 0) {
-    if (!has_extension(extensions, "EGL_KHR_no_config_context")) {
+    if (windows || !has_extension(extensions, "EGL_KHR_no_config_context")) {
       eglTerminate(display);
       c.failure = "no OpenGL-renderable EGL config";
       return c;
@@ -111,6 +123,7 @@ Candidate open_display(EGLDisplay display) {
     if (eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, context)) {
       c.display = display;
       c.context = context;
+      c.config = config;
       c.profile = p.name;
       return c;
     }
@@ -149,7 +162,24 @@ std::mutex& creation_mutex() {
   return m;
 }
 
+// The window system's display a windowed process renders through (GLFW's X11 Display*).
+void*& x11_display() {
+  static void* display = nullptr;
+  return display;
+}
+
 }  // namespace
+
+void Context::use_x11_display(void* display) {
+  std::lock_guard<std::mutex> lock(creation_mutex());
+  auto& slot = instance_slot();
+  if (slot && slot->pid_ == getpid() && x11_display() != display) {
+    throw RenderError(
+        "a window needs the engine's OpenGL context on its X11 display, but this process "
+        "rendered before the window was opened: open windows before the first capture");
+  }
+  x11_display() = display;
+}
 
 Context& Context::get() {
   std::lock_guard<std::mutex> lock(creation_mutex());
@@ -190,7 +220,16 @@ Context::Context() : pid_(getpid()) {
   std::string how;
   const int egl_index = env_index("AMBFPLUS_EGL_DEVICE");
   const int cuda_index = env_index("AMBFPLUS_CUDA_DEVICE");
-  if (egl_index >= 0) {
+  if (x11_display() != nullptr) {
+    // Windows present this context: its display is the window system's.
+    chosen =
+        open_display(eglGetPlatformDisplayEXT(EGL_PLATFORM_X11_KHR, x11_display(), nullptr), true);
+    if (!chosen.failure.empty()) {
+      throw RenderError("the X11 display of the window: " + chosen.failure +
+                        " (is DISPLAY an X server with GLX/EGL support, e.g. Xvfb?)");
+    }
+    how = "the X11 display of a window";
+  } else if (egl_index >= 0) {
     if (egl_index >= static_cast<int>(devices.size())) {
       throw RenderError("AMBFPLUS_EGL_DEVICE=" + std::to_string(egl_index) +
                         " but this machine has " + std::to_string(devices.size()) +
@@ -258,8 +297,11 @@ Context::Context() : pid_(getpid()) {
   }
   display_ = chosen.display;
   context_ = chosen.context;
+  config_ = chosen.config;
   info_.profile = chosen.profile;
-  info_.platform = info_.device_index >= 0 ? "device" : "surfaceless";
+  info_.platform = x11_display() != nullptr  ? "x11"
+                   : info_.device_index >= 0 ? "device"
+                                             : "surfaceless";
   info_.device = how;
   info_.vendor = gl_string(GL_VENDOR);
   info_.renderer = gl_string(GL_RENDERER);
@@ -311,6 +353,15 @@ Program& Context::program(const std::string& key,
   if (it == programs_.end()) it = programs_.emplace(key, make()).first;
   return *it->second;
 }
+
+void Context::make_current(EGLSurface surface) {
+  if (!eglMakeCurrent(display_, surface, surface, context_)) {
+    throw RenderError("eglMakeCurrent with a window surface failed: " +
+                      egl_error_name(eglGetError()));
+  }
+}
+
+std::string Context::error_name() { return egl_error_name(eglGetError()); }
 
 void Context::make_current() {
   if (!eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_)) {

@@ -30,6 +30,16 @@ class Context {
   const GlInfo& info() const { return info_; }
   /// True once the context exists in this process (it is never destroyed before exit).
   static bool exists();
+  /// Makes the context (when it is created) use this X11 Display* (GLFW's), so windows of that
+  /// display can show cameras. Throws RenderError when the process already rendered.
+  static void use_x11_display(void* display);
+
+  EGLDisplay display() const { return display_; }
+  EGLConfig config() const { return config_; }
+  /// Within a Scope: draw and read through a window surface (eglSwapBuffers shows it).
+  void make_current(EGLSurface surface);
+  /// The name of the last EGL error.
+  static std::string error_name();
 
   /// A program built from two files of shader_dir() with the given defines, compiled once per
   /// process. Needs a Scope.
@@ -58,6 +68,7 @@ class Context {
 
   EGLDisplay display_ = EGL_NO_DISPLAY;
   EGLContext context_ = EGL_NO_CONTEXT;
+  EGLConfig config_ = nullptr;
   pid_t pid_ = 0;
   GlInfo info_;
   std::recursive_mutex mutex_;

@@ -60,23 +60,35 @@ std::optional<VolumeUpload> SceneRenderer::last_upload(const VolumeData* data) c
   return it->second->last_upload();
 }
 
+void SceneRenderer::snapshot(const Camera& camera, unsigned passes, Snapshot& snapshot,
+                             Frame& frame) {
+  auto lock = world_.lock_state();
+  world_.graphics_update();
+  take(camera, passes, snapshot);
+  frame.width = camera.width();
+  frame.height = camera.height();
+  frame.time = world_.time();
+  frame.step = world_.step_index();
+  frame.camera = camera.name();
+  frame.intrinsics = camera.intrinsics();
+  frame.pose = camera.pose().matrix();
+}
+
 void SceneRenderer::render(const Camera& camera, const CaptureBuffers& buffers, Frame& frame) {
-  Snapshot snapshot;
-  {
-    auto lock = world_.lock_state();
-    world_.graphics_update();
-    take(camera, buffers.passes(), snapshot);
-    frame.width = camera.width();
-    frame.height = camera.height();
-    frame.time = world_.time();
-    frame.step = world_.step_index();
-    frame.camera = camera.name();
-    frame.intrinsics = camera.intrinsics();
-    frame.pose = camera.pose().matrix();
-  }
+  Snapshot s;
+  snapshot(camera, buffers.passes(), s, frame);
   Context::Scope scope;
-  draw(snapshot);
-  read(snapshot, buffers);
+  draw(s);
+  read(s, buffers);
+}
+
+const RenderTarget& SceneRenderer::render_to_target(const Camera& camera, unsigned passes,
+                                                    Frame& frame) {
+  Snapshot s;
+  snapshot(camera, passes, s, frame);
+  Context::Scope scope;
+  draw(s);
+  return target_for(s);
 }
 
 void SceneRenderer::take(const Camera& camera, unsigned passes, Snapshot& s) {

@@ -103,6 +103,9 @@ class SceneRenderer {
   /// Renders camera's view into buffers (null ones are skipped) and fills frame's time, step,
   /// intrinsics and pose, all of one simulation step.
   void render(const Camera& camera, const CaptureBuffers& buffers, Frame& frame);
+  /// Renders camera's view (those passes) and leaves it in the camera's render target, for a
+  /// window to show; fills frame as render does. Needs no Scope.
+  const RenderTarget& render_to_target(const Camera& camera, unsigned passes, Frame& frame);
   /// What the last upload of this volume data sent to the GPU (nullptr before its first draw).
   std::optional<VolumeUpload> last_upload(const VolumeData* data) const;
 
@@ -113,6 +116,8 @@ class SceneRenderer {
   void draw(const Snapshot& snapshot);
   /// Reads the last draw of a snapshot's camera into buffers.
   void read(const Snapshot& snapshot, const CaptureBuffers& buffers);
+  /// Copies the camera's view out of the world (under its lock) and fills frame.
+  void snapshot(const Camera& camera, unsigned passes, Snapshot& snapshot, Frame& frame);
 
   GpuMesh& mesh_for(const std::shared_ptr<const MeshData>& mesh);
   /// The soft body's GPU mesh, its vertices refreshed from the snapshot (normals recomputed).

@@ -10,10 +10,12 @@
 namespace ambfplus {
 namespace {
 
+// The 4x4 matrix, row after row: exactly the pose (a replay sets it back bit for bit).
 void push_pose(std::vector<double>& out, const Eigen::Isometry3d& pose) {
-  const Eigen::Quaterniond q(pose.linear());
-  const Eigen::Vector3d& t = pose.translation();
-  out.insert(out.end(), {t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w()});
+  const Eigen::Matrix4d& m = pose.matrix();
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) out.push_back(m(r, c));
+  }
 }
 
 void push(std::vector<double>& out, const Eigen::Vector3d& v) {
@@ -26,9 +28,9 @@ StepLog::StepLog(std::vector<const Object*> objects) : objects_(std::move(object
   for (const Object* o : objects_) {
     const std::string& n = o->name();
     // An input device has no pose of its own: its reading is its state.
-    if (o->kind() != ObjectKind::kInputDevice) columns_.push_back({n + ".pose", 7, {}});
+    if (o->kind() != ObjectKind::kInputDevice) columns_.push_back({n + ".pose", 16, {}});
     if (o->kind() == ObjectKind::kDrill) {
-      for (const auto& [field, width] : std::vector<std::pair<const char*, int>>{{"goal", 7},
+      for (const auto& [field, width] : std::vector<std::pair<const char*, int>>{{"goal", 16},
                                                                                  {"force", 3},
                                                                                  {"total_force", 3},
                                                                                  {"on", 1},

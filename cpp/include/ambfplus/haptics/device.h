@@ -144,6 +144,29 @@ class AMBFPLUS_API ScriptedDevice final : public Device {
   DeviceState sample_;
 };
 
+/// The keyboard as a device, with the original drilling simulator's bindings (GLFW key codes):
+/// Ctrl+W/S move up/down, Ctrl+D/A right/left, Ctrl+I/K into/out of the screen by `step`
+/// (device frame: x right, y up, z towards the viewer; bind it with the camera as reference to
+/// move relative to the view); keypad 8/5 tilt about x, 4/6 turn about y by `angle`; Space
+/// toggles button 0 (spin the burr); C presses button 2 (the next burr). Key events come from
+/// the window's thread; a press shows in at least one reading even if released before it.
+class AMBFPLUS_API KeyboardDevice final : public Device {
+ public:
+  explicit KeyboardDevice(double step = 0.001, double angle = 0.05235987755982988);
+  /// A key event (GLFW key, action 0 release / 1 press / 2 repeat, modifier bits); true when it
+  /// is one of the device's keys (thread-safe).
+  bool key(int key, int action, int mods);
+  DeviceState read(std::int64_t step, double time) override;
+  /// Moves the device (to a reset pose, say) without a key (thread-safe).
+  void set_state(const DeviceState& state);
+
+ private:
+  double step_, angle_;
+  std::mutex mutex_;
+  DeviceState state_;
+  std::uint32_t latched_ = 0;  // presses not yet read
+};
+
 /// One logged reading: what a device gave for a step.
 struct AMBFPLUS_API DeviceRecord {
   std::int64_t step = 0;

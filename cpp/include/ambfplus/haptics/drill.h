@@ -110,6 +110,12 @@ class AMBFPLUS_API Drill : public Object {
   /// Bodies that move with the drill (its meshes), at a fixed offset from the drill frame; they
   /// become kinematic.
   void attach(RigidBody& body, const Eigen::Isometry3d& offset = Eigen::Isometry3d::Identity());
+  /// Whether attached bodies show the goal (where the hand is) instead of the drill's pose
+  /// (where the leading cursor's proxy holds it, the default).
+  void set_meshes_follow_goal(bool on) { meshes_follow_goal_ = on; }
+  bool meshes_follow_goal() const { return meshes_follow_goal_; }
+  /// Compatible removal: voxels a step removes with burr i.
+  void set_voxels_per_step(int burr, int count);
 
   /// One haptic step: cursors, force, removal. Called by World::step.
   void tick(double dt, std::int64_t step);
@@ -180,6 +186,7 @@ class AMBFPLUS_API Drill : public Object {
   std::size_t objects_seen_ = 0;         // world objects when meshes_ was built
   std::vector<DrillWaypoint> waypoints_;
   double waypoint_clock_ = 0.0;
+  bool meshes_follow_goal_ = false;
 };
 
 }  // namespace ambfplus

@@ -11,13 +11,14 @@ namespace ambfplus {
 class Object;
 
 /// What a world appends after every step while it logs (World::start_step_log), for
-/// recordings: the step, its time, and for each chosen object but input devices its pose (x, y,
-/// z, qx, qy, qz, qw, world frame), plus for a drill its goal (same layout), the force fed back and
-/// the sum over its cursors (N), whether the burr spins, the burr index and the leading cursor; for
-/// an input device its reading (position, orientation x y z w, buttons) and the force sent to it
-/// (N). Columns are named "<object>.<field>": "drill.pose", "drill.goal", "drill.force",
-/// "drill.total_force", "drill.on", "drill.burr", "drill.leading", "hand.position",
-/// "hand.orientation", "hand.buttons", "hand.force".
+/// recordings: the step, its time, and for each chosen object but input devices its pose (the
+/// 4x4 world-from-object matrix, row by row: exact, so a replay can set it back), plus for a
+/// drill its goal (the same), the force fed back and the sum over its cursors (N), whether the burr
+/// spins, the burr index and the leading cursor; for an input device its reading (position,
+/// orientation x y z w, buttons) and the force sent to it (N). Columns are named
+/// "<object>.<field>": "drill.pose", "drill.goal", "drill.force", "drill.total_force", "drill.on",
+/// "drill.burr", "drill.leading", "hand.position", "hand.orientation", "hand.buttons",
+/// "hand.force".
 class AMBFPLUS_API StepLog {
  public:
   struct Column {

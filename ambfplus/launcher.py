@@ -425,6 +425,11 @@ def run_window(glfw, args: argparse.Namespace, plugin_args: list[str]) -> int:
     frame_times: list[float] = []
     last_status: dict | None = None
     cpu_started: float | None = None  # process CPU time at the first frame
+    # A first frame before the clock starts: uploading the anatomy whole takes far longer than a
+    # physics period, and would stall the loop.
+    width, height = glfw.get_framebuffer_size(window)
+    views[(width, height)] = _view_of(world, camera, width, height, 0)
+    _window_of(window).present([views[(width, height)]], width, height)
     with session.loop:
         print(f"ambfplus-launch: {camera.name} in a {args.width}x{args.height} window; "
               f"physics: {session.loop.scheduling}", flush=True)  # fmt: skip

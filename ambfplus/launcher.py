@@ -18,6 +18,19 @@ the launch file names the anatomy for the drilling plugin (``--labels``). Keyboa
 - the camera: left drag orbits about the point it looks at, right (or Shift+left) drag pans,
   the wheel zooms.
 
+``--stereo side-by-side`` shows a stereo pair riding on the camera (``--ipd`` apart, zero
+disparity at the depth the camera looks at or ``--convergence``) for 3D monitors and
+projectors; ``--stereo hmd`` shows OpenHMD's first head-mounted display's eyes (its null device
+without hardware), turned by the head, each with the eye's projection and seen through the
+lens's distortion correction, in a window of the HMD's screen size; ``--stereo openxr`` checks
+for an OpenXR runtime and says why it falls back to OpenHMD.
+
+``--device`` chooses what moves the drill: the keyboard, ``network[:PORT]`` (poses from a
+bridge process over UDP on loopback, forces sent back every step; see ``ambfplus.network`` and
+``examples/network_bridge.py``) or ``joystick[:PATH]`` (a gamepad's sticks); ``--pedal PATH``
+adds a foot pedal's buttons (``--pedal-map drill=0,clutch=1,burr=2``: held spins the burr, held
+clutches, pressed takes the next burr). The keyboard's Space and C keep working with any device.
+
 The status line shows the burr, whether it spins, the control mode, the distance to the nearest
 critical structure (a warning under 2 mm or when one is cut), and the graphics and physics
 rates. ``--record`` writes the session (every step's drill state, the keyboard's readings and
@@ -37,8 +50,21 @@ from pathlib import Path
 
 import numpy as np
 
-from . import KeyboardDevice, RealTimeLoop, Simulator, __version__
+from . import (
+    AssetNotFound,
+    Device,
+    JoystickDevice,
+    JoystickMapping,
+    KeyboardDevice,
+    MergedDevice,
+    NetworkDevice,
+    RealTimeLoop,
+    Simulator,
+    __version__,
+)
 from ._core import Window, use_x11_display
+from .hmd import HmdError, HmdView, OpenHMD, openxr_status
+from .stereo import StereoRig
 
 # GLFW's codes for the keys and buttons the launcher handles itself.
 KEY_ESCAPE, KEY_Q, KEY_N, KEY_R = 256, 81, 78, 82
@@ -47,6 +73,7 @@ PRESS, RELEASE = 1, 0
 MOUSE_LEFT, MOUSE_RIGHT = 0, 1
 # How close a critical structure may come before the status warns, metres.
 WARN_DISTANCE = 0.002
+STEREO_MODES = ("off", "side-by-side", "hmd", "openxr")
 
 
 def parse_args(argv: list[str] | None) -> tuple[argparse.Namespace, list[str]]:
@@ -78,8 +105,27 @@ def parse_args(argv: list[str] | None) -> tuple[argparse.Namespace, list[str]]:
     p.add_argument("--ns", default="", help="namespace prefix")
     p.add_argument("--plugins", default="", help="simulator plugins, comma separated")
     p.add_argument("--camera", help="the camera to show (default: the world's first)")
-    p.add_argument("--width", type=int, default=1536)
-    p.add_argument("--height", type=int, default=540)
+    p.add_argument("--width", type=int, help="window width (default 1536, an HMD's screen)")
+    p.add_argument("--height", type=int, help="window height (default 540, an HMD's screen)")
+    p.add_argument("--stereo", choices=STEREO_MODES, default="off",
+                   help="side-by-side: a stereo pair riding on the camera; hmd: OpenHMD's "
+                   "first head-mounted display (its null device without one), head tracked, "
+                   "lens corrected; openxr: an OpenXR runtime where one exists, else as hmd",
+                   )  # fmt: skip
+    p.add_argument("--ipd", type=float,
+                   help="metres between the eyes (default: the HMD's; else the scene's stereoL "
+                   "to stereoR; else 0.065)")  # fmt: skip
+    p.add_argument("--convergence", type=float,
+                   help="side-by-side: the depth (m) shown with zero disparity (default: where "
+                   "the camera looks; 0: parallel cameras)")  # fmt: skip
+    p.add_argument("--device", default="keyboard",
+                   help="what moves the drill: keyboard, network[:PORT] (a bridge's UDP poses, "
+                   "loopback) or joystick[:PATH] (default /dev/input/js0)")  # fmt: skip
+    p.add_argument("--pedal", help="a foot pedal or gamepad for the drill's buttons "
+                   "(/dev/input/jsN)")  # fmt: skip
+    p.add_argument("--pedal-map", default="drill=0,clutch=1,burr=2",
+                   help="which pedal buttons spin the burr (held), clutch (held) and take the "
+                   "next burr (pressed)")  # fmt: skip
     p.add_argument("--record", type=Path, help="record the session to this HDF5 file")
     p.add_argument("--seconds", type=float, help="quit after this many seconds")
     p.add_argument("--status", type=Path, help="write the status (JSON) here as it changes")
@@ -235,6 +281,7 @@ class Session:
             raise SystemExit(f"ambfplus-launch: {launch} has no camera to show")
         self.drill = self.world.drills[0] if self.world.drills else None
         self.keyboard = KeyboardDevice()
+        self.device, self.device_name = make_device(args, self.keyboard)
         self.binding = None
         self.spec = {
             "builder": "launch",
@@ -251,12 +298,13 @@ class Session:
         self.device_options = {
             "reference": self.camera.name,
             "drill_button": 0,
-            "clutch_button": -1,
+            "clutch_button": 1,
             "burr_button": 2,
         }
         if self.drill is not None:
             options = dict(self.device_options, reference=self.camera)
-            self.binding = self.world.add_input_device("keyboard", self.keyboard, self.drill,
+            # Named "keyboard" whatever drives it: the name replay looks for (scenes.launch_scene).
+            self.binding = self.world.add_input_device("keyboard", self.device, self.drill,
                                                        **options)  # fmt: skip
         self.initial_goal = self.drill.goal.copy() if self.drill is not None else None
         self.loop = RealTimeLoop(self.world, rate=args.phx_frequency)
@@ -273,7 +321,8 @@ class Session:
             "scene": self.spec,
             "device": {
                 "name": "keyboard",
-                "kind": "KeyboardDevice",
+                "kind": type(self.device).__name__,
+                "source": self.device_name,
                 "options": self.device_options,
             },  # fmt: skip
             "camera": self.camera.name,
@@ -313,6 +362,7 @@ class Session:
         if self.drill is None:
             status.mode = "no drill"
             return status
+        status.mode = "clutch" if self.binding.clutched else self.device_name
         status.burr_mm = self.drill.burr_diameters[self.drill.burr] * 1000
         status.spinning = self.drill.on
         status.drill_position = self.drill.cursor_proxies[0].round(6).tolist()
@@ -327,6 +377,55 @@ class Session:
         else:
             status.warning = ""
         return status
+
+
+def make_device(args: argparse.Namespace, keyboard: KeyboardDevice) -> tuple[Device, str]:
+    """The device --device names (its buttons merged with the keyboard's and --pedal's), and
+    how the status line names it."""
+    kind, _, where = args.device.partition(":")
+    if kind == "keyboard" and not where:
+        pose: Device = keyboard
+    elif kind == "network":
+        try:
+            pose = NetworkDevice(int(where) if where else 0)
+        except ValueError as error:
+            raise SystemExit(f"ambfplus-launch: --device {args.device}: {error}") from None
+        except RuntimeError as error:
+            raise SystemExit(f"ambfplus-launch: {error}") from None
+        print(f"ambfplus-launch: network device on 127.0.0.1:{pose.port} (UDP)", flush=True)
+        kind = f"network :{pose.port}"
+    elif kind == "joystick":
+        pose = _joystick(where or "/dev/input/js0")
+    else:
+        raise SystemExit(
+            f"ambfplus-launch: --device is keyboard, network[:PORT] or joystick[:PATH], got "
+            f"'{args.device}'"
+        )
+    buttons = [] if pose is keyboard else [keyboard]
+    if args.pedal:
+        buttons.append(_joystick(args.pedal, pedal_mapping(args.pedal_map)))
+        kind += " + pedal"
+    return (MergedDevice(pose, buttons) if buttons else pose), kind
+
+
+def pedal_mapping(text: str) -> JoystickMapping:
+    """--pedal-map: "drill=0,clutch=1,burr=2" (a role left out: no button); no axes."""
+    roles = {"drill": -1, "clutch": -1, "burr": -1}
+    for item in text.replace(" ", "").split(","):
+        role, _, number = item.partition("=")
+        if role not in roles or not number.lstrip("-").isdigit():
+            raise SystemExit(
+                f"ambfplus-launch: --pedal-map takes drill=N,clutch=N,burr=N, got '{text}'"
+            )
+        roles[role] = int(number)
+    return JoystickMapping(**roles, axes=(-1, -1, -1))
+
+
+def _joystick(path: str, mapping: JoystickMapping | None = None) -> JoystickDevice:
+    try:
+        return JoystickDevice(path, mapping or JoystickMapping())
+    except AssetNotFound as error:
+        raise SystemExit(f"ambfplus-launch: {error}") from None
 
 
 def run(argv: list[str] | None = None) -> int:
@@ -369,15 +468,21 @@ def run_headless(args: argparse.Namespace, plugin_args: list[str]) -> int:
 
 
 def run_window(glfw, args: argparse.Namespace, plugin_args: list[str]) -> int:
-    glfw.window_hint(glfw.CLIENT_API, glfw.NO_API)
-    window = glfw.create_window(args.width, args.height, "ambfplus", None, None)
-    if not window:
-        print("ambfplus-launch: GLFW could not create a window", file=sys.stderr)
-        return 2
     use_x11_display(ctypes.cast(glfw.get_x11_display(), ctypes.c_void_p).value)
     session = Session(args, plugin_args)
     world, camera = session.world, session.camera
-    views: dict[tuple[int, int], object] = {}  # the camera seen at each window size
+    views = Views(session, args)
+    for note in views.notes:
+        print(f"ambfplus-launch: {note}", flush=True)
+    glfw.window_hint(glfw.CLIENT_API, glfw.NO_API)
+    window_size = views.window_size(args)
+    window = glfw.create_window(*window_size, "ambfplus", None, None)
+    if not window:
+        print("ambfplus-launch: GLFW could not create a window", file=sys.stderr)
+        return 2
+    lens = views.lens()
+    if lens is not None:
+        _window_of(window).set_lens(**lens)
     target = camera.pose[:3, 3] + camera.pose[:3, 2] * _look_distance(session)
     orbit = Orbit(target)
     status = Status()
@@ -428,11 +533,10 @@ def run_window(glfw, args: argparse.Namespace, plugin_args: list[str]) -> int:
     # A first frame before the clock starts: uploading the anatomy whole takes far longer than a
     # physics period, and would stall the loop.
     width, height = glfw.get_framebuffer_size(window)
-    views[(width, height)] = _view_of(world, camera, width, height, 0)
-    _window_of(window).present([views[(width, height)]], width, height)
+    _window_of(window).present(views.cameras(width, height), width, height)
     with session.loop:
-        print(f"ambfplus-launch: {camera.name} in a {args.width}x{args.height} window; "
-              f"physics: {session.loop.scheduling}", flush=True)  # fmt: skip
+        print(f"ambfplus-launch: {camera.name} in a {window_size[0]}x{window_size[1]} window "
+              f"({views.mode}); physics: {session.loop.scheduling}", flush=True)  # fmt: skip
         while not glfw.window_should_close(window):
             glfw.poll_events()
             now = time.perf_counter()
@@ -443,10 +547,8 @@ def run_window(glfw, args: argparse.Namespace, plugin_args: list[str]) -> int:
             )
             session.status(status, fps)
             width, height = glfw.get_framebuffer_size(window)
-            if (width, height) not in views:
-                views[(width, height)] = _view_of(world, camera, width, height, len(views))
             overlay = draw_overlay(status, width, height)
-            shown = _window_of(window).present([views[(width, height)]], width, height, overlay)
+            shown = _window_of(window).present(views.cameras(width, height), width, height, overlay)
             shown_at = time.perf_counter()
             status.frames += 1
             # CPU per frame of the whole process (rendering threads, physics and all).
@@ -464,7 +566,8 @@ def run_window(glfw, args: argparse.Namespace, plugin_args: list[str]) -> int:
                     latency_log.flush()
             session.drain()
             if args.status is not None:
-                current = {**status.__dict__, "step": step}
+                current = {**status.__dict__, "step": step,
+                           "stereo": views.describe(width, height)}  # fmt: skip
                 if current != last_status:
                     args.status.write_text(json.dumps(current))
                     last_status = current
@@ -489,17 +592,130 @@ def _window_of(window) -> Window:
     return _windows[key]
 
 
-def _view_of(world, camera, width: int, height: int, index: int):
-    """A camera riding on `camera` with its optics at the window's size (a camera's own size is
-    what it publishes; the window shows its view at the window's)."""
+def _view_of(world, camera, width: int, height: int, name: str, x: float = 0.0):
+    """A camera riding on `camera` (x metres along its x axis) with its optics at the window's
+    size (a camera's own size is what it publishes; the window shows its view at the
+    window's)."""
+    offset = np.eye(4)
+    offset[0, 3] = x
     with world.lock():
         view = world.add_camera(
-            f"{camera.name}_window{index}", width, height, fov_y=camera.fov_y, near=camera.near,
-            far=camera.far,
-        )  # fmt: skip
-        view.attach_to(camera, np.eye(4))
-        view.pose = camera.pose
+            name, width, height, fov_y=camera.fov_y, near=camera.near, far=camera.far
+        )
+        view.attach_to(camera, offset)
+        view.pose = camera.pose @ offset
     return view
+
+
+class Views:
+    """What the window shows (--stereo): the camera; a stereo pair riding on it, side by side; or
+    a head-mounted display's eyes, turned by the head and seen through its lenses."""
+
+    def __init__(self, session: Session, args: argparse.Namespace) -> None:
+        self.world, self.camera = session.world, session.camera
+        self.mode = args.stereo
+        self.notes: list[str] = []
+        self.hmd = None
+        if self.mode == "openxr":
+            available, why = openxr_status()
+            why = (
+                "an OpenXR runtime is there, but ambfplus does not run OpenXR sessions yet"
+                if available
+                else f"OpenXR: {why}"
+            )
+            self.notes.append(f"{why}; using OpenHMD")
+            self.mode = "hmd"
+        if self.mode == "hmd":
+            try:
+                self.hmd = OpenHMD()
+                self.notes.append(f"head-mounted display: {self.hmd.name}")
+            except HmdError as error:
+                self.notes.append(f"{error}; showing side-by-side stereo instead")
+                self.mode = "side-by-side"
+        self.ipd = args.ipd if args.ipd is not None else self._default_ipd()
+        if not self.ipd > 0:
+            raise SystemExit(f"ambfplus-launch: --ipd must be > 0 m, got {self.ipd}")
+        self.convergence = args.convergence
+        self.look_distance = _look_distance(session)
+        self._views: dict[tuple[int, int], list] = {}
+        self._hmd_views: dict[tuple[int, int], HmdView] = {}
+
+    def _default_ipd(self) -> float:
+        """The HMD's; else the baseline of the scene's stereo pair (stereoL and stereoR, as the
+        original's drilling scene has); else 65 mm."""
+        if self.hmd is not None:
+            return self.hmd.ipd
+        if "stereoL" in self.world and "stereoR" in self.world:
+            try:
+                return StereoRig.from_cameras(self.world["stereoL"], self.world["stereoR"]).baseline
+            except ValueError:
+                pass
+        return 0.065
+
+    def window_size(self, args: argparse.Namespace) -> tuple[int, int]:
+        if self.hmd is not None:
+            eye_width, eye_height = self.hmd.eye_resolution
+            default = (2 * eye_width, eye_height)
+        else:
+            default = (1536, 540)
+        return args.width or default[0], args.height or default[1]
+
+    def lens(self) -> dict | None:
+        return self.hmd.lens() if self.hmd is not None else None
+
+    def cameras(self, width: int, height: int) -> list:
+        """The cameras shown left to right in a window of this size (made once per size); an
+        HMD's eyes turned to where the head now looks."""
+        key = (width, height)
+        if key not in self._views:
+            self._views[key] = self._make(width, height, len(self._views))
+        if key in self._hmd_views:
+            with self.world.lock():
+                self._hmd_views[key].update()
+        return self._views[key]
+
+    def _make(self, width: int, height: int, index: int) -> list:
+        camera, world = self.camera, self.world
+        name = f"{camera.name}_window{index}"
+        if self.mode == "off":
+            return [_view_of(world, camera, width, height, name)]
+        if self.mode == "hmd":
+            with world.lock():
+                view = HmdView(world, self.hmd, camera, name=name,
+                               scale=(width // 2) / self.hmd.eye_resolution[0])  # fmt: skip
+            self._hmd_views[(width, height)] = view
+            return view.cameras
+        # Side by side: each eye half the window, half the IPD either side of the camera.
+        left = _view_of(world, camera, width // 2, height, f"{name}_left", -self.ipd / 2)
+        right = _view_of(world, camera, width - width // 2, height, f"{name}_right", self.ipd / 2)
+        convergence = self.look_distance if self.convergence is None else self.convergence
+        if convergence > 0:
+            with world.lock():
+                StereoRig.from_cameras(left, right).set_working_distance(convergence)
+        return [left, right]
+
+    def describe(self, width: int, height: int) -> dict:
+        """The views' geometry, for the status file: mode, IPD, each eye's focal length and
+        principal point, and (side by side) the zero-disparity depth."""
+        cameras = self._views.get((width, height)) or self.cameras(width, height)
+        out = {"mode": self.mode, "ipd": self.ipd, "views": len(cameras)}
+        if self.hmd is not None:
+            out["hmd"] = self.hmd.name
+            out["head"] = [float(v) for v in self.hmd.rotation]
+        out["eyes"] = [
+            {
+                "name": c.name,
+                "size": [c.width, c.height],
+                "focal": float(c.intrinsics[0, 0]),
+                "principal_point": [float(v) for v in c.principal_point],
+            }
+            for c in cameras
+        ]
+        if self.mode == "side-by-side":
+            out["convergence"] = self.look_distance if self.convergence is None else (
+                self.convergence
+            )  # fmt: skip
+        return out
 
 
 def _look_distance(session: Session) -> float:

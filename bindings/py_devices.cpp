@@ -451,6 +451,73 @@ void register_devices(py::module_& m,
           [](KeyboardDevice& d, const py::object& state) { d.set_state(to_state(state, "state")); },
           py::arg("state"), "Sets the reading ({position, orientation, buttons}).");
 
+  py::class_<NetworkDevice, Device, std::shared_ptr<NetworkDevice>>(
+      m, "NetworkDevice",
+      "A device on the network: a bridge sends 80-byte UDP pose datagrams and gets 48-byte "
+      "force datagrams back after every step (format in ambfplus/haptics/device.h and "
+      "README); bound to loopback unless another address is given. Malformed, oversized or "
+      "stale messages are rejected and counted.")
+      .def(py::init([](int port, const std::string& address, double max_distance) {
+             py::gil_scoped_release release;
+             return std::make_shared<NetworkDevice>(port, address, max_distance);
+           }),
+           py::arg("port") = 0, py::arg("address") = "127.0.0.1", py::arg("max_distance") = 10.0)
+      .def_property_readonly("port", &NetworkDevice::port, "the bound UDP port")
+      .def_property_readonly("accepted", &NetworkDevice::accepted, "poses accepted")
+      .def_property_readonly(
+          "rejected",
+          [](NetworkDevice& d) {
+            py::dict out;
+            for (const auto& [reason, count] : d.rejected()) out[py::str(reason)] = count;
+            return out;
+          },
+          "messages rejected, by reason (size, magic, version, values, range, rotation, "
+          "sequence)");
+
+  py::class_<JoystickDevice::Mapping>(m, "JoystickMapping",
+                                      "Which joystick buttons and axes do what.")
+      .def(py::init([](int drill, int clutch, int burr, std::array<int, 3> axes, double speed,
+                       double deadband) {
+             return JoystickMapping{drill, clutch, burr, axes, speed, deadband};
+           }),
+           py::arg("drill") = 0, py::arg("clutch") = 1, py::arg("burr") = 2,
+           py::arg("axes") = std::array<int, 3>{0, 1, -1}, py::arg("speed") = 0.02,
+           py::arg("deadband") = 0.05)
+      .def_readonly("drill", &JoystickDevice::Mapping::drill)
+      .def_readonly("clutch", &JoystickDevice::Mapping::clutch)
+      .def_readonly("burr", &JoystickDevice::Mapping::burr)
+      .def_readonly("axes", &JoystickDevice::Mapping::axes)
+      .def_readonly("speed", &JoystickDevice::Mapping::speed)
+      .def_readonly("deadband", &JoystickDevice::Mapping::deadband);
+
+  py::class_<JoystickDevice, Device, std::shared_ptr<JoystickDevice>>(
+      m, "JoystickDevice",
+      "A joystick, gamepad or foot pedal through the Linux joystick interface (/dev/input/jsN): "
+      "buttons spin the burr (held), clutch (held) or take the next burr (pressed); axes move "
+      "the device. Without a path, events come only from feed().")
+      .def(py::init([](const std::string& path, const JoystickDevice::Mapping& mapping) {
+             return std::make_shared<JoystickDevice>(path, mapping);
+           }),
+           py::arg("path") = "", py::arg("mapping") = JoystickDevice::Mapping())
+      .def(
+          "feed",
+          [](JoystickDevice& d, const py::bytes& events) {
+            const std::string s = events;
+            d.feed(reinterpret_cast<const std::uint8_t*>(s.data()), s.size());
+          },
+          py::arg("events"),
+          "Linux js_event records (8 bytes each: uint32 time ms, int16 value, uint8 type, uint8 "
+          "number), as read from the device file.")
+      .def_property_readonly("mapping", &JoystickDevice::mapping)
+      .def_property_readonly("disconnected", &JoystickDevice::disconnected,
+                             "the device file failed (unplugged): every button is released");
+
+  py::class_<MergedDevice, Device, std::shared_ptr<MergedDevice>>(
+      m, "MergedDevice",
+      "A pose from one device and buttons from others (a haptic device with a foot pedal).")
+      .def(py::init<std::shared_ptr<Device>, std::vector<std::shared_ptr<Device>>>(),
+           py::arg("pose"), py::arg("buttons"));
+
   py::class_<ReplayDevice, Device, std::shared_ptr<ReplayDevice>>(
       m, "ReplayDevice", "Plays back the readings of an InputDevice's log, step by step.")
       .def(py::init([](const py::dict& log) {

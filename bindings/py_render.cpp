@@ -87,7 +87,32 @@ void register_render(py::module_& m) {
           py::arg("cameras"), py::arg("width"), py::arg("height"), py::arg("overlay") = py::none(),
           "Renders the cameras side by side into the window (width x height pixels), blends the "
           "RGBA overlay over them and shows it (GIL released); returns each view's camera, step "
-          "and time.");
+          "and time.")
+      .def(
+          "set_lens",
+          [](Window& w, std::optional<std::array<float, 4>> k, std::array<float, 3> aberration,
+             std::vector<std::array<float, 2>> centres, float radius, float aspect) {
+            if (!k) {
+              w.set_lens(std::nullopt);
+              return;
+            }
+            LensDistortion lens;
+            lens.k = *k;
+            lens.aberration = aberration;
+            lens.centres = std::move(centres);
+            lens.radius = radius;
+            lens.aspect = aspect;
+            w.set_lens(lens);
+          },
+          py::arg("k"), py::arg("aberration") = std::array<float, 3>{1, 1, 1},
+          py::arg("centres") = std::vector<std::array<float, 2>>{}, py::arg("radius") = 0.5f,
+          py::arg("aspect") = 1.0f,
+          "Undoes a head-mounted display's lens distortion on every view from now on (k: the "
+          "PanoTools coefficients a, b, c, d; a window pixel at r from its view's lens centre "
+          "shows the image at r (a r^3 + b r^2 + c r + d); r in units of radius, a fraction of "
+          "the view's width; centres: each view's lens centre as fractions of its viewport, y "
+          "from the bottom; aspect: the view's physical width / height). k=None shows plain "
+          "images.");
 }
 
 }  // namespace ambfplus::bindings

@@ -3,6 +3,9 @@
 from __future__ import annotations
 
 import os
+import shutil
+import subprocess
+import time
 from pathlib import Path
 
 import numpy as np
@@ -41,3 +44,32 @@ def backproject(frame) -> np.ndarray:
     cam = rays[valid] * frame.depth[valid][:, None].astype(np.float64)
     pose = frame.pose
     return cam @ pose[:3, :3].T + pose[:3, 3]
+
+
+# What window tests need: a virtual X server, keys sent to it, the screen read back.
+X11_TOOLS = ("Xvfb", "xdotool", "xwd")
+
+
+@pytest.fixture(scope="session")
+def display():
+    """A virtual X display of its own (Xvfb), torn down after the tests."""
+    missing = [tool for tool in X11_TOOLS if shutil.which(tool) is None]
+    if missing:
+        pytest.skip(f"needs {', '.join(missing)} (Debian: xvfb xdotool x11-apps)")
+    pytest.importorskip("glfw", reason="the launcher's window needs glfw (pip: ambfplus[gui])")
+    for number in range(90, 110):
+        if not Path(f"/tmp/.X11-unix/X{number}").exists():
+            break
+    name = f":{number}"
+    server = subprocess.Popen(
+        ["Xvfb", name, "-screen", "0", "1920x1080x24", "-nolisten", "tcp"],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    for _ in range(100):
+        if Path(f"/tmp/.X11-unix/X{number}").exists():
+            break
+        time.sleep(0.05)
+    yield name
+    server.terminate()
+    server.wait(timeout=10)

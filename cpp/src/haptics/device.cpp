@@ -218,6 +218,28 @@ void KeyboardDevice::set_state(const DeviceState& state) {
   state_.orientation.normalize();
 }
 
+MergedDevice::MergedDevice(std::shared_ptr<Device> pose,
+                           std::vector<std::shared_ptr<Device>> buttons)
+    : Device(pose ? pose->spec() : DeviceSpec{}),
+      pose_(std::move(pose)),
+      buttons_(std::move(buttons)) {
+  if (!pose_) throw std::invalid_argument("merged device: needs a device for the pose");
+  for (const auto& b : buttons_) {
+    if (!b) throw std::invalid_argument("merged device: a button device is missing");
+  }
+}
+
+DeviceState MergedDevice::read(std::int64_t step, double time) {
+  DeviceState s = pose_->read(step, time);
+  for (const auto& b : buttons_) s.buttons |= b->read(step, time).buttons;
+  return s;
+}
+
+void MergedDevice::write(const Eigen::Vector3d& force, double dt) {
+  last_force_ = force;
+  pose_->write(force, dt);
+}
+
 ReplayDevice::ReplayDevice(std::vector<DeviceRecord> records, DeviceSpec spec)
     : Device(std::move(spec)), records_(std::move(records)) {
   for (std::size_t i = 1; i < records_.size(); ++i) {

@@ -3,6 +3,9 @@
 #include <epoxy/egl.h>
 #include <epoxy/gl.h>
 
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
 #include <string>
 
 #include "ambfplus/errors.h"
@@ -15,11 +18,59 @@ namespace ambfplus {
 
 void use_x11_display(void* display) { render::Context::use_x11_display(display); }
 
+namespace {
+
+// Copies the view's image into a texture (the lens pass samples it anywhere), then draws the
+// viewport through the lens.
+void draw_through_lens(const render::RenderTarget& target, const LensDistortion& lens, int view,
+                       std::array<GLuint, 3>& texture, GLuint vao, int x, int width, int height) {
+  if (texture[0] == 0 || static_cast<int>(texture[1]) != target.width ||
+      static_cast<int>(texture[2]) != target.height) {
+    // Storage is immutable: a new size takes a new texture.
+    if (texture[0] != 0) glDeleteTextures(1, &texture[0]);
+    glGenTextures(1, &texture[0]);
+    glBindTexture(GL_TEXTURE_2D, texture[0]);
+    glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA8, target.width, target.height);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    texture[1] = static_cast<GLuint>(target.width);
+    texture[2] = static_cast<GLuint>(target.height);
+  }
+  glCopyImageSubData(target.renderbuffers[0], GL_RENDERBUFFER, 0, 0, 0, 0, texture[0],
+                     GL_TEXTURE_2D, 0, 0, 0, 0, target.width, target.height, 1);
+  std::array<float, 2> centre{0.5f, 0.5f};
+  if (!lens.centres.empty()) {
+    centre = lens.centres[std::min(static_cast<std::size_t>(view), lens.centres.size() - 1)];
+  }
+  render::Program& program = render::Context::get().program("overlay.vert", "lens.frag");
+  program.use();
+  glUniform1i(program.uniform("u_image"), 0);
+  glUniform4f(program.uniform("u_k"), lens.k[0], lens.k[1], lens.k[2], lens.k[3]);
+  glUniform3f(program.uniform("u_aberration"), lens.aberration[0], lens.aberration[1],
+              lens.aberration[2]);
+  glUniform2f(program.uniform("u_centre"), centre[0], centre[1]);
+  glUniform1f(program.uniform("u_radius"), lens.radius);
+  glUniform1f(program.uniform("u_aspect"), lens.aspect);
+  glActiveTexture(GL_TEXTURE0);
+  glBindTexture(GL_TEXTURE_2D, texture[0]);
+  glViewport(x, 0, width, height);
+  glBindVertexArray(vao);
+  glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+  glBindVertexArray(0);
+}
+
+}  // namespace
+
 struct Window::State {
   EGLSurface surface = EGL_NO_SURFACE;
   GLuint overlay = 0;  // texture
   GLuint vao = 0;      // empty: the quad comes from vertex ids
   int overlay_width = 0, overlay_height = 0;
+  std::optional<LensDistortion> lens;
+  // A texture per view holding its image for the lens pass: texture, width, height.
+  std::vector<std::array<GLuint, 3>> views;
 };
 
 Window::Window(unsigned long x11_window) : state_(std::make_unique<State>()) {
@@ -50,6 +101,7 @@ Window::~Window() {
   if (!render::Context::exists()) return;
   try {
     render::Context::Scope scope;
+    for (const auto& v : state_->views) glDeleteTextures(1, &v[0]);
     glDeleteTextures(1, &state_->overlay);
     glDeleteVertexArrays(1, &state_->vao);
     eglDestroySurface(render::Context::get().display(), state_->surface);
@@ -86,10 +138,17 @@ std::vector<Frame> Window::present(const std::vector<const Camera*>& cameras, in
   for (int i = 0; i < n; ++i) {
     const render::RenderTarget& t = *targets[i];
     const int x0 = width * i / n, x1 = width * (i + 1) / n;
+    if (s.lens) {
+      while (static_cast<int>(s.views.size()) <= i) s.views.push_back({0, 0, 0});
+      draw_through_lens(t, *s.lens, i, s.views[static_cast<std::size_t>(i)], s.vao, x0, x1 - x0,
+                        height);
+      continue;
+    }
     glBindFramebuffer(GL_READ_FRAMEBUFFER, t.framebuffer);
     glReadBuffer(GL_COLOR_ATTACHMENT0);
     glBlitFramebuffer(0, 0, t.width, t.height, x0, height, x1, 0, GL_COLOR_BUFFER_BIT, GL_LINEAR);
   }
+  glViewport(0, 0, width, height);
   if (overlay != nullptr) {
     glBindTexture(GL_TEXTURE_2D, s.overlay);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
@@ -118,6 +177,21 @@ std::vector<Frame> Window::present(const std::vector<const Camera*>& cameras, in
   }
   context.make_current(EGL_NO_SURFACE);
   return frames;
+}
+
+void Window::set_lens(std::optional<LensDistortion> lens) {
+  if (lens) {
+    const auto finite = [](float v) { return std::isfinite(v); };
+    const bool ok = std::all_of(lens->k.begin(), lens->k.end(), finite) &&
+                    std::all_of(lens->aberration.begin(), lens->aberration.end(), finite) &&
+                    finite(lens->radius) && finite(lens->aspect) && lens->radius > 0 &&
+                    lens->aspect > 0;
+    if (!ok) {
+      throw std::invalid_argument(
+          "a lens needs finite coefficients and aberrations and a positive radius and aspect");
+    }
+  }
+  state_->lens = std::move(lens);
 }
 
 }  // namespace ambfplus

@@ -1,10 +1,15 @@
 #pragma once
 
+#include <array>
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <mutex>
 #include <string>
+#include <thread>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -165,6 +170,123 @@ class AMBFPLUS_API KeyboardDevice final : public Device {
   std::mutex mutex_;
   DeviceState state_;
   std::uint32_t latched_ = 0;  // presses not yet read
+};
+
+/// A device on the network: a bridge process (a proprietary haptic SDK, a recorded trajectory)
+/// sends poses over UDP and receives the force to render, so no SDK links into the engine.
+///
+/// Messages are little-endian datagrams. Pose, bridge to engine, exactly 80 bytes:
+///   0 magic "APDP", 4 uint16 version (1), 6 uint16 reserved (0), 8 uint64 sequence (increasing),
+///   16 float64 x3 position (m, device frame), 40 float64 x4 orientation (x, y, z, w; unit to
+///   1e-3, renormalised), 72 uint32 buttons, 76 uint32 reserved (0).
+/// Force, engine to the sender of the last accepted pose, 48 bytes, after every step:
+///   0 magic "APDF", 4 uint16 version (1), 6 uint16 reserved, 8 uint64 sequence of the pose it
+///   answers, 16 float64 simulation time (s), 24 float64 x3 force (N, device frame).
+/// Anything else (another size, magic or version, non-finite numbers, a position farther than
+/// `max_distance`, a quaternion that is not a rotation, a sequence not after the last accepted
+/// one) is rejected and counted by reason; the last accepted reading stays in force. Readings
+/// are relative to the first accepted pose (position minus its position, orientation times its
+/// inverse), so a bridge's device takes the drill up where it is, as a clutch would.
+class AMBFPLUS_API NetworkDevice final : public Device {
+ public:
+  static constexpr std::size_t kPoseBytes = 80, kForceBytes = 48;
+  /// Binds UDP `port` (0: any free port, see port()) on `address` (loopback unless another
+  /// address is given on purpose). Throws std::runtime_error naming the address if it cannot.
+  explicit NetworkDevice(int port = 0, const std::string& address = "127.0.0.1",
+                         double max_distance = 10.0);
+  ~NetworkDevice() override;
+
+  int port() const { return port_; }
+  DeviceState read(std::int64_t step, double time) override;
+  void write(const Eigen::Vector3d& force, double dt) override;
+  /// Poses accepted, and messages rejected by reason ("size", "magic", "version", "values",
+  /// "range", "rotation", "sequence").
+  std::uint64_t accepted() const;
+  std::vector<std::pair<std::string, std::uint64_t>> rejected() const;
+  /// Checks a datagram; the reading it carries, or the reason it is refused.
+  static bool parse(const std::uint8_t* data, std::size_t size, double max_distance,
+                    DeviceState& state, std::uint64_t& sequence, std::string& reason);
+
+ private:
+  void receive();
+
+  int socket_ = -1;
+  int port_ = 0;
+  double max_distance_;
+  double time_ = 0.0;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+  mutable std::mutex mutex_;
+  DeviceState state_;
+  Eigen::Vector3d origin_position_ = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond origin_orientation_ = Eigen::Quaterniond::Identity();
+  std::uint64_t sequence_ = 0;
+  bool has_client_ = false;
+  std::uint8_t client_[128] = {};  // sockaddr_storage of the last sender
+  unsigned client_size_ = 0;
+  std::uint64_t accepted_ = 0;
+  std::vector<std::pair<std::string, std::uint64_t>> rejected_;
+};
+
+/// Which joystick buttons and axes do what (JoystickDevice).
+struct AMBFPLUS_API JoystickMapping {
+  int drill = 0;                      ///< joystick button held: the burr spins (device button 0)
+  int clutch = 1;                     ///< held: clutch (device button 1)
+  int burr = 2;                       ///< pressed: the next burr (device button 2)
+  std::array<int, 3> axes{0, 1, -1};  ///< joystick axis moving x, y, z (-1: none)
+  double speed = 0.02;                ///< m/s at full deflection
+  double deadband = 0.05;             ///< of full deflection
+};
+
+/// A joystick, gamepad or foot pedal through the Linux joystick interface (/dev/input/jsN):
+/// buttons take roles (held: the burr spins, held: clutch, pressed: the next burr) and axes move
+/// the device at `speed` m/s at full deflection (x right, y up, z towards the user). Events come
+/// from the device file on a thread of its own, or from feed() (tests, other sources).
+class AMBFPLUS_API JoystickDevice final : public Device {
+ public:
+  using Mapping = JoystickMapping;
+  /// Without a path: events only through feed().
+  explicit JoystickDevice(const std::string& path = "", Mapping mapping = Mapping());
+  ~JoystickDevice() override;
+
+  /// Linux js_event records (8 bytes each: uint32 time ms, int16 value, uint8 type, uint8
+  /// number); a partial record waits for the rest.
+  void feed(const std::uint8_t* data, std::size_t size);
+  DeviceState read(std::int64_t step, double time) override;
+  const Mapping& mapping() const { return mapping_; }
+  /// The device file failed (unplugged): every button is released and the device stands still.
+  bool disconnected() const;
+
+ private:
+  void event(std::int16_t value, std::uint8_t type, std::uint8_t number);
+  void listen();
+
+  Mapping mapping_;
+  int fd_ = -1;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+  mutable std::mutex mutex_;
+  std::vector<std::uint8_t> partial_;
+  bool disconnected_ = false;
+  std::array<double, 3> deflection_{0, 0, 0};
+  std::uint32_t held_ = 0, latched_ = 0;  // device buttons
+  DeviceState state_;
+  double last_time_ = -1;
+};
+
+/// A pose from one device and buttons from others (a haptic device with a foot pedal).
+class AMBFPLUS_API MergedDevice final : public Device {
+ public:
+  MergedDevice(std::shared_ptr<Device> pose, std::vector<std::shared_ptr<Device>> buttons);
+  DeviceState read(std::int64_t step, double time) override;
+  void write(const Eigen::Vector3d& force, double dt) override;
+  bool polled() const override { return pose_->polled(); }
+  int poll_every() const override { return pose_->poll_every(); }
+  void poll(double time) override { pose_->poll(time); }
+
+ private:
+  std::shared_ptr<Device> pose_;
+  std::vector<std::shared_ptr<Device>> buttons_;
 };
 
 /// One logged reading: what a device gave for a step.

@@ -425,7 +425,7 @@ def _joystick(path: str, mapping: JoystickMapping | None = None) -> JoystickDevi
     try:
         return JoystickDevice(path, mapping or JoystickMapping())
     except AssetNotFound as error:
-        raise SystemExit(f"ambfplus-launch: {error}") from None
+        raise SystemExit(f"ambfplus-launch: {error.strerror}") from None
 
 
 def run(argv: list[str] | None = None) -> int:

@@ -111,15 +111,7 @@ class SimulatorStereoDataset(IterableDataset):
         self.epoch = int(epoch)
 
     def _build(self) -> Scene:
-        try:
-            scene = self.scene(**self.scene_options)
-        except RenderError as error:
-            raise RenderError(
-                f"{error}\nSimulatorStereoDataset builds its scene in the process that iterates "
-                "it; a process forked after its parent rendered cannot render. Start DataLoader "
-                "workers with multiprocessing_context='spawn' (ambfplus.learning.make_loader "
-                "does)."
-            ) from error
+        scene = self.scene(**self.scene_options)
         if not isinstance(scene, Scene):
             raise TypeError(
                 f"scene {getattr(self.scene, '__name__', self.scene)!r} returned "
@@ -128,6 +120,17 @@ class SimulatorStereoDataset(IterableDataset):
         return scene
 
     def __iter__(self) -> Iterator[dict[str, torch.Tensor]]:
+        try:
+            yield from self._samples()
+        except RenderError as error:
+            raise RenderError(
+                f"{error}\nSimulatorStereoDataset renders in the process that iterates it, and a "
+                "process forked after its parent rendered cannot render: start DataLoader "
+                "workers with multiprocessing_context='spawn' (ambfplus.learning.make_loader "
+                "does)."
+            ) from error
+
+    def _samples(self) -> Iterator[dict[str, torch.Tensor]]:
         worker, workers = _worker()
         quota = _share(self.samples, worker, workers)
         rng = np.random.default_rng(np.random.SeedSequence([self.seed, self.epoch, worker]))

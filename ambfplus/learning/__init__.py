@@ -42,13 +42,14 @@ except ImportError as _error:  # pragma: no cover - exercised in a subprocess by
 
 from .datasets import RecordingStereoDataset, SimulatorStereoDataset, make_loader
 from .metrics import disparity_metrics, fill_invalid_along_rows
-from .samples import stereo_sample
+from .samples import crop_sample, stereo_sample
 from .scenarios import CameraPath, DrillScript
 from .stereo_transformer import StereoTransformer, stereo_loss
 from .targets import depth_from_disparity, disparity_from_depth, occlusion_mask, stereo_targets
 
 __all__ = [
     "CameraPath",
+    "crop_sample",
     "depth_from_disparity",
     "disparity_from_depth",
     "disparity_metrics",

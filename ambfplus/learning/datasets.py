@@ -135,11 +135,8 @@ class SimulatorStereoDataset(IterableDataset):
         quota = _share(self.samples, worker, workers)
         rng = np.random.default_rng(np.random.SeedSequence([self.seed, self.epoch, worker]))
         scene = self._build()
-        world, rig, volume = scene.world, scene.rig, scene.drill.volume
-        script = DrillScript(volume, scene.drill.goal[:3, 3], scene.drill.burr_radius, rng)
-        device = ScriptedDevice()
-        device.set_callback(script, every=10)
-        world.add_input_device(scene.device_name, device, scene.drill, **scene.device_options)
+        world, rig = scene.world, scene.rig
+        script = self._bind_hand(scene, rng)
         recorder = self._recorder(worker, scene)
         produced = 0
         try:
@@ -161,6 +158,16 @@ class SimulatorStereoDataset(IterableDataset):
         finally:
             if recorder is not None:
                 recorder.close()
+
+    @staticmethod
+    def _bind_hand(scene: Scene, rng) -> DrillScript:
+        """A scripted hand driving the scene's drill, resting until an episode plans plunges."""
+        drill = scene.drill
+        script = DrillScript(drill.volume, drill.goal[:3, 3], drill.burr_radius, rng)
+        device = ScriptedDevice()
+        device.set_callback(script, every=10)
+        scene.world.add_input_device(scene.device_name, device, drill, **scene.device_options)
+        return script
 
     def _start_episode(self, scene: Scene, script: DrillScript, kind: str, rng) -> CameraPath:
         """Brings the drill back to rest, restores drilled anatomy and plans the episode."""

@@ -25,19 +25,25 @@ examples/tracking_experiment.py --recordings OUT).
 
 from __future__ import annotations
 
-import argparse
-import json
-import math
-import sys
-import time
-from pathlib import Path
+import os
 
-import cv2
-import numpy as np
-import torch
+# Idle PyTorch threads sleep instead of spinning: on a shared CPU a spinning thread takes the
+# core its partner needs, and training slows several times over.
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
-import ambfplus
-from ambfplus.learning import (
+import argparse  # noqa: E402
+import json  # noqa: E402
+import math  # noqa: E402
+import sys  # noqa: E402
+import time  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import cv2  # noqa: E402
+import numpy as np  # noqa: E402
+import torch  # noqa: E402
+
+import ambfplus  # noqa: E402
+from ambfplus.learning import (  # noqa: E402
     RecordingStereoDataset,
     StereoTransformer,
     disparity_metrics,
@@ -45,9 +51,9 @@ from ambfplus.learning import (
     make_loader,
     stereo_loss,
 )
-from ambfplus.learning.metrics import pool
-from ambfplus.learning.samples import crop_sample
-from ambfplus.learning.sequences import MOVING_CAMERA, MOVING_DRILL, ensure_sequence
+from ambfplus.learning.metrics import pool  # noqa: E402
+from ambfplus.learning.samples import crop_sample  # noqa: E402
+from ambfplus.learning.sequences import MOVING_CAMERA, MOVING_DRILL, ensure_sequence  # noqa: E402
 
 # SGBM's fixed parameters (blockSize 5, OpenCV's recommended smoothness penalties for 3
 # channels); the disparity range comes from the rig (see sgbm_range).

@@ -8,7 +8,13 @@ from pathlib import Path
 
 import pytest
 
-EXAMPLES = sorted((Path(__file__).resolve().parents[1] / "examples").glob("*.py"))
+# The paper's experiments need the torch extra and run at CI size in tests/test_learning.py.
+TESTED_ELSEWHERE = {"stereo_depth_experiment.py", "tracking_experiment.py"}
+EXAMPLES = sorted(
+    p
+    for p in (Path(__file__).resolve().parents[1] / "examples").glob("*.py")
+    if p.name not in TESTED_ELSEWHERE
+)
 
 
 @pytest.mark.parametrize("script", EXAMPLES, ids=[p.name for p in EXAMPLES])

@@ -674,6 +674,77 @@ def launcher(args) -> Iterator[dict]:
     }
 
 
+@benchmark
+def learning(args) -> Iterator[dict]:
+    """Stereo samples per second delivered to a training loop through make_loader (2 spawned
+    workers, batches of 4): rendered in the loop by SimulatorStereoDataset (the paper's rig at
+    640x480 over the phantom, mixed camera and drilling scenarios, with targets) against reading
+    the same samples back from their recordings with RecordingStereoDataset. Rates are steady
+    state, from the first batch to the last; worker start-up is reported apart. CPU counts the
+    parent and the workers (all threads)."""
+    import resource
+    import tempfile
+
+    from ambfplus.learning import RecordingStereoDataset, SimulatorStereoDataset, make_loader
+
+    samples, batch, workers = (40, 4, 2) if args.quick else (160, 4, 2)
+
+    def children_cpu() -> float:
+        usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+        return usage.ru_utime + usage.ru_stime
+
+    def deliver(dataset) -> dict:
+        """Runs a loader to the end; the loop touches every tensor as training would."""
+        w0, c0, k0 = time.perf_counter(), time.process_time(), children_cpu()
+        first, count = None, 0
+        for item in make_loader(dataset, batch_size=batch, num_workers=workers):
+            for value in item.values():
+                value.sum()
+            count += len(item["left"])
+            if first is None:
+                first = time.perf_counter()
+        end = time.perf_counter()
+        return {
+            "rate": (count - batch) / (end - first),
+            "startup": first - w0,
+            "cpu_per_sample": (time.process_time() - c0 + children_cpu() - k0) / count,
+            "count": count,
+        }
+
+    def simulator(record_to=None):
+        return SimulatorStereoDataset(samples=samples, seed=7, record_to=record_to)
+
+    with tempfile.TemporaryDirectory() as folder:
+        deliver(simulator(record_to=folder))  # the same samples, recorded once
+        recordings = sorted(Path(folder).glob("worker*_epoch0.h5"))
+        rounds = 1 if args.quick else 2
+        live = [deliver(simulator()) for _ in range(rounds)]
+        recorded = [deliver(RecordingStereoDataset(recordings)) for _ in range(rounds)]
+        megabytes = sum(p.stat().st_size for p in Path(folder).glob("worker*")) / 1e6
+
+    def median(runs, key) -> float:
+        return statistics.median(r[key] for r in runs)
+
+    live_rate, recorded_rate = median(live, "rate"), median(recorded, "rate")
+    yield {
+        "bench": "learning_samples_per_s_in_loop",
+        "value": round(live_rate, 2),
+        "unit": "samples/s",
+        "baseline": round(recorded_rate, 2),
+        "ratio": round(live_rate / recorded_rate, 4),
+        "cpu_s_per_sample": round(median(live, "cpu_per_sample"), 4),
+        "baseline_cpu_s_per_sample": round(median(recorded, "cpu_per_sample"), 4),
+        "startup_s": round(median(live, "startup"), 2),
+        "baseline_startup_s": round(median(recorded, "startup"), 2),
+        "samples": live[0]["count"],
+        "recording_mb_per_sample": round(megabytes / samples, 3),
+        "what": "640x480 stereo samples (rgb, depth, label, instance, segmentation, disparity, "
+        "occlusion) to a training loop, 2 spawned workers, batch 4: rendered in the loop vs "
+        "read from their recordings",
+        "quick": args.quick,
+    }
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--only", choices=sorted(BENCHMARKS), help="run one benchmark")

@@ -13,7 +13,12 @@ follows the head; ``lens()`` gives the distortion a ``Window`` applies when it s
 by side.
 
 ``openxr_status()`` says whether an OpenXR runtime is there (the loader's
-``xrCreateInstance``); without one the launcher falls back to OpenHMD.
+``xrCreateInstance``); without one the launcher falls back to OpenHMD. Where there is one,
+``ambfplus.OpenXrSession`` runs a session with it, and ``XrView(world, base)`` keeps two eye
+cameras where the session's eyes are: each is the base camera moved by the eye's pose in the
+session's LOCAL space (whose origin is the head's at the start), with the eye's asymmetric field
+of view as square pixels (its height the swapchain image's, times ``scale``) and an off-axis
+principal point.
 """
 
 from __future__ import annotations
@@ -229,6 +234,54 @@ class HmdView:
 
     def lens(self) -> dict:
         return self.hmd.lens()
+
+
+def xr_eye_geometry(fov, size, scale: float = 1.0) -> tuple[int, int, float, float, float]:
+    """(width, height, fov_y, cx, cy) of a camera with square pixels covering an OpenXR eye's
+    field of view (angles left, right, up, down in radians; left and down negative) for a
+    swapchain image of size (width, height), its height times scale."""
+    left, right, up, down = (math.tan(a) for a in fov)
+    if not (right > left and up > down):
+        raise ValueError(f"an eye's field of view must open right and up, got {list(fov)}")
+    height = max(1, int(round(size[1] * scale)))
+    focal = height / (up - down)
+    width = max(1, int(round(focal * (right - left))))
+    return width, height, 2 * math.atan(height / (2 * focal)), -left * focal, up * focal
+
+
+class XrView:
+    """Two eye cameras riding on a base camera where an OpenXR session's eyes are (update()
+    each frame with wait_frame()'s eyes). The cameras exist after the first update."""
+
+    def __init__(self, world, base, name: str = "openxr", scale: float = 1.0):
+        self.world, self.base, self.name, self.scale = world, base, name, scale
+        self.cameras: list = []
+        self._made = 0
+
+    def update(self, eyes: list[dict]) -> list:
+        """Places the eye cameras (made, or made again when an eye's image changes size) and
+        returns them, left then right."""
+        with self.world.lock():
+            shapes = [xr_eye_geometry(e["fov"], e["size"], self.scale) for e in eyes]
+            if [(c.width, c.height) for c in self.cameras] != [g[:2] for g in shapes]:
+                self._made += 1
+                suffix = "" if self._made == 1 else f"_{self._made}"
+                self.cameras = [
+                    self.world.add_camera(
+                        f"{self.name}_{side}{suffix}",
+                        g[0],
+                        g[1],
+                        fov_y=g[2],
+                        near=self.base.near,
+                        far=self.base.far,
+                    )  # fmt: skip
+                    for side, g in zip(("left", "right"), shapes)
+                ]
+            for camera, eye, g in zip(self.cameras, eyes, shapes):
+                camera.fov_y = g[2]
+                camera.principal_point = g[3:]
+                camera.pose = self.base.pose @ np.asarray(eye["pose"])
+        return self.cameras
 
 
 # OpenXR's values (openxr.h 1.0).

@@ -22,8 +22,10 @@ the launch file names the anatomy for the drilling plugin (``--labels``). Keyboa
 disparity at the depth the camera looks at or ``--convergence``) for 3D monitors and
 projectors; ``--stereo hmd`` shows OpenHMD's first head-mounted display's eyes (its null device
 without hardware), turned by the head, each with the eye's projection and seen through the
-lens's distortion correction, in a window of the HMD's screen size; ``--stereo openxr`` checks
-for an OpenXR runtime and says why it falls back to OpenHMD.
+lens's distortion correction, in a window of the HMD's screen size; ``--stereo openxr`` shows
+the eyes in the OpenXR runtime's headset (Monado, SteamVR, ...; head pose and each eye's field
+of view from the runtime, the images into its swapchains) with the window mirroring them, and
+says why it falls back to OpenHMD where there is no runtime or headset.
 
 ``--device`` chooses what moves the drill: the keyboard, ``network[:PORT]`` (poses from a
 bridge process over UDP on loopback, forces sent back every step; see ``ambfplus.network`` and
@@ -62,8 +64,8 @@ from . import (
     Simulator,
     __version__,
 )
-from ._core import Window, use_x11_display
-from .hmd import HmdError, HmdView, OpenHMD, openxr_status
+from ._core import OpenXrSession, RenderError, Window, use_x11_display
+from .hmd import HmdError, HmdView, OpenHMD, XrView
 from .stereo import StereoRig
 
 # GLFW's codes for the keys and buttons the launcher handles itself.
@@ -533,7 +535,7 @@ def run_window(glfw, args: argparse.Namespace, plugin_args: list[str]) -> int:
     # A first frame before the clock starts: uploading the anatomy whole takes far longer than a
     # physics period, and would stall the loop.
     width, height = glfw.get_framebuffer_size(window)
-    _window_of(window).present(views.cameras(width, height), width, height)
+    views.show(_window_of(window), width, height)
     with session.loop:
         print(f"ambfplus-launch: {camera.name} in a {window_size[0]}x{window_size[1]} window "
               f"({views.mode}); physics: {session.loop.scheduling}", flush=True)  # fmt: skip
@@ -548,7 +550,7 @@ def run_window(glfw, args: argparse.Namespace, plugin_args: list[str]) -> int:
             session.status(status, fps)
             width, height = glfw.get_framebuffer_size(window)
             overlay = draw_overlay(status, width, height)
-            shown = _window_of(window).present(views.cameras(width, height), width, height, overlay)
+            shown = views.show(_window_of(window), width, height, overlay)
             shown_at = time.perf_counter()
             status.frames += 1
             # CPU per frame of the whole process (rendering threads, physics and all).
@@ -616,15 +618,16 @@ class Views:
         self.mode = args.stereo
         self.notes: list[str] = []
         self.hmd = None
+        self.xr = None  # an OpenXR session
+        self.xr_view: XrView | None = None
         if self.mode == "openxr":
-            available, why = openxr_status()
-            why = (
-                "an OpenXR runtime is there, but ambfplus does not run OpenXR sessions yet"
-                if available
-                else f"OpenXR: {why}"
-            )
-            self.notes.append(f"{why}; using OpenHMD")
-            self.mode = "hmd"
+            try:
+                self.xr = OpenXrSession("ambfplus-launch")
+                self.xr_view = XrView(self.world, self.camera, name=f"{self.camera.name}_xr")
+                self.notes.append(f"OpenXR: {self.xr.system} on {self.xr.runtime}")
+            except RenderError as error:
+                self.notes.append(f"{error}; using OpenHMD")
+                self.mode = "hmd"
         if self.mode == "hmd":
             try:
                 self.hmd = OpenHMD()
@@ -653,7 +656,12 @@ class Views:
         return 0.065
 
     def window_size(self, args: argparse.Namespace) -> tuple[int, int]:
-        if self.hmd is not None:
+        if self.xr is not None:
+            # The eyes side by side, at most 1536 pixels wide.
+            (w0, h0), (w1, _) = self.xr.eye_sizes
+            shrink = min(1.0, 1536 / (w0 + w1))
+            default = (int((w0 + w1) * shrink), int(h0 * shrink))
+        elif self.hmd is not None:
             eye_width, eye_height = self.hmd.eye_resolution
             default = (2 * eye_width, eye_height)
         else:
@@ -663,9 +671,27 @@ class Views:
     def lens(self) -> dict | None:
         return self.hmd.lens() if self.hmd is not None else None
 
+    def show(self, window: Window, width: int, height: int, overlay=None) -> list[dict]:
+        """Shows a frame: in the window, and with OpenXR in the headset (the window then mirrors
+        the eyes without rendering them again). The frames shown, each with its step."""
+        xr = self.xr
+        if xr is not None:
+            xr.poll_events()
+            if xr.running:
+                eyes = xr.wait_frame()
+                cameras = self.xr_view.update(eyes) if eyes else []
+                frames = xr.end_frame(cameras)
+                if frames:
+                    window.present(cameras, width, height, overlay, rendered=True)
+                    return frames
+        return window.present(self.cameras(width, height), width, height, overlay)
+
     def cameras(self, width: int, height: int) -> list:
         """The cameras shown left to right in a window of this size (made once per size); an
-        HMD's eyes turned to where the head now looks."""
+        HMD's eyes turned to where the head now looks; an OpenXR session's eyes as they were
+        last (it is not running)."""
+        if self.xr_view is not None and self.xr_view.cameras:
+            return self.xr_view.cameras
         key = (width, height)
         if key not in self._views:
             self._views[key] = self._make(width, height, len(self._views))
@@ -677,7 +703,7 @@ class Views:
     def _make(self, width: int, height: int, index: int) -> list:
         camera, world = self.camera, self.world
         name = f"{camera.name}_window{index}"
-        if self.mode == "off":
+        if self.mode in ("off", "openxr"):
             return [_view_of(world, camera, width, height, name)]
         if self.mode == "hmd":
             with world.lock():
@@ -697,11 +723,18 @@ class Views:
     def describe(self, width: int, height: int) -> dict:
         """The views' geometry, for the status file: mode, IPD, each eye's focal length and
         principal point, and (side by side) the zero-disparity depth."""
-        cameras = self._views.get((width, height)) or self.cameras(width, height)
+        cameras = (self.xr_view.cameras if self.xr_view is not None else None) or (
+            self._views.get((width, height)) or self.cameras(width, height)
+        )
         out = {"mode": self.mode, "ipd": self.ipd, "views": len(cameras)}
         if self.hmd is not None:
             out["hmd"] = self.hmd.name
             out["head"] = [float(v) for v in self.hmd.rotation]
+        if self.xr is not None:
+            out["openxr"] = {"runtime": self.xr.runtime, "system": self.xr.system,
+                             "state": self.xr.state, "frames": self.xr.frames}  # fmt: skip
+            if len(cameras) == 2:  # the eyes' distance, as the runtime places them
+                out["ipd"] = float(np.linalg.norm(cameras[1].pose[:3, 3] - cameras[0].pose[:3, 3]))
         out["eyes"] = [
             {
                 "name": c.name,

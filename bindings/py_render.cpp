@@ -1,11 +1,14 @@
+#include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <Eigen/Core>
 #include <memory>
 #include <vector>
 
 #include "ambfplus/render/gl_info.h"
+#include "ambfplus/render/openxr.h"
 #include "ambfplus/render/window.h"
 #include "ambfplus/scene/camera.h"
 #include "bindings.h"
@@ -13,6 +16,22 @@
 namespace py = pybind11;
 
 namespace ambfplus::bindings {
+namespace {
+
+// What a display showed: each view's camera, step and time.
+py::list shown(const std::vector<Frame>& frames) {
+  py::list out;
+  for (const Frame& f : frames) {
+    py::dict d;
+    d["camera"] = f.camera;
+    d["step"] = f.step;
+    d["time"] = f.time;
+    out.append(d);
+  }
+  return out;
+}
+
+}  // namespace
 
 void register_render(py::module_& m) {
   m.def(
@@ -54,7 +73,7 @@ void register_render(py::module_& m) {
       .def(
           "present",
           [](Window& w, const std::vector<std::shared_ptr<Camera>>& cameras, int width, int height,
-             py::object overlay) {
+             py::object overlay, bool rendered) {
             std::vector<const Camera*> list;
             for (const auto& c : cameras) list.push_back(c.get());
             const std::uint8_t* pixels = nullptr;
@@ -72,22 +91,16 @@ void register_render(py::module_& m) {
             std::vector<Frame> frames;
             {
               py::gil_scoped_release release;
-              frames = w.present(list, width, height, pixels);
+              frames = w.present(list, width, height, pixels, rendered);
             }
-            py::list out;
-            for (const Frame& f : frames) {
-              py::dict d;
-              d["camera"] = f.camera;
-              d["step"] = f.step;
-              d["time"] = f.time;
-              out.append(d);
-            }
-            return out;
+            return shown(frames);
           },
           py::arg("cameras"), py::arg("width"), py::arg("height"), py::arg("overlay") = py::none(),
+          py::arg("rendered") = false,
           "Renders the cameras side by side into the window (width x height pixels), blends the "
           "RGBA overlay over them and shows it (GIL released); returns each view's camera, step "
-          "and time.")
+          "and time. rendered=True shows what the cameras last rendered for a display (an "
+          "OpenXR session's end_frame) without rendering again.")
       .def(
           "set_lens",
           [](Window& w, std::optional<std::array<float, 4>> k, std::array<float, 3> aberration,
@@ -113,6 +126,73 @@ void register_render(py::module_& m) {
           "the view's width; centres: each view's lens centre as fractions of its viewport, y "
           "from the bottom; aspect: the view's physical width / height). k=None shows plain "
           "images.");
+
+  m.def("openxr_built", &openxr_built,
+        "True when this build has OpenXR sessions (OpenXR's headers were there at build time).");
+  py::class_<OpenXrSession>(
+      m, "OpenXrSession",
+      "A session with the OpenXR runtime's head-mounted display, given the engine's EGL context "
+      "(XR_MNDX_egl_enable). Per frame: poll_events(); while running: eyes = wait_frame(), "
+      "place a camera per eye, end_frame(cameras). Raises RenderError naming the call and the "
+      "runtime's result when the loader, a runtime or a headset is missing.")
+      .def(py::init([](const std::string& application) {
+             py::gil_scoped_release release;
+             return std::make_unique<OpenXrSession>(application);
+           }),
+           py::arg("application") = "ambfplus")
+      .def_property_readonly("runtime", &OpenXrSession::runtime, "the runtime's name and version")
+      .def_property_readonly("system", &OpenXrSession::system, "the headset's name")
+      .def_property_readonly("eye_sizes", &OpenXrSession::eye_sizes,
+                             "each eye's swapchain image size (width, height)")
+      .def_property_readonly("state", &OpenXrSession::state,
+                             "idle, ready, synchronized, visible, focused, stopping, "
+                             "loss_pending or exiting")
+      .def_property_readonly("running", &OpenXrSession::running,
+                             "frames are expected (between ready and stopping)")
+      .def_property_readonly("ended", &OpenXrSession::ended,
+                             "the runtime ended the session: no more frames")
+      .def_property_readonly("frames", &OpenXrSession::frames, "frames submitted")
+      .def("poll_events", &OpenXrSession::poll_events, py::call_guard<py::gil_scoped_release>(),
+           "Handles the runtime's events: begins the session when ready, ends it when stopping.")
+      .def(
+          "wait_frame",
+          [](OpenXrSession& x) {
+            std::vector<XrEye> eyes;
+            {
+              py::gil_scoped_release release;
+              eyes = x.wait_frame();
+            }
+            py::list out;
+            for (const XrEye& e : eyes) {
+              py::dict d;
+              d["pose"] = Eigen::Matrix4d(e.pose);
+              d["fov"] = e.fov;
+              d["size"] = std::array<int, 2>{e.width, e.height};
+              out.append(d);
+            }
+            return out;
+          },
+          "Waits for the runtime's next frame and begins it (GIL released). Each eye to draw: "
+          "pose (4x4, head-start from eye, OpenCV frame), fov (left, right, up, down angles, "
+          "radians) and size (its swapchain image); empty when the runtime shows nothing now. "
+          "end_frame must follow.")
+      .def(
+          "end_frame",
+          [](OpenXrSession& x, const std::vector<std::shared_ptr<Camera>>& cameras) {
+            std::vector<const Camera*> list;
+            for (const auto& c : cameras) list.push_back(c.get());
+            std::vector<Frame> frames;
+            {
+              py::gil_scoped_release release;
+              frames = x.end_frame(list);
+            }
+            return shown(frames);
+          },
+          py::arg("cameras"),
+          "Renders cameras[i] for eye i into the runtime's swapchain images and ends the frame "
+          "(GIL released); each eye's camera, step and time (empty when wait_frame gave no "
+          "eyes).")
+      .def("request_exit", &OpenXrSession::request_exit, "Asks the runtime to stop the session.");
 }
 
 }  // namespace ambfplus::bindings

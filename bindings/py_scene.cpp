@@ -577,7 +577,8 @@ void register_scene(py::module_& m) {
           "what an ADF asked it to publish: image/depth flags and intervals (every n-th "
           "render), depth noise (mean, std_dev, bias) or None")
       .def_property_readonly("height", &Camera::height)
-      .def_property_readonly("fov_y", &Camera::fov_y, "vertical field of view, radians")
+      .def_property("fov_y", &Camera::fov_y, &Camera::set_fov_y,
+                    "vertical field of view, radians (the principal point stays)")
       .def_property_readonly("near", &Camera::near)
       .def_property_readonly("far", &Camera::far)
       .def_property_readonly("intrinsics", &Camera::intrinsics,

@@ -88,3 +88,16 @@ if(NOT AMBFPLUS_BULLET_LINKS)
 endif()
 
 find_package(Threads REQUIRED)
+
+# OpenXR: optional. Only its headers are needed at build time (libopenxr-dev); the Khronos loader
+# is opened at run time, so a machine without one still runs everything else.
+find_path(AMBFPLUS_OPENXR_INCLUDE_DIR openxr/openxr_platform.h)
+add_library(ambfplus_dep_openxr INTERFACE)
+if(AMBFPLUS_OPENXR_INCLUDE_DIR)
+  target_include_directories(ambfplus_dep_openxr INTERFACE ${AMBFPLUS_OPENXR_INCLUDE_DIR})
+  target_compile_definitions(ambfplus_dep_openxr INTERFACE AMBFPLUS_WITH_OPENXR=1)
+  message(STATUS "OpenXR headers in ${AMBFPLUS_OPENXR_INCLUDE_DIR}: OpenXR sessions built")
+else()
+  message(STATUS "OpenXR headers not found (libopenxr-dev): OpenXR sessions not built")
+endif()
+add_library(ambfplus::dep_openxr ALIAS ambfplus_dep_openxr)

@@ -36,6 +36,7 @@ class Context {
 
   EGLDisplay display() const { return display_; }
   EGLConfig config() const { return config_; }
+  EGLContext context() const { return context_; }
   /// Within a Scope: draw and read through a window surface (eglSwapBuffers shows it).
   void make_current(EGLSurface surface);
   /// The name of the last EGL error.

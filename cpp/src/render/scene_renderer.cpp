@@ -91,6 +91,12 @@ const RenderTarget& SceneRenderer::render_to_target(const Camera& camera, unsign
   return target_for(s);
 }
 
+const RenderTarget* SceneRenderer::last_target(const Camera& camera) {
+  Context::Scope scope;
+  auto it = targets_.find(camera.id());
+  return it == targets_.end() ? nullptr : &it->second;
+}
+
 void SceneRenderer::take(const Camera& camera, unsigned passes, Snapshot& s) {
   s.camera_id = camera.id();
   s.camera_name = camera.name();

@@ -106,6 +106,8 @@ class SceneRenderer {
   /// Renders camera's view (those passes) and leaves it in the camera's render target, for a
   /// window to show; fills frame as render does. Needs no Scope.
   const RenderTarget& render_to_target(const Camera& camera, unsigned passes, Frame& frame);
+  /// The camera's render target as its last render_to_target left it; nullptr before one.
+  const RenderTarget* last_target(const Camera& camera);
   /// What the last upload of this volume data sent to the GPU (nullptr before its first draw).
   std::optional<VolumeUpload> last_upload(const VolumeData* data) const;
 

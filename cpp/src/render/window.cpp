@@ -111,7 +111,7 @@ Window::~Window() {
 }
 
 std::vector<Frame> Window::present(const std::vector<const Camera*>& cameras, int width, int height,
-                                   const std::uint8_t* overlay) {
+                                   const std::uint8_t* overlay, bool rendered) {
   if (width <= 0 || height <= 0) {
     throw std::invalid_argument("a window's size must be positive, got " + std::to_string(width) +
                                 "x" + std::to_string(height));
@@ -119,8 +119,18 @@ std::vector<Frame> Window::present(const std::vector<const Camera*>& cameras, in
   std::vector<Frame> frames(cameras.size());
   std::vector<const render::RenderTarget*> targets;
   for (std::size_t i = 0; i < cameras.size(); ++i) {
-    targets.push_back(
-        &cameras[i]->world().renderer().render_to_target(*cameras[i], kPassRgb, frames[i]));
+    render::SceneRenderer& renderer = cameras[i]->world().renderer();
+    if (!rendered) {
+      targets.push_back(&renderer.render_to_target(*cameras[i], kPassRgb, frames[i]));
+      continue;
+    }
+    const render::RenderTarget* last = renderer.last_target(*cameras[i]);
+    if (last == nullptr) {
+      throw std::invalid_argument("camera '" + cameras[i]->name() +
+                                  "' has not rendered for a display yet (rendered=True)");
+    }
+    frames[i].camera = cameras[i]->name();
+    targets.push_back(last);
   }
   render::Context& context = render::Context::get();
   render::Context::Scope scope;

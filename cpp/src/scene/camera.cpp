@@ -74,6 +74,14 @@ void Camera::set_principal_point(double cx, double cy) {
   cy_ = cy;
 }
 
+void Camera::set_fov_y(double fov_y) {
+  if (!(fov_y > 0.0 && fov_y < M_PI)) {
+    throw std::invalid_argument("camera '" + name() + "': fov_y must be in (0, pi) radians, got " +
+                                std::to_string(fov_y));
+  }
+  fov_y_ = fov_y;
+}
+
 const char* pass_name(int index) {
   static const char* const kNames[kPassCount] = {"rgb",      "depth", "label",
                                                  "instance", "voxel", "segmentation"};

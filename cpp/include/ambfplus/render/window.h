@@ -45,8 +45,10 @@ class AMBFPLUS_API Window {
   /// Renders each camera and shows them side by side, left to right, filling a window of
   /// width x height pixels; overlay (RGBA, width x height, row 0 at the top; may be null) is
   /// blended over them. Returns the frames' metadata (time, step, pose of what is shown).
+  /// rendered: show the images the cameras last rendered for a display (e.g. an OpenXR
+  /// session's end_frame) without rendering again; their frames then carry only the names.
   std::vector<Frame> present(const std::vector<const Camera*>& cameras, int width, int height,
-                             const std::uint8_t* overlay = nullptr);
+                             const std::uint8_t* overlay = nullptr, bool rendered = false);
   /// Undoes a lens's distortion on every view from now on (std::nullopt: plain images).
   void set_lens(std::optional<LensDistortion> lens);
 

@@ -70,6 +70,8 @@ class AMBFPLUS_API Camera : public Object {
   /// Moves the principal point (pixels): an off-axis camera, e.g. one of a stereo pair whose
   /// views converge at a working distance. The image plane stays parallel.
   void set_principal_point(double cx, double cy);
+  /// Changes the vertical field of view (radians, in (0, pi)); the principal point stays.
+  void set_fov_y(double fov_y);
   Eigen::Vector2d principal_point() const { return {cx_, cy_}; }
 
   /// The passes a capture into a new frame renders (CapturePass bits; default rgb, depth, label).

@@ -1,5 +1,5 @@
-"""Head-mounted displays: OpenHMD's devices (its null device without hardware), and a probe of
-OpenXR.
+"""Head-mounted displays: OpenHMD's devices (its null device without hardware), and the eye
+cameras of an OpenXR session.
 
 ``OpenHMD()`` opens the first head-mounted display OpenHMD finds, else its null HMD, through
 Debian's ``libopenhmd0`` (ctypes, nothing to compile). It gives the head's orientation, the
@@ -12,13 +12,12 @@ the eye's resolution, focal length and principal point from OpenHMD's projection
 follows the head; ``lens()`` gives the distortion a ``Window`` applies when it shows them side
 by side.
 
-``openxr_status()`` says whether an OpenXR runtime is there (the loader's
-``xrCreateInstance``); without one the launcher falls back to OpenHMD. Where there is one,
-``ambfplus.OpenXrSession`` runs a session with it, and ``XrView(world, base)`` keeps two eye
-cameras where the session's eyes are: each is the base camera moved by the eye's pose in the
-session's LOCAL space (whose origin is the head's at the start), with the eye's asymmetric field
-of view as square pixels (its height the swapchain image's, times ``scale``) and an off-axis
-principal point.
+For an OpenXR runtime's headset, ``ambfplus.OpenXrSession`` runs the session (its error says
+why where there is no runtime or headset; the launcher then falls back to OpenHMD), and
+``XrView(world, base)`` keeps two eye cameras where the session's eyes are: each is the base
+camera moved by the eye's pose in the session's LOCAL space (whose origin is the head's at the
+start), with the eye's asymmetric field of view as square pixels (its height the swapchain
+image's, times ``scale``) and an off-axis principal point.
 """
 
 from __future__ import annotations
@@ -282,60 +281,3 @@ class XrView:
                 camera.principal_point = g[3:]
                 camera.pose = self.base.pose @ np.asarray(eye["pose"])
         return self.cameras
-
-
-# OpenXR's values (openxr.h 1.0).
-_XR_TYPE_INSTANCE_CREATE_INFO = 3
-_XR_RESULTS = {
-    -1: "XR_ERROR_VALIDATION_FAILURE",
-    -2: "XR_ERROR_RUNTIME_FAILURE",
-    -6: "XR_ERROR_API_VERSION_UNSUPPORTED",
-    -51: "XR_ERROR_RUNTIME_UNAVAILABLE",
-}
-
-
-class _XrApplicationInfo(ctypes.Structure):
-    _fields_ = [
-        ("applicationName", ctypes.c_char * 128),
-        ("applicationVersion", ctypes.c_uint32),
-        ("engineName", ctypes.c_char * 128),
-        ("engineVersion", ctypes.c_uint32),
-        ("apiVersion", ctypes.c_uint64),
-    ]
-
-
-class _XrInstanceCreateInfo(ctypes.Structure):
-    _fields_ = [
-        ("type", ctypes.c_int),
-        ("next", ctypes.c_void_p),
-        ("createFlags", ctypes.c_uint64),
-        ("applicationInfo", _XrApplicationInfo),
-        ("enabledApiLayerCount", ctypes.c_uint32),
-        ("enabledApiLayerNames", ctypes.c_void_p),
-        ("enabledExtensionCount", ctypes.c_uint32),
-        ("enabledExtensionNames", ctypes.c_void_p),
-    ]
-
-
-def openxr_status() -> tuple[bool, str]:
-    """(True, runtime's message) when an OpenXR runtime creates an instance; else (False, why:
-    no loader, or the loader's result such as XR_ERROR_RUNTIME_UNAVAILABLE)."""
-    name = ctypes.util.find_library("openxr_loader") or "libopenxr_loader.so.1"
-    try:
-        lib = ctypes.CDLL(name)
-    except OSError:
-        return False, "no OpenXR loader (Debian: libopenxr-loader1)"
-    info = _XrInstanceCreateInfo()
-    info.type = _XR_TYPE_INSTANCE_CREATE_INFO
-    info.applicationInfo.applicationName = b"ambfplus"
-    info.applicationInfo.engineName = b"ambfplus"
-    info.applicationInfo.apiVersion = 1 << 48  # 1.0.0
-    instance = ctypes.c_void_p()
-    lib.xrCreateInstance.argtypes = [ctypes.POINTER(_XrInstanceCreateInfo),
-                                     ctypes.POINTER(ctypes.c_void_p)]  # fmt: skip
-    result = lib.xrCreateInstance(ctypes.byref(info), ctypes.byref(instance))
-    if result != 0:
-        return False, _XR_RESULTS.get(result, f"xrCreateInstance returned {result}")
-    lib.xrDestroyInstance.argtypes = [ctypes.c_void_p]
-    lib.xrDestroyInstance(instance)
-    return True, "an OpenXR runtime is available"

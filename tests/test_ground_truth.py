@@ -12,8 +12,8 @@ import ambfplus
 from ambfplus.stereo import (
     StereoRig,
     ambf_to_opencv,
-    block_match,
     depth_to_disparity,
+    disparity_agreement,
     disparity_to_depth,
     legend,
     opencv_to_ambf,
@@ -82,21 +82,13 @@ def test_stereo_disparity_from_depth_matches_the_images(working_distance):
     else:
         assert frames.dcx == pytest.approx(focal * 0.065 / 0.25)
         assert right.intrinsics[0, 2] - left.intrinsics[0, 2] == pytest.approx(frames.dcx)
-    predicted = frames.disparity()
-    rows, cols = (g.ravel() for g in np.meshgrid(np.arange(20, 460, 12), np.arange(20, 620, 12)))
-    keep = ~np.isnan(predicted[rows, cols])
-    rows, cols = rows[keep], cols[keep]
-    d = predicted[rows, cols]
-    measured = block_match(left.rgb, right.rgb, rows, cols, int(d.min()) - 40, int(d.max()) + 40)
-    # Non-occluded: the match lies inside the right image, away from its edge.
-    ok = ~np.isnan(measured) & (cols - d > 15) & (cols - d < 625)
-    assert ok.sum() > 500
-    error = np.abs(measured[ok] - d[ok])
-    assert np.median(error) <= 0.25
-    assert np.percentile(error, 95) <= 1.0
+    # Block matching on the non-occluded pixels (the match inside the right image).
+    agreement = disparity_agreement(frames, step=12)
+    assert agreement["points"] > 500
+    assert agreement["median_error"] <= 0.25
+    assert agreement["p95_error"] <= 1.0
     # The baseline recovered from the images: B = (d + dcx) Z / f.
-    z = left.depth[rows[ok], cols[ok]]
-    baseline = np.median((measured[ok] + frames.dcx) * z / focal)
+    baseline = agreement["baseline"]
     assert baseline == pytest.approx(0.065, rel=0.01)
 
 
@@ -227,20 +219,11 @@ def test_fixture_stereo_pair_renders_the_ear_with_its_baseline(fixtures):
     rig = StereoRig.from_cameras(sim.get("stereoL"), sim.get("stereoR"))
     assert rig.baseline == pytest.approx(0.025)
     frames = rig.capture()
-    predicted = frames.disparity()
-    rows, cols = (g.ravel() for g in np.meshgrid(np.arange(20, 460, 8), np.arange(20, 620, 8)))
-    keep = ~np.isnan(predicted[rows, cols])
-    rows, cols = rows[keep], cols[keep]
-    d = predicted[rows, cols]
-    measured = block_match(
-        frames.left.rgb, frames.right.rgb, rows, cols, int(d.min()) - 40, int(d.max()) + 40
-    )
-    ok = ~np.isnan(measured) & (cols - d > 15) & (cols - d < 625)
-    assert ok.sum() > 500
+    agreement = disparity_agreement(frames, step=8)
+    assert agreement["points"] > 500
     # Bone is smooth in places (wrong matches there); most matches agree with depth.
-    assert np.median(np.abs(measured[ok] - d[ok])) <= 1.0
-    z = frames.left.depth[rows[ok], cols[ok]]
-    baseline = np.median((measured[ok] + frames.dcx) * z / frames.focal)
+    assert agreement["median_error"] <= 1.0
+    baseline = agreement["baseline"]
     assert baseline == pytest.approx(0.025, rel=0.01)
 
 

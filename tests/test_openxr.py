@@ -249,3 +249,20 @@ def test_the_launcher_shows_the_eyes_in_the_headset_and_mirrors_them(
     # The window (two eyes side by side, 640x240) mirrors what the headset got.
     mirror = shot[top : top + 240, left_edge : left_edge + 320].astype(float)
     assert np.abs(mirror - eye.astype(float)).mean() < 8
+
+
+def test_an_eye_camera_follows_a_changed_field_of_view():
+    """Runtimes may change an eye's field of view; the camera's focal length and principal point
+    follow it (fov_y is settable and checked)."""
+    world = ambfplus.World()
+    camera = world.add_camera("eye", 282, 240)
+    width, height, fov_y, cx, cy = xr_eye_geometry((-0.5, 0.6, 0.45, -0.5), (320, 240))
+    camera.fov_y = fov_y
+    camera.principal_point = (cx, cy)
+    k = camera.intrinsics
+    assert k[0, 0] == pytest.approx(height / (math.tan(0.45) + math.tan(0.5)))
+    assert k[0, 2] == pytest.approx(math.tan(0.5) * k[0, 0])
+    assert k[1, 2] == pytest.approx(math.tan(0.45) * k[1, 1])
+    with pytest.raises(ValueError, match="fov_y"):
+        camera.fov_y = math.pi
+    assert camera.fov_y == fov_y

@@ -91,6 +91,15 @@ struct OpenXrSession::State {
   std::vector<Eye> eyes;
   std::vector<XrView> views;  // located for the frame begun, empty when nothing is drawn
   GLuint framebuffer = 0;
+  // The calls every frame makes, looked up once.
+  PFN_xrPollEvent poll_event = nullptr;
+  PFN_xrWaitFrame wait_frame = nullptr;
+  PFN_xrBeginFrame begin_frame = nullptr;
+  PFN_xrLocateViews locate_views = nullptr;
+  PFN_xrAcquireSwapchainImage acquire_image = nullptr;
+  PFN_xrWaitSwapchainImage wait_image = nullptr;
+  PFN_xrReleaseSwapchainImage release_image = nullptr;
+  PFN_xrEndFrame end_frame = nullptr;
 
   // An OpenXR function by name; throws if the runtime lacks it.
   template <typename F>
@@ -317,6 +326,14 @@ OpenXrSession::OpenXrSession(const std::string& application) : state_(std::make_
     }
     glGenFramebuffers(1, &s.framebuffer);
     render::check_gl("making the OpenXR eyes' framebuffer");
+    s.poll_event = s.function<PFN_xrPollEvent>("xrPollEvent");
+    s.wait_frame = s.function<PFN_xrWaitFrame>("xrWaitFrame");
+    s.begin_frame = s.function<PFN_xrBeginFrame>("xrBeginFrame");
+    s.locate_views = s.function<PFN_xrLocateViews>("xrLocateViews");
+    s.acquire_image = s.function<PFN_xrAcquireSwapchainImage>("xrAcquireSwapchainImage");
+    s.wait_image = s.function<PFN_xrWaitSwapchainImage>("xrWaitSwapchainImage");
+    s.release_image = s.function<PFN_xrReleaseSwapchainImage>("xrReleaseSwapchainImage");
+    s.end_frame = s.function<PFN_xrEndFrame>("xrEndFrame");
   } catch (...) {
     s.destroy();
     throw;
@@ -347,10 +364,9 @@ long OpenXrSession::frames() const { return state_->frames; }
 
 void OpenXrSession::poll_events() {
   State& s = *state_;
-  auto poll = s.function<PFN_xrPollEvent>("xrPollEvent");
   for (;;) {
     XrEventDataBuffer event{XR_TYPE_EVENT_DATA_BUFFER};
-    const XrResult r = poll(s.instance, &event);
+    const XrResult r = s.poll_event(s.instance, &event);
     if (r == XR_EVENT_UNAVAILABLE) return;
     s.check(r, "xrPollEvent");
     if (event.type == XR_TYPE_EVENT_DATA_INSTANCE_LOSS_PENDING) {
@@ -390,13 +406,13 @@ std::vector<XrEye> OpenXrSession::wait_frame() {
   XrFrameWaitInfo wait{XR_TYPE_FRAME_WAIT_INFO};
   XrFrameState frame{XR_TYPE_FRAME_STATE};
   // Waiting paces the loop to the display; the context stays free for captures meanwhile.
-  s.check(s.function<PFN_xrWaitFrame>("xrWaitFrame")(s.session, &wait, &frame), "xrWaitFrame");
+  s.check(s.wait_frame(s.session, &wait, &frame), "xrWaitFrame");
   s.display_time = frame.predictedDisplayTime;
   s.views.clear();
   {
     render::Context::Scope scope;
     XrFrameBeginInfo begin{XR_TYPE_FRAME_BEGIN_INFO};
-    s.check(s.function<PFN_xrBeginFrame>("xrBeginFrame")(s.session, &begin), "xrBeginFrame");
+    s.check(s.begin_frame(s.session, &begin), "xrBeginFrame");
   }
   s.in_frame = true;
   std::vector<XrEye> eyes;
@@ -408,9 +424,8 @@ std::vector<XrEye> OpenXrSession::wait_frame() {
   XrViewState view_state{XR_TYPE_VIEW_STATE};
   std::vector<XrView> views(s.eyes.size(), {XR_TYPE_VIEW});
   uint32_t count = 0;
-  s.check(s.function<PFN_xrLocateViews>("xrLocateViews")(s.session, &locate, &view_state,
-                                                         static_cast<uint32_t>(views.size()),
-                                                         &count, views.data()),
+  s.check(s.locate_views(s.session, &locate, &view_state, static_cast<uint32_t>(views.size()),
+                         &count, views.data()),
           "xrLocateViews");
   // Without a tracked orientation there is nothing to draw this frame (the frame still ends).
   if (!(view_state.viewStateFlags & XR_VIEW_STATE_ORIENTATION_VALID_BIT) || count != views.size()) {
@@ -443,7 +458,7 @@ std::vector<Frame> OpenXrSession::end_frame(const std::vector<const Camera*>& ca
       reinterpret_cast<const XrCompositionLayerBaseHeader*>(&layer)};
   auto finish = [&] {
     render::Context::Scope scope;
-    s.check(s.function<PFN_xrEndFrame>("xrEndFrame")(s.session, &end), "xrEndFrame");
+    s.check(s.end_frame(s.session, &end), "xrEndFrame");
   };
   if (s.views.empty()) {
     finish();
@@ -456,9 +471,6 @@ std::vector<Frame> OpenXrSession::end_frame(const std::vector<const Camera*>& ca
                                 std::to_string(cameras.size()));
   }
   frames.resize(cameras.size());
-  auto acquire = s.function<PFN_xrAcquireSwapchainImage>("xrAcquireSwapchainImage");
-  auto wait = s.function<PFN_xrWaitSwapchainImage>("xrWaitSwapchainImage");
-  auto release = s.function<PFN_xrReleaseSwapchainImage>("xrReleaseSwapchainImage");
   for (std::size_t i = 0; i < cameras.size(); ++i) {
     const render::RenderTarget& target =
         cameras[i]->world().renderer().render_to_target(*cameras[i], kPassRgb, frames[i]);
@@ -466,10 +478,10 @@ std::vector<Frame> OpenXrSession::end_frame(const std::vector<const Camera*>& ca
     render::Context::Scope scope;
     uint32_t index = 0;
     XrSwapchainImageAcquireInfo acquire_info{XR_TYPE_SWAPCHAIN_IMAGE_ACQUIRE_INFO};
-    s.check(acquire(eye.swapchain, &acquire_info, &index), "xrAcquireSwapchainImage");
+    s.check(s.acquire_image(eye.swapchain, &acquire_info, &index), "xrAcquireSwapchainImage");
     XrSwapchainImageWaitInfo wait_info{XR_TYPE_SWAPCHAIN_IMAGE_WAIT_INFO};
     wait_info.timeout = kImageTimeout;
-    const XrResult waited = wait(eye.swapchain, &wait_info);
+    const XrResult waited = s.wait_image(eye.swapchain, &wait_info);
     if (waited == XR_TIMEOUT_EXPIRED) {
       throw RenderError("OpenXR (" + s.runtime + "): a swapchain image was not free within 1 s");
     }
@@ -488,7 +500,7 @@ std::vector<Frame> OpenXrSession::end_frame(const std::vector<const Camera*>& ca
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     render::check_gl("copying an eye into its OpenXR swapchain image");
     XrSwapchainImageReleaseInfo release_info{XR_TYPE_SWAPCHAIN_IMAGE_RELEASE_INFO};
-    s.check(release(eye.swapchain, &release_info), "xrReleaseSwapchainImage");
+    s.check(s.release_image(eye.swapchain, &release_info), "xrReleaseSwapchainImage");
 
     XrCompositionLayerProjectionView view{XR_TYPE_COMPOSITION_LAYER_PROJECTION_VIEW};
     view.pose = s.views[i].pose;

@@ -13,6 +13,7 @@ import os
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import argparse  # noqa: E402
+import importlib.util  # noqa: E402
 import json  # noqa: E402
 import statistics  # noqa: E402
 import sys  # noqa: E402
@@ -745,7 +746,21 @@ def learning(args) -> Iterator[dict]:
     }
 
 
+def load_benchmark_files() -> None:
+    """Adds the benchmarks of each tests/benchmarks/bench_<area>.py: its module-level dict
+    BENCHMARKS maps names to functions of (args) yielding figures, like the ones above."""
+    for path in sorted(Path(__file__).resolve().parent.glob("bench_*.py")):
+        spec = importlib.util.spec_from_file_location(f"ambfplus_{path.stem}", path)
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        for name, fn in module.BENCHMARKS.items():
+            if name in BENCHMARKS:
+                raise SystemExit(f"benchmark {name!r} of {path.name} is already defined")
+            BENCHMARKS[name] = fn
+
+
 def main() -> int:
+    load_benchmark_files()
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--only", choices=sorted(BENCHMARKS), help="run one benchmark")
     parser.add_argument("--quick", action="store_true", help="fewer repetitions")

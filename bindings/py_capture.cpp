@@ -9,7 +9,9 @@
 #include <sstream>
 #include <vector>
 
+#include "ambfplus/capture/capture.h"
 #include "ambfplus/capture/frame.h"
+#include "ambfplus/capture/points.h"
 #include "ambfplus/scene/camera.h"
 #include "ambfplus/scene/world.h"
 #include "bindings.h"
@@ -81,24 +83,15 @@ unsigned parse_passes(const py::handle& names) {
     throw py::type_error("passes must be a list of names, e.g. ['rgb', 'depth']");
   }
   unsigned passes = 0;
-  for (const py::handle& n : names) {
-    const std::string name = py::str(n);
-    int index = 0;
-    while (index < kPassCount && name != pass_name(index)) ++index;
-    if (index == kPassCount) {
-      throw py::value_error("unknown pass '" + name +
-                            "': expected rgb, depth, label, instance, voxel or segmentation");
-    }
-    passes |= 1u << index;
-  }
+  for (const py::handle& n : names) passes |= parse_pass(py::str(n));
   if (passes == 0) throw py::value_error("passes must name at least one image");
   return passes;
 }
 
 py::list pass_names(unsigned passes) {
   py::list out;
-  for (int i = 0; i < kPassCount; ++i) {
-    if (passes & (1u << i)) out.append(pass_name(i));
+  for (const PassInfo& p : capture_passes()) {
+    if (passes & p.bit) out.append(p.name);
   }
   return out;
 }
@@ -132,47 +125,37 @@ py::object from_shader(const std::optional<ShaderSpec>& shader) {
 
 namespace {
 
-// frame.poses: the world poses of the objects asked for, at the capture.
-void record_poses(Camera& camera, py::object frame, const py::object& poses) {
-  if (poses.is_none() || (py::isinstance<py::bool_>(poses) && !poses.cast<bool>())) return;
-  py::dict out;
-  World& world = camera.world();
+// The poses a capture records: None or False (none), True (every object), or names.
+PoseRequest pose_request(const py::object& poses) {
+  PoseRequest request;
+  if (poses.is_none()) return request;
   if (py::isinstance<py::bool_>(poses)) {
-    for (Object* o : world.objects()) out[py::str(o->name())] = Eigen::Matrix4d(o->pose().matrix());
-  } else {
-    for (const py::handle& n : poses) {
-      const std::string name = py::str(n);
-      Object* o = world.find(name);
-      if (o == nullptr) throw py::key_error("poses: no object named '" + name + "' in the world");
-      out[py::str(name)] = Eigen::Matrix4d(o->pose().matrix());
-    }
+    request.all = poses.cast<bool>();
+    return request;
   }
-  frame.attr("poses") = out;
+  if (py::isinstance<py::str>(poses)) {
+    throw py::type_error("poses must be True, None or a list of object names, e.g. ['drill']");
+  }
+  for (const py::handle& n : poses) request.names.push_back(py::str(n));
+  if (request.names.empty()) {
+    throw py::value_error("poses names no object: give True for every object, or None");
+  }
+  return request;
 }
 
 }  // namespace
 
 py::object capture(Camera& camera, py::object out, py::object passes, py::object poses) {
+  const PoseRequest request = pose_request(poses);
   if (out.is_none()) {
     auto frame = std::make_shared<Frame>();
-    if (!passes.is_none()) {
-      // The frame's buffers decide what a capture renders.
-      const unsigned p = parse_passes(passes);
-      const int h = camera.height(), w = camera.width();
-      if (p & kPassRgb) frame->rgb.allocate(h, w, 3);
-      if (p & kPassDepth) frame->depth.allocate(h, w, 1);
-      if (p & kPassLabel) frame->label.allocate(h, w, 1);
-      if (p & kPassInstance) frame->instance.allocate(h, w, 1);
-      if (p & kPassVoxel) frame->voxel.allocate(h, w, 1);
-      if (p & kPassSegmentation) frame->segmentation.allocate(h, w, 3);
-    }
+    // The frame's buffers decide what a capture makes.
+    if (!passes.is_none()) camera.allocate(*frame, parse_passes(passes));
     {
       py::gil_scoped_release release;
-      camera.capture(*frame);
+      camera.capture(*frame, request);
     }
-    py::object result = py::cast(frame);
-    record_poses(camera, result, poses);
-    return result;
+    return py::cast(frame);
   }
   if (!passes.is_none()) {
     throw py::value_error("passes goes with a new frame; out's buffers already decide them");
@@ -181,40 +164,42 @@ py::object capture(Camera& camera, py::object out, py::object passes, py::object
     Frame& frame = out.cast<Frame&>();
     {
       py::gil_scoped_release release;
-      camera.capture(frame);
+      camera.capture(frame, request);
     }
-    record_poses(camera, out, poses);
     return out;
   }
   if (py::isinstance<py::dict>(out)) {
     auto buffers = py::reinterpret_borrow<py::dict>(out);
     const py::ssize_t h = camera.height(), w = camera.width();
+    const int hi = camera.height(), wi = camera.width();
     auto frame = std::make_shared<Frame>();
     CaptureBuffers targets;
     for (auto item : buffers) {
       const std::string key = py::str(item.first);
       if (key == "rgb") {
         targets.rgb = checked_output<std::uint8_t>(item.second, "rgb", {h, w, 3});
-        frame->rgb.attach(targets.rgb, camera.height(), camera.width(), 3);
+        frame->rgb.attach(targets.rgb, hi, wi, 3);
       } else if (key == "depth") {
         targets.depth = checked_output<float>(item.second, "depth", {h, w});
-        frame->depth.attach(targets.depth, camera.height(), camera.width(), 1);
+        frame->depth.attach(targets.depth, hi, wi, 1);
       } else if (key == "label") {
         targets.label = checked_output<std::uint16_t>(item.second, "label", {h, w});
-        frame->label.attach(targets.label, camera.height(), camera.width(), 1);
+        frame->label.attach(targets.label, hi, wi, 1);
       } else if (key == "instance") {
         targets.instance = checked_output<std::int32_t>(item.second, "instance", {h, w});
-        frame->instance.attach(targets.instance, camera.height(), camera.width(), 1);
+        frame->instance.attach(targets.instance, hi, wi, 1);
       } else if (key == "voxel") {
         targets.voxel = checked_output<std::int32_t>(item.second, "voxel", {h, w});
-        frame->voxel.attach(targets.voxel, camera.height(), camera.width(), 1);
+        frame->voxel.attach(targets.voxel, hi, wi, 1);
       } else if (key == "segmentation") {
         targets.segmentation = checked_output<std::uint8_t>(item.second, "segmentation", {h, w, 3});
-        frame->segmentation.attach(targets.segmentation, camera.height(), camera.width(), 3);
+        frame->segmentation.attach(targets.segmentation, hi, wi, 3);
+      } else if (key == "points") {
+        targets.points = checked_output<float>(item.second, "points", {h, w, 3});
+        frame->points.attach(targets.points, hi, wi, 3);
       } else {
-        throw py::value_error(
-            "out has an unknown key '" + key +
-            "': expected 'rgb', 'depth', 'label', 'instance', 'voxel', 'segmentation'");
+        throw py::value_error("out has an unknown key '" + key + "': expected one of " +
+                              ambfplus::pass_names(kAllPasses));
       }
     }
     py::object result = py::cast(frame);
@@ -222,9 +207,8 @@ py::object capture(Camera& camera, py::object out, py::object passes, py::object
     result.attr("_out") = buffers;
     {
       py::gil_scoped_release release;
-      camera.capture(targets, *frame);
+      camera.capture(targets, *frame, request);
     }
-    record_poses(camera, result, poses);
     return result;
   }
   throw py::type_error(
@@ -259,28 +243,31 @@ void register_capture(py::module_& m) {
           "camera's preprocessing shader where set), or None when not rendered")
       .def_property_readonly(
           "points",
-          [](Frame& f) -> py::object {
+          [](py::object self) -> py::object {
+            Frame& f = self.cast<Frame&>();
+            if (!f.points.empty()) return view(self, f.points, false);
             if (f.depth.empty()) return py::none();
-            const auto h = static_cast<py::ssize_t>(f.height),
-                       w = static_cast<py::ssize_t>(f.width);
-            py::array_t<float> out({h, w, static_cast<py::ssize_t>(3)});
-            float* p = out.mutable_data();
-            const float* z = f.depth.data();
-            const double fx = f.intrinsics(0, 0), fy = f.intrinsics(1, 1);
-            const double cx = f.intrinsics(0, 2), cy = f.intrinsics(1, 2);
-            for (py::ssize_t r = 0; r < h; ++r) {
-              for (py::ssize_t c = 0; c < w; ++c, ++z, p += 3) {
-                const double d = *z;
-                p[0] = static_cast<float>((static_cast<double>(c) + 0.5 - cx) / fx * d);
-                p[1] = static_cast<float>((static_cast<double>(r) + 0.5 - cy) / fy * d);
-                p[2] = static_cast<float>(d);
-              }
-            }
+            py::array_t<float> out({static_cast<py::ssize_t>(f.height),
+                                    static_cast<py::ssize_t>(f.width), py::ssize_t{3}});
+            capture::points_from_depth(f.depth.data(), f.intrinsics, f.width, f.height,
+                                       out.mutable_data());
             return std::move(out);
           },
           "float32 (H, W, 3) organised point cloud in the camera frame (OpenCV: x right, y "
-          "down, z forward) from depth and the intrinsics; (0, 0, 0) where nothing was hit. Its "
-          "colours and labels are rgb and label at the same pixels (a new array per access).")
+          "down, z forward), (0, 0, 0) where nothing was hit: a view of the captured points "
+          "pass, or without one a new array computed from depth and the intrinsics at each "
+          "access; its colours and labels are rgb and label at the same pixels")
+      .def_property_readonly(
+          "poses",
+          [](const Frame& f) -> py::object {
+            if (!f.has_poses) return py::none();
+            py::dict out;
+            for (const Frame::ObjectPose& p : f.poses) out[py::str(p.name)] = p.pose;
+            return std::move(out);
+          },
+          "{name: 4x4 world-from-object pose} of the objects the capture was asked for "
+          "(poses=True: every object), taken with the images at the same step; None when none "
+          "were asked for")
       .def_readonly("width", &Frame::width)
       .def_readonly("height", &Frame::height)
       .def_readonly("time", &Frame::time, "simulation time of the capture, seconds")
@@ -298,6 +285,26 @@ void register_capture(py::module_& m) {
           << " step=" << f.step << " time=" << f.time << ">";
         return s.str();
       });
+
+  m.def(
+      "capture_passes",
+      []() {
+        py::list out;
+        for (const PassInfo& p : capture_passes()) {
+          py::dict d;
+          d["name"] = p.name;
+          d["dtype"] = p.dtype;
+          d["channels"] = p.channels;
+          d["rendered"] = p.rendered;
+          d["default"] = (kDefaultPasses & p.bit) != 0;
+          d["description"] = p.description;
+          out.append(d);
+        }
+        return out;
+      },
+      "The capture passes, in order: dicts of name, dtype (NumPy's name), channels (1: an (H, "
+      "W) image, 3: (H, W, 3)), rendered (drawn by the GPU, else computed from other passes), "
+      "default (made when a camera is not told otherwise) and description");
 
   // The baseline of the capture benchmark: the same draw and readback, in C++, into buffers
   // allocated once, with no Python in the loop.

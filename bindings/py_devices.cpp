@@ -191,7 +191,7 @@ using LoopHolder = std::unique_ptr<RealTimeLoop, ReleaseGilDelete>;
 // Holds a world's state lock for a `with` block (acquired with the GIL released).
 struct StateLock {
   std::shared_ptr<World> world;
-  std::unique_lock<std::recursive_mutex> lock;
+  std::unique_lock<StateMutex> lock;
 };
 
 py::dict stats_dict(const RealTimeStats& s) {
@@ -205,6 +205,8 @@ py::dict stats_dict(const RealTimeStats& s) {
   d["step_cpu_p99"] = s.step_p99;
   d["step_cpu_max"] = s.step_cpu_max;
   d["step_wall_max"] = s.step_wall_max;
+  d["lock_wait_max"] = s.lock_wait_max;
+  d["lock_wait_p99"] = s.lock_wait_p99;
   d["late"] = s.late;
   d["late_step_wall"] = s.late_step_wall;
   d["late_step_cpu"] = s.late_step_cpu;

@@ -443,6 +443,10 @@ def realtime(args) -> Iterator[dict]:
             "rate_target_hz": 995,
             "step_cpu_p99_us": round(s["step_cpu_p99"] * 1e6, 1),
             "step_wall_max_us": round(s["step_wall_max"] * 1e6, 1),
+            # The longest the physics thread waited for the world's lock (a capture's copy).
+            "lock_wait_max_us": round(s["lock_wait_max"] * 1e6, 1),
+            "lock_wait_p99_us": round(s["lock_wait_p99"] * 1e6, 1),
+            "lock_wait_target_us": 200,
             # For each period over 2 ms, the wall time of the step before it: short steps mean
             # the thread woke late (the host), not that a step ran long.
             "late_step_wall_us": [round(w * 1e6, 1) for w in s["late_step_wall"]],

@@ -7,6 +7,7 @@
 #include "ambfplus/render/gl_info.h"
 #include "ambfplus/scene/simulator.h"
 #include "render/egl_context.h"
+#include "render/scene_renderer.h"
 
 namespace ambfplus {
 namespace {
@@ -16,6 +17,40 @@ TEST(Render, ContextReportsOpenGL45) {
   EXPECT_FALSE(info.renderer.empty());
   EXPECT_NE(info.version.find("4."), std::string::npos) << info.version;
   EXPECT_TRUE(info.profile == "compatibility" || info.profile == "core");
+}
+
+// Removing a model frees the GL objects only it used, and the renderer (with the resources of
+// what stays) carries on: it is not thrown away and rebuilt.
+TEST(Render, RemovingAModelReleasesItsResourcesOnly) {
+  auto sim = Simulator::create();
+  World& world = sim->world();
+  RigidBodySpec box;
+  box.name = "box";
+  box.dynamics.mass = 0;
+  world.default_model().add_body(box);
+  CameraSpec spec;
+  spec.name = "cam";
+  spec.width = 32;
+  spec.height = 24;
+  Camera& cam = world.default_model().add_camera(spec);
+  cam.look_at({0, 0, 3}, {0, 0, 0}, {0, 1, 0});
+  Model& model = world.add_model("extra");
+  RigidBodySpec ball;
+  ball.name = "ball";
+  ball.shape.kind = Shape::Kind::kSphere;
+  ball.dynamics.mass = 0;
+  model.add_body(ball);
+  spec.name = "cam2";
+  model.add_camera(spec).look_at({0, 3, 0}, {0, 0, 0});
+  cam.capture();
+  static_cast<Camera&>(*world.find("cam2")).capture();
+  auto& renderer = static_cast<render::SceneRenderer&>(world.renderer());
+  EXPECT_EQ(renderer.resource_counts(), (std::array<std::size_t, 4>{2, 0, 2, 0}));
+  world.remove_model(model);
+  const Frame frame = cam.capture();
+  EXPECT_EQ(&world.renderer(), &renderer);
+  EXPECT_EQ(renderer.resource_counts(), (std::array<std::size_t, 4>{1, 0, 1, 0}));
+  EXPECT_NEAR(frame.depth.data()[12 * 32 + 16], 2.5f, 1e-5f);
 }
 
 // A box face parallel to the image plane has one depth everywhere it covers, and the capture

@@ -67,6 +67,38 @@ TEST(VolumeData, DirtySinceUnitesLaterEdits) {
   EXPECT_EQ(box, (VoxelBox{{5, 5, 5}, {7, 6, 6}}));
 }
 
+// A tool's consecutive edits make one box; an edit far away stays a box of its own.
+TEST(VolumeData, DirtyBoxesKeepFarEditsApart) {
+  VolumeData v({64, 64, 64}, Eigen::Vector3d::Constant(0.064), LabelType::kUInt8, bone());
+  const std::int64_t r0 = v.revision();
+  v.mark_dirty(VoxelBox{{10, 10, 10}, {14, 14, 14}});
+  v.mark_dirty(VoxelBox{{11, 10, 10}, {15, 14, 14}});
+  v.mark_dirty(VoxelBox{{50, 50, 50}, {54, 54, 54}});
+  std::vector<VoxelBox> boxes;
+  ASSERT_TRUE(v.dirty_boxes_since(r0, &boxes));
+  ASSERT_EQ(boxes.size(), 2u);
+  EXPECT_EQ(boxes[0], (VoxelBox{{10, 10, 10}, {15, 14, 14}}));
+  EXPECT_EQ(boxes[1], (VoxelBox{{50, 50, 50}, {54, 54, 54}}));
+  // Beyond max_boxes, one union.
+  ASSERT_TRUE(v.dirty_boxes_since(r0, &boxes, 1));
+  EXPECT_EQ(boxes, (std::vector<VoxelBox>{VoxelBox{{10, 10, 10}, {54, 54, 54}}}));
+  EXPECT_FALSE(v.dirty_boxes_since(v.revision(), &boxes));
+}
+
+// The edit log keeps the newest edits up to its caps and counts those it dropped.
+TEST(VolumeData, EditLogIsCapped) {
+  VolumeData v({8, 8, 8}, Eigen::Vector3d::Constant(0.008), LabelType::kUInt8, bone());
+  const std::size_t extra = 10;
+  for (std::size_t n = 0; n < VolumeData::kEditLogEdits + extra; ++n) {
+    v.mark_dirty(VoxelBox{{0, 0, 0}, {1, 1, 1}});
+  }
+  EXPECT_EQ(v.edit_log().size(), VolumeData::kEditLogEdits);
+  EXPECT_EQ(v.edit_log_dropped(), static_cast<std::int64_t>(extra));
+  EXPECT_EQ(v.edit_log().back().revision, v.revision());
+  EXPECT_EQ(v.take_edit_log().size(), VolumeData::kEditLogEdits);
+  EXPECT_TRUE(v.edit_log().empty());
+}
+
 // The two-pass distance map equals a brute-force Chebyshev distance to the nearest occupied brick.
 TEST(BrickDistances, MatchBruteForce) {
   const std::array<int, 3> n = {9, 7, 11};

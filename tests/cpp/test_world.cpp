@@ -1,8 +1,12 @@
 #include <gtest/gtest.h>
 
+#include <memory>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "ambfplus/scene/simulator.h"
+#include "ambfplus/scene/system.h"
 
 namespace ambfplus {
 namespace {
@@ -39,6 +43,56 @@ TEST(World, IdsAreStableAndNotReusedAfterAFailedAdd) {
   EXPECT_EQ(a, 1);
   EXPECT_GT(b, a);
   EXPECT_EQ(world.find("a")->id(), a);
+}
+
+// A system that writes down what it hears, and refuses objects named "refused".
+class Recorder : public System {
+ public:
+  explicit Recorder(std::vector<std::string>& log, unsigned stages) : log_(log), stages_(stages) {}
+  const char* name() const override { return "recorder"; }
+  unsigned stages() const override { return stages_; }
+  void object_added(Object& o) override {
+    if (o.name() == "refused") throw std::invalid_argument("refused");
+    log_.push_back("added " + o.name());
+  }
+  void object_removed(Object& o) override { log_.push_back("removed " + o.name()); }
+  void prepare(const StepContext& c) override {
+    log_.push_back("prepare " + std::to_string(c.step));
+  }
+  void run(StepStage stage, const StepContext& c) override {
+    log_.push_back(std::string(step_stage_name(stage)) + " " + std::to_string(c.step));
+  }
+
+ private:
+  std::vector<std::string>& log_;
+  unsigned stages_;
+};
+
+// A step prepares every system, advances the clock, then runs the stages in their stated
+// order; an object a system refuses is not kept and the systems that took it let it go.
+TEST(World, StepRunsSystemsStageByStageAndObjectsAreAnnounced) {
+  auto sim = Simulator::create();
+  World& world = sim->world();
+  std::vector<std::string> log;
+  world.add_system(std::make_unique<Recorder>(
+      log, stage_bit(StepStage::kSensors) | stage_bit(StepStage::kDeviceInput)));
+  world.step(1);
+  EXPECT_EQ(log, (std::vector<std::string>{"prepare 1", "device input 1", "sensors 1"}));
+  log.clear();
+  world.default_model().add_body(sphere("kept"));
+  EXPECT_THROW(world.default_model().add_body(sphere("refused")), std::invalid_argument);
+  EXPECT_EQ(world.find("refused"), nullptr);
+  EXPECT_EQ(world.objects().size(), 1u);
+  EXPECT_EQ(log, (std::vector<std::string>{"added kept"}));
+  Model& model = world.add_model("m");
+  model.add_body(sphere("gone"));
+  log.clear();
+  world.remove_model(model);
+  EXPECT_EQ(log, (std::vector<std::string>{"removed gone"}));
+  std::vector<std::string> names;
+  for (System* s : world.systems()) names.push_back(s->name());
+  EXPECT_EQ(names, (std::vector<std::string>{"physics", "devices", "drills", "attachments",
+                                             "renderer", "step log", "plugins", "recorder"}));
 }
 
 TEST(World, ClockCountsFixedStepsWithoutDrift) {

@@ -1,5 +1,8 @@
 #include "haptics/critical_distances.h"
 
+#include <pthread.h>
+#include <sched.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -7,7 +10,12 @@
 namespace ambfplus {
 namespace {
 
-constexpr std::size_t kRebuildAfter = 4096;  // exposed voxels kept aside before a rebuild
+// A rebuild's thread runs at normal priority, whatever the thread that started it (a real-time
+// loop's SCHED_FIFO thread passes its policy on to threads it creates).
+void run_at_normal_priority() {
+  sched_param p{};
+  pthread_setschedparam(pthread_self(), SCHED_OTHER, &p);
+}
 
 }  // namespace
 
@@ -18,10 +26,11 @@ CriticalDistances::CriticalDistances(const VolumeData& data,
   std::vector<bool> tracked(65536, false);
   for (std::uint16_t l : labels_) {
     tracked[l] = true;
-    trees_[l];
+    structures_[l];
   }
   // One pass over the grid for every label. The nearest voxel of a structure to a point outside
   // it is on the structure's boundary, so only boundary voxels are kept.
+  std::map<std::uint16_t, std::vector<Point>> boundary;
   for (int k = 0; k < n[2]; ++k)
     for (int j = 0; j < n[1]; ++j)
       for (int i = 0; i < n[0]; ++i) {
@@ -35,24 +44,44 @@ CriticalDistances::CriticalDistances(const VolumeData& data,
             same(i, j, k - 1) && same(i, j, k + 1)) {
           continue;
         }
-        trees_[l].points.push_back({data_.voxel_center(i, j, k), {i, j, k}});
+        boundary[l].push_back({data_.voxel_center(i, j, k), {i, j, k}});
       }
-  for (auto& [label, tree] : trees_) build(tree);
+  for (auto& [label, s] : structures_) s.tree = build(std::move(boundary[label]));
 }
 
-void CriticalDistances::build(Tree& tree) {
-  // Keep only voxels that still have their label, with those exposed since the last build.
-  std::vector<Point> all;
-  all.reserve(tree.points.size() + tree.added.size());
-  for (auto* list : {&tree.points, &tree.added}) {
-    for (const Point& q : *list) all.push_back(q);
+CriticalDistances::~CriticalDistances() {
+  for (auto& [label, s] : structures_) {
+    if (s.rebuilding.valid()) s.rebuilding.wait();
+    if (s.retiring.valid()) s.retiring.wait();
   }
-  tree.points.swap(all);
-  tree.added.clear();
-  tree.axis.assign(tree.points.size(), 0);
-  tree.box_lo.assign(tree.points.size(), Eigen::Vector3d::Zero());
-  tree.box_hi.assign(tree.points.size(), Eigen::Vector3d::Zero());
-  build(tree, 0, tree.points.size());
+}
+
+std::shared_ptr<const CriticalDistances::Tree> CriticalDistances::build(std::vector<Point> points) {
+  auto tree = std::make_shared<Tree>();
+  tree->points = std::move(points);
+  tree->axis.assign(tree->points.size(), 0);
+  tree->box_lo.assign(tree->points.size(), Eigen::Vector3d::Zero());
+  tree->box_hi.assign(tree->points.size(), Eigen::Vector3d::Zero());
+  build(*tree, 0, tree->points.size());
+  return tree;
+}
+
+void CriticalDistances::collect(Structure& s) {
+  if (!s.rebuilding.valid() ||
+      s.rebuilding.wait_for(std::chrono::seconds(0)) != std::future_status::ready) {
+    return;
+  }
+  std::shared_ptr<const Tree> old = std::move(s.tree);
+  s.tree = s.rebuilding.get();
+  // The old tree is freed on another thread: its pages going back cost milliseconds.
+  if (s.retiring.valid()) s.retiring.wait();
+  s.retiring = std::async(std::launch::async, [old = std::move(old)]() mutable {
+    run_at_normal_priority();
+    old.reset();
+  });
+  s.added.erase(s.added.begin(), s.added.begin() + static_cast<std::ptrdiff_t>(s.folding));
+  s.folding = 0;
+  ++rebuilds_;
 }
 
 void CriticalDistances::build(Tree& tree, std::size_t lo, std::size_t hi) {
@@ -106,28 +135,43 @@ void CriticalDistances::search(const Tree& tree, std::size_t lo, std::size_t hi,
 }
 
 void CriticalDistances::removed(const std::array<int, 3>& v, std::uint16_t label) {
-  auto it = trees_.find(label);
-  if (it == trees_.end()) return;
+  auto it = structures_.find(label);
+  if (it == structures_.end()) return;
+  Structure& s = it->second;
   const auto& n = data_.shape();
   const int offsets[6][3] = {{-1, 0, 0}, {1, 0, 0}, {0, -1, 0}, {0, 1, 0}, {0, 0, -1}, {0, 0, 1}};
   for (const auto& o : offsets) {
     const std::array<int, 3> w = {v[0] + o[0], v[1] + o[1], v[2] + o[2]};
     if (w[0] < 0 || w[1] < 0 || w[2] < 0 || w[0] >= n[0] || w[1] >= n[1] || w[2] >= n[2]) continue;
     if (data_.label(w[0], w[1], w[2]) == label) {
-      it->second.added.push_back({data_.voxel_center(w[0], w[1], w[2]), w});
+      s.added.push_back({data_.voxel_center(w[0], w[1], w[2]), w});
     }
   }
-  if (it->second.added.size() > kRebuildAfter) build(it->second);
+  collect(s);
+  if (s.rebuilding.valid() || s.added.size() <= kRebuildAfter) return;
+  // The old tree is shared, not copied: this thread only copies the short list.
+  s.folding = s.added.size();
+  std::shared_ptr<const Tree> old = s.tree;
+  std::vector<Point> added(s.added.begin(), s.added.end());
+  s.rebuilding = std::async(std::launch::async, [old, added = std::move(added)]() {
+    run_at_normal_priority();
+    std::vector<Point> all;
+    all.reserve(old->points.size() + added.size());
+    all.insert(all.end(), old->points.begin(), old->points.end());
+    all.insert(all.end(), added.begin(), added.end());
+    return build(std::move(all));
+  });
 }
 
 double CriticalDistances::distance(const Eigen::Vector3d& p, std::uint16_t label) {
-  const Tree& tree = trees_[label];
+  Structure& s = structures_[label];
+  collect(s);
   double best = std::numeric_limits<double>::infinity();
-  for (const Point& q : tree.added) {
+  for (const Point& q : s.added) {
     const double d = (q.p - p).norm();
     if (d < best && alive(q, label)) best = d;
   }
-  search(tree, 0, tree.points.size(), p, label, best);
+  if (s.tree) search(*s.tree, 0, s.tree->points.size(), p, label, best);
   return best;
 }
 

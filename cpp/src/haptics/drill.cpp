@@ -146,13 +146,13 @@ void Drill::attach(RigidBody& body, const Eigen::Isometry3d& offset) {
   body.set_kinematic(true);  // the drill carries it
   attached_.emplace_back(&body, offset);
   body.set_pose(pose() * offset);
-  objects_seen_ = 0;  // rebuild the mesh collider without it
+  meshes_stale_ = true;  // rebuild the mesh collider without it
 }
 
 void Drill::sync_meshes() {
-  const std::vector<Object*> objects = volume_->world().objects();
-  if (objects.size() != objects_seen_) {
-    objects_seen_ = objects.size();
+  if (meshes_stale_) {
+    meshes_stale_ = false;
+    const std::vector<Object*> objects = volume_->world().objects();
     meshes_.clear();
     mesh_bodies_.clear();
     for (Object* o : objects) {

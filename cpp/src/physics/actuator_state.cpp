@@ -9,8 +9,6 @@
 
 namespace ambfplus {
 
-ConstraintActuator::~ConstraintActuator() = default;
-
 void ConstraintActuator::actuate(RigidBody& body, const Eigen::Isometry3d& offset) {
   if (&body == &parent()) {
     throw std::invalid_argument("actuator '" + name() + "' cannot hold its own parent '" +
@@ -30,8 +28,8 @@ void ConstraintActuator::actuate(RigidBody& body, const Eigen::Isometry3d& offse
   if (body_ == &body) return;  // already held (as AMBF, a new offset does not re-grip)
   deactuate();
 
-  physics::Body& pa = *parent().physics_body();
-  physics::Body& pb = *body.physics_body();
+  physics::Body& pa = *physics::body_of(parent());
+  physics::Body& pb = *physics::body_of(body);
   // The actuator frame on each body, in the body's centre-of-mass frame (Bullet's body frame).
   auto c = std::make_unique<physics::Constraint>();
   c->frame_a = physics::to_bullet(Eigen::Isometry3d(pa.offset.inverse() * location()));
@@ -47,24 +45,24 @@ void ConstraintActuator::actuate(RigidBody& body, const Eigen::Isometry3d& offse
   }
   c->constraint->setUserConstraintPtr(c.get());
   c->actuator = this;
-  btSoftRigidDynamicsWorld& bullet = world().physics().bullet();
+  btSoftRigidDynamicsWorld& bullet = physics::physics_of(*this).bullet();
   // The two bodies keep colliding, as in AMBF.
   bullet.addConstraint(c->constraint.get(), false);
   c->world = &bullet;
   pa.body->activate(true);
   pb.body->activate(true);
-  constraint_ = std::move(c);
+  set_physics_state(std::move(c));
   body_ = &body;
 }
 
 void ConstraintActuator::deactuate() {
-  if (!constraint_) return;
+  if (physics_state() == nullptr) return;
   RigidBody* held = body_;
-  constraint_.reset();  // leaves Bullet
+  set_physics_state(nullptr);  // leaves Bullet
   body_ = nullptr;
   // A body held still may have gone to sleep; it falls now.
-  if (held != nullptr && held->physics_body() != nullptr)
-    held->physics_body()->body->activate(true);
+  if (held != nullptr && physics::body_of(*held) != nullptr)
+    physics::body_of(*held)->body->activate(true);
 }
 
 }  // namespace ambfplus

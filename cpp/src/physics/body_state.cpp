@@ -16,21 +16,20 @@ void check_finite(const Eigen::Vector3d& v, const std::string& body, const char*
 
 }  // namespace
 
-RigidBody::~RigidBody() = default;
-
 void RigidBody::set_pose(const Eigen::Isometry3d& pose) {
   Object::set_pose(pose);
-  if (!physics_) return;
-  const btTransform t = physics::to_bullet(pose * physics_->offset);
-  btRigidBody& body = *physics_->body;
+  if (physics::body_of(*this) == nullptr) return;
+  const btTransform t = physics::to_bullet(pose * physics::body_of(*this)->offset);
+  btRigidBody& body = *physics::body_of(*this)->body;
   // Kinematic bodies move through their motion state, so Bullet sees their velocity.
-  physics_->motion->setWorldTransform(t);
+  physics::body_of(*this)->motion->setWorldTransform(t);
   if (!dynamics_.kinematic) {
     body.setWorldTransform(t);
     body.setInterpolationWorldTransform(t);
     body.activate(true);
     // Ray tests see the body's new place before the next step.
-    if (physics_->world != nullptr) physics_->world->updateSingleAabb(&body);
+    if (physics::body_of(*this)->world != nullptr)
+      physics::body_of(*this)->world->updateSingleAabb(&body);
   }
 }
 
@@ -40,25 +39,25 @@ void RigidBody::set_kinematic(bool kinematic) {
     throw std::invalid_argument("body '" + name() + "': a plane cannot be dynamic");
   }
   dynamics_.kinematic = kinematic;
-  if (physics_) {
-    world().physics().refresh(*this);
+  if (physics::body_of(*this) != nullptr) {
+    physics::physics_of(*this).refresh(*this);
     set_pose(pose());
   }
 }
 
 Eigen::Vector3d RigidBody::linear_velocity() const {
-  const btRigidBody& b = *physics_->body;
+  const btRigidBody& b = *physics::body_of(*this)->body;
   const Eigen::Vector3d r = pose().translation() - physics::to_eigen(b.getCenterOfMassPosition());
   return physics::to_eigen(b.getVelocityInLocalPoint(physics::to_bullet(r)));
 }
 
 Eigen::Vector3d RigidBody::angular_velocity() const {
-  return physics::to_eigen(physics_->body->getAngularVelocity());
+  return physics::to_eigen(physics::body_of(*this)->body->getAngularVelocity());
 }
 
 void RigidBody::set_linear_velocity(const Eigen::Vector3d& v) {
   check_finite(v, name(), "velocity");
-  btRigidBody& b = *physics_->body;
+  btRigidBody& b = *physics::body_of(*this)->body;
   // The centre of mass moves with v less the part the spin adds at the body origin.
   const Eigen::Vector3d r = pose().translation() - physics::to_eigen(b.getCenterOfMassPosition());
   const Eigen::Vector3d w = physics::to_eigen(b.getAngularVelocity());
@@ -69,7 +68,7 @@ void RigidBody::set_linear_velocity(const Eigen::Vector3d& v) {
 void RigidBody::set_angular_velocity(const Eigen::Vector3d& w) {
   check_finite(w, name(), "angular velocity");
   const Eigen::Vector3d v = linear_velocity();
-  physics_->body->setAngularVelocity(physics::to_bullet(w));
+  physics::body_of(*this)->body->setAngularVelocity(physics::to_bullet(w));
   set_linear_velocity(v);
 }
 
@@ -83,9 +82,9 @@ void RigidBody::set_torque(const Eigen::Vector3d& t) {
   torque_ = t;
 }
 
-Eigen::Vector3d RigidBody::inertia() const { return physics_->inertia; }
+Eigen::Vector3d RigidBody::inertia() const { return physics::body_of(*this)->inertia; }
 
-Eigen::Isometry3d RigidBody::inertial_offset() const { return physics_->offset; }
+Eigen::Isometry3d RigidBody::inertial_offset() const { return physics::body_of(*this)->offset; }
 
 void RigidBody::set_friction(double static_friction, double rolling_friction) {
   if (!(static_friction >= 0) || !(rolling_friction >= 0)) {
@@ -93,8 +92,8 @@ void RigidBody::set_friction(double static_friction, double rolling_friction) {
   }
   dynamics_.static_friction = static_friction;
   dynamics_.rolling_friction = rolling_friction;
-  physics_->body->setFriction(static_friction);
-  physics_->body->setRollingFriction(rolling_friction);
+  physics::body_of(*this)->body->setFriction(static_friction);
+  physics::body_of(*this)->body->setRollingFriction(rolling_friction);
 }
 
 void RigidBody::set_restitution(double restitution) {
@@ -102,7 +101,7 @@ void RigidBody::set_restitution(double restitution) {
     throw std::invalid_argument("body '" + name() + "': restitution must be in 0..1");
   }
   dynamics_.restitution = restitution;
-  physics_->body->setRestitution(restitution);
+  physics::body_of(*this)->body->setRestitution(restitution);
 }
 
 void RigidBody::set_damping(double linear, double angular) {
@@ -111,13 +110,14 @@ void RigidBody::set_damping(double linear, double angular) {
   }
   dynamics_.linear_damping = linear;
   dynamics_.angular_damping = angular;
-  physics_->body->setDamping(linear, angular);
+  physics::body_of(*this)->body->setDamping(linear, angular);
 }
 
 void RigidBody::ignore_collisions_with(RigidBody& other) {
-  if (!physics_ || !other.physics_ || &other == this) return;
-  physics_->body->setIgnoreCollisionCheck(other.physics_->body.get(), true);
-  other.physics_->body->setIgnoreCollisionCheck(physics_->body.get(), true);
+  if (physics::body_of(*this) == nullptr || physics::body_of(other) == nullptr || &other == this)
+    return;
+  physics::body_of(*this)->body->setIgnoreCollisionCheck(physics::body_of(other)->body.get(), true);
+  physics::body_of(other)->body->setIgnoreCollisionCheck(physics::body_of(*this)->body.get(), true);
 }
 
 }  // namespace ambfplus

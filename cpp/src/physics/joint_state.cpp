@@ -7,8 +7,6 @@
 
 namespace ambfplus {
 
-Joint::~Joint() = default;
-
 double Joint::position() const { return physics::PhysicsWorld::position(*this); }
 
 double Joint::velocity() const { return physics::PhysicsWorld::velocity(*this); }
@@ -21,8 +19,8 @@ void Joint::set_limits(std::optional<double> lower, std::optional<double> upper)
   }
   spec_.lower = lower;
   spec_.upper = upper;
-  if (!constraint_) return;
-  btTypedConstraint* c = constraint_->constraint.get();
+  if (physics::constraint_of(*this) == nullptr) return;
+  btTypedConstraint* c = physics::constraint_of(*this)->constraint.get();
   const double big = 1e30;
   const double lo = lower.value_or(-big), hi = upper.value_or(big);
   const bool limited = lower || upper;

@@ -8,8 +8,10 @@
 
 #include "ambfplus/scene/constraint_actuator.h"
 #include "ambfplus/scene/joint.h"
+#include "ambfplus/scene/proximity_sensor.h"
 #include "ambfplus/scene/rigid_body.h"
 #include "ambfplus/scene/soft_body.h"
+#include "ambfplus/scene/world.h"
 #include "physics/shapes.h"
 
 namespace ambfplus {
@@ -68,9 +70,9 @@ bool slides(JointType type) {
 
 // World frames of a joint on its parent and its child.
 void joint_frames(const Joint& joint, btTransform& a, btTransform& b) {
-  const Constraint& c = *joint.constraint();
-  a = joint.parent().physics_body()->body->getWorldTransform() * c.frame_a;
-  b = joint.child().physics_body()->body->getWorldTransform() * c.frame_b;
+  const Constraint& c = *constraint_of(joint);
+  a = body_of(joint.parent())->body->getWorldTransform() * c.frame_a;
+  b = body_of(joint.child())->body->getWorldTransform() * c.frame_b;
 }
 
 double wrap(double angle) { return std::remainder(angle, 2 * kPi); }
@@ -117,16 +119,93 @@ PhysicsWorld::PhysicsWorld() {
 
 PhysicsWorld::~PhysicsWorld() { detach_all(); }
 
+std::unique_ptr<Physics> make_physics(World&) { return std::make_unique<PhysicsWorld>(); }
+
+PhysicsWorld& physics_of(const Object& object) {
+  return static_cast<PhysicsWorld&>(object.world().physics());
+}
+
+void PhysicsWorld::object_added(Object& object) {
+  switch (object.kind()) {
+    case ObjectKind::kRigidBody:
+      add(static_cast<RigidBody&>(object));
+      break;
+    case ObjectKind::kJoint:
+      add(static_cast<Joint&>(object));
+      break;
+    case ObjectKind::kSoftBody:
+      add(static_cast<SoftBody&>(object));
+      break;
+    case ObjectKind::kActuator:
+      actuators_.push_back(static_cast<ConstraintActuator*>(&object));
+      break;
+    case ObjectKind::kSensor:
+      sensors_.push_back(static_cast<ProximitySensor*>(&object));
+      // Readings from the start, before the first step.
+      static_cast<ProximitySensor&>(object).update();
+      break;
+    default:
+      break;
+  }
+}
+
+void PhysicsWorld::object_removed(Object& object) {
+  switch (object.kind()) {
+    case ObjectKind::kRigidBody:
+      remove(static_cast<RigidBody&>(object));
+      break;
+    case ObjectKind::kJoint:
+      remove(static_cast<Joint&>(object));
+      break;
+    case ObjectKind::kSoftBody: {
+      Soft* soft = soft_of(static_cast<SoftBody&>(object));
+      if (soft != nullptr && soft->world != nullptr) {
+        soft->world->removeSoftBody(soft->body.get());
+        soft->world = nullptr;
+      }
+      break;
+    }
+    case ObjectKind::kActuator: {
+      auto* actuator = static_cast<ConstraintActuator*>(&object);
+      actuator->deactuate();
+      actuators_.erase(std::remove(actuators_.begin(), actuators_.end(), actuator),
+                       actuators_.end());
+      break;
+    }
+    case ObjectKind::kSensor:
+      sensors_.erase(std::remove(sensors_.begin(), sensors_.end(), &object), sensors_.end());
+      break;
+    default:
+      break;
+  }
+}
+
+void PhysicsWorld::run(StepStage stage, const StepContext& context) {
+  switch (stage) {
+    case StepStage::kPhysics:
+      step(context.dt);
+      break;
+    case StepStage::kActuators:
+      for (ConstraintActuator* a : actuators_) a->update();
+      break;
+    case StepStage::kSensors:
+      for (ProximitySensor* p : sensors_) p->update();
+      break;
+    default:
+      break;
+  }
+}
+
 void PhysicsWorld::detach_all() {
   for (Joint* j : joints_) {
-    Constraint* c = j->constraint();
+    Constraint* c = constraint_of(*j);
     if (c != nullptr && c->world != nullptr) {
       world_->removeConstraint(c->constraint.get());
       c->world = nullptr;
     }
   }
   for (RigidBody* rb : bodies_) {
-    Body* b = rb->physics_body();
+    Body* b = body_of(*rb);
     if (b != nullptr && b->world != nullptr) {
       world_->removeRigidBody(b->body.get());
       b->world = nullptr;
@@ -144,11 +223,13 @@ void PhysicsWorld::detach_all() {
   btSoftBodyArray& softs = world_->getSoftBodyArray();
   while (softs.size() > 0) {
     btSoftBody* sb = softs[softs.size() - 1];
-    static_cast<SoftBody*>(sb->getUserPointer())->physics_soft()->world = nullptr;
+    soft_of(*static_cast<SoftBody*>(sb->getUserPointer()))->world = nullptr;
     world_->removeSoftBody(sb);
   }
   joints_.clear();
   bodies_.clear();
+  actuators_.clear();
+  sensors_.clear();
 }
 
 void PhysicsWorld::set_gravity(const Eigen::Vector3d& g) {
@@ -162,7 +243,7 @@ Eigen::Vector3d PhysicsWorld::gravity() const { return to_eigen(world_->getGravi
 void PhysicsWorld::remove(RigidBody& rb) {
   bodies_.erase(std::remove(bodies_.begin(), bodies_.end(), &rb), bodies_.end());
   // Actuators let go of it (or of the body their parent holds) while it still exists.
-  const btRigidBody* bullet_body = rb.physics_body() ? rb.physics_body()->body.get() : nullptr;
+  const btRigidBody* bullet_body = body_of(rb) ? body_of(rb)->body.get() : nullptr;
   for (int i = world_->getNumConstraints() - 1; i >= 0; --i) {
     btTypedConstraint* t = world_->getConstraint(i);
     void* user = t->getUserConstraintPtr();
@@ -178,7 +259,7 @@ void PhysicsWorld::remove(RigidBody& rb) {
 void PhysicsWorld::remove(Joint& joint) {
   joints_.erase(std::remove(joints_.begin(), joints_.end(), &joint), joints_.end());
   // Its constraint leaves Bullet now, while both bodies still exist.
-  if (physics::Constraint* c = joint.constraint()) {
+  if (physics::Constraint* c = constraint_of(joint)) {
     if (c->world != nullptr && c->constraint) c->world->removeConstraint(c->constraint.get());
     c->world = nullptr;
   }
@@ -260,12 +341,12 @@ void PhysicsWorld::add(RigidBody& rb) {
   b->owner = &rb;
   world_->addRigidBody(b->body.get());
   b->world = world_.get();
-  rb.physics_ = std::move(b);
+  rb.set_physics_state(std::move(b));
   bodies_.push_back(&rb);
 }
 
 void PhysicsWorld::refresh(RigidBody& rb) {
-  Body& b = *rb.physics_body();
+  Body& b = *body_of(rb);
   btRigidBody& body = *b.body;
   world_->removeRigidBody(&body);
   int flags = body.getCollisionFlags() & ~btCollisionObject::CF_KINEMATIC_OBJECT;
@@ -287,8 +368,8 @@ void PhysicsWorld::refresh(RigidBody& rb) {
 
 void PhysicsWorld::add(Joint& joint) {
   const JointSpec& s = joint.spec();
-  Body& pa = *s.parent->physics_body();
-  Body& pb = *s.child->physics_body();
+  Body& pa = *body_of(*s.parent);
+  Body& pb = *body_of(*s.child);
   auto c = std::make_unique<Constraint>();
   const Eigen::Vector3d axis0 = default_axis(s.type);
   c->frame_a = joint_frame(s.parent_pivot, s.parent_axis, s.offset, axis0, pa.offset);
@@ -353,7 +434,7 @@ void PhysicsWorld::add(Joint& joint) {
   }
   world_->addConstraint(c->constraint.get(), s.ignore_inter_collision);
   c->world = world_.get();
-  joint.constraint_ = std::move(c);
+  joint.set_physics_state(std::move(c));
   joint.set_limits(s.lower, s.upper);
   a.activate(true);
   b.activate(true);
@@ -369,7 +450,7 @@ double PhysicsWorld::position(const Joint& joint) {
     const btMatrix3x3& r = rel.getBasis();
     const double raw = std::atan2(r[1][0], r[0][0]);
     // Continuous through full turns: the nearest to the last step's position.
-    const double last = joint.constraint()->last_position;
+    const double last = constraint_of(joint)->last_position;
     return last + wrap(raw - last);
   }
   if (type == JointType::kPrismatic) return rel.getOrigin().x();
@@ -382,8 +463,8 @@ double PhysicsWorld::velocity(const Joint& joint) {
   if (!rotates(type) && !slides(type)) return 0.0;
   btTransform a, b;
   joint_frames(joint, a, b);
-  const btRigidBody& ra = *joint.parent().physics_body()->body;
-  const btRigidBody& rb = *joint.child().physics_body()->body;
+  const btRigidBody& ra = *body_of(joint.parent())->body;
+  const btRigidBody& rb = *body_of(joint.child())->body;
   const btVector3 axis = a.getBasis().getColumn(type == JointType::kPrismatic ? 0 : 2);
   if (rotates(type)) return (rb.getAngularVelocity() - ra.getAngularVelocity()).dot(axis);
   // The child's pivot moving relative to the same point carried by the parent.
@@ -435,11 +516,11 @@ void PhysicsWorld::apply_joint(Joint& joint, double dt) {
   if (type == JointType::kRevolute || type == JointType::kPrismatic) effort -= s.damping * vel;
   joint.effort_ = effort;
 
-  btRigidBody& ra = *joint.parent().physics_body()->body;
-  btRigidBody& rb = *joint.child().physics_body()->body;
+  btRigidBody& ra = *body_of(joint.parent())->body;
+  btRigidBody& rb = *body_of(joint.child())->body;
   btTransform a, b;
   joint_frames(joint, a, b);
-  btTypedConstraint* c = joint.constraint()->constraint.get();
+  btTypedConstraint* c = constraint_of(joint)->constraint.get();
   // The motor drives the same quantity position() and velocity() measure: the child relative to
   // the parent about (along) the parent's axis.
   if (type == JointType::kRevolute) {
@@ -474,7 +555,7 @@ void PhysicsWorld::step(double dt) {
   for (RigidBody* rb : bodies_) {
     if (!rb->is_dynamic()) continue;
     moving = true;
-    btRigidBody& body = *rb->physics_body()->body;
+    btRigidBody& body = *body_of(*rb)->body;
     if (!rb->force().isZero() || !rb->torque().isZero()) {
       body.applyCentralForce(to_bullet(rb->force()));
       body.applyTorque(to_bullet(rb->torque()));
@@ -487,9 +568,9 @@ void PhysicsWorld::step(double dt) {
     // take their new poses (for ray tests) without a step.
     for (RigidBody* rb : bodies_) {
       if (!rb->dynamics().kinematic) continue;
-      btRigidBody& body = *rb->physics_body()->body;
+      btRigidBody& body = *body_of(*rb)->body;
       btTransform t;
-      rb->physics_body()->motion->getWorldTransform(t);
+      body_of(*rb)->motion->getWorldTransform(t);
       body.setWorldTransform(t);
       body.setInterpolationWorldTransform(t);
       world_->updateSingleAabb(&body);
@@ -501,14 +582,14 @@ void PhysicsWorld::step(double dt) {
   sync_soft_bodies();
   for (RigidBody* rb : bodies_) {
     if (!rb->is_dynamic()) continue;
-    const Body& b = *rb->physics_body();
+    const Body& b = *body_of(*rb);
     rb->store_pose(to_eigen(b.body->getWorldTransform()) * b.offset.inverse());
   }
   for (Joint* j : joints_) {
     btTransform a, b;
     joint_frames(*j, a, b);
     j->set_pose(to_eigen(a));
-    j->constraint()->last_position = position(*j);
+    constraint_of(*j)->last_position = position(*j);
   }
 }
 

@@ -10,10 +10,15 @@
 #include <btBulletDynamicsCommon.h>
 #include <Eigen/Geometry>
 
+#include "ambfplus/physics/physics.h"
+#include "ambfplus/scene/rigid_body.h"
+#include "ambfplus/scene/soft_body.h"
+
 namespace ambfplus {
 
 class ConstraintActuator;
 class Joint;
+class ProximitySensor;
 class RigidBody;
 class SoftBody;
 
@@ -25,8 +30,8 @@ inline btVector3 to_bullet(const Eigen::Vector3d& v) { return btVector3(v.x(), v
 inline Eigen::Vector3d to_eigen(const btVector3& v) { return Eigen::Vector3d(v.x(), v.y(), v.z()); }
 
 /// A body's Bullet side: its shapes (and the mesh data they point into) and the rigid body.
-struct Body {
-  ~Body();
+struct Body : ObjectState {
+  ~Body() override;
   std::vector<std::unique_ptr<btCollisionShape>> shapes;  // the last one is the body's
   std::vector<std::unique_ptr<btStridingMeshInterface>> meshes;
   std::vector<std::vector<btScalar>> vertices;
@@ -41,8 +46,8 @@ struct Body {
 };
 
 /// A soft body's Bullet side (its user pointer is the scene SoftBody).
-struct Soft {
-  ~Soft();
+struct Soft : ObjectState {
+  ~Soft() override;
   std::unique_ptr<btSoftBody> body;
   btSoftRigidDynamicsWorld* world = nullptr;  // while in one
   double node_mass = 0.0;                     // of each free node, kg
@@ -59,9 +64,10 @@ struct RayHit {
   int soft_body_node = -1;
 };
 
-/// A joint's Bullet constraint and its frames (in each body's centre-of-mass frame).
-struct Constraint {
-  ~Constraint();
+/// A joint's (or an actuator's hold's) Bullet constraint and its frames (in each body's
+/// centre-of-mass frame).
+struct Constraint : ObjectState {
+  ~Constraint() override;
   std::unique_ptr<btTypedConstraint> constraint;
   btTransform frame_a, frame_b;
   btDynamicsWorld* world = nullptr;
@@ -69,13 +75,34 @@ struct Constraint {
   ConstraintActuator* actuator = nullptr;  // an actuator's hold (its user pointer is this)
 };
 
-/// One Bullet world per scene world: bodies, joints, their controllers, a fixed step.
-class PhysicsWorld {
+/// The Bullet side of objects, as their physics state (Object::physics_state); nullptr for
+/// an object physics does not hold (yet, or any more).
+inline Body* body_of(const RigidBody& body) { return static_cast<Body*>(body.physics_state()); }
+inline Soft* soft_of(const SoftBody& body) { return static_cast<Soft*>(body.physics_state()); }
+inline Constraint* constraint_of(const Object& joint_or_actuator) {
+  return static_cast<Constraint*>(joint_or_actuator.physics_state());
+}
+
+/// One Bullet world per scene world: bodies, joints, their controllers, actuators and sensors,
+/// a fixed step.
+class PhysicsWorld : public Physics {
  public:
   PhysicsWorld();
-  ~PhysicsWorld();
+  ~PhysicsWorld() override;
   PhysicsWorld(const PhysicsWorld&) = delete;
   PhysicsWorld& operator=(const PhysicsWorld&) = delete;
+
+  // System
+  const char* name() const override { return "physics"; }
+  unsigned stages() const override {
+    return stage_bit(StepStage::kPhysics) | stage_bit(StepStage::kActuators) |
+           stage_bit(StepStage::kSensors);
+  }
+  void object_added(Object& object) override;
+  void object_removed(Object& object) override;
+  void run(StepStage stage, const StepContext& context) override;
+  /// Takes every body and constraint out of Bullet (before the scene objects go away).
+  void detach_all() override;
 
   /// Builds the body's Bullet side and adds it. Throws std::invalid_argument for geometry Bullet
   /// cannot simulate (a dynamic plane).
@@ -96,10 +123,8 @@ class PhysicsWorld {
   /// Controllers and commands, one Bullet step of dt, then poses back into the scene.
   void step(double dt);
 
-  void set_gravity(const Eigen::Vector3d& g);
-  Eigen::Vector3d gravity() const;
-  /// Takes every body and constraint out of Bullet (before the scene objects go away).
-  void detach_all();
+  void set_gravity(const Eigen::Vector3d& g) override;
+  Eigen::Vector3d gravity() const override;
 
   /// Joint state from Bullet.
   static double position(const Joint& joint);
@@ -122,7 +147,12 @@ class PhysicsWorld {
   std::unique_ptr<btSoftRigidDynamicsWorld> world_;
   std::vector<RigidBody*> bodies_;
   std::vector<Joint*> joints_;
+  std::vector<ConstraintActuator*> actuators_;
+  std::vector<ProximitySensor*> sensors_;
 };
+
+/// The physics of an object's world.
+PhysicsWorld& physics_of(const Object& object);
 
 }  // namespace physics
 }  // namespace ambfplus

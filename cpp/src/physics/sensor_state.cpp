@@ -84,7 +84,7 @@ RayHit PhysicsWorld::ray_test(const Eigen::Vector3d& from, const Eigen::Vector3d
                               const RigidBody* ignore) const {
   const btVector3 a = to_bullet(from), b = to_bullet(to);
   const btCollisionObject* skip =
-      ignore != nullptr && ignore->physics_body() ? ignore->physics_body()->body.get() : nullptr;
+      ignore != nullptr && body_of(*ignore) ? body_of(*ignore)->body.get() : nullptr;
   NearestHit callback(a, b, skip);
   world_->rayTest(a, b, callback);
   RayHit out;
@@ -125,7 +125,7 @@ ProximitySensor::~ProximitySensor() = default;
 void ProximitySensor::update() {
   const Eigen::Isometry3d frame = parent().pose() * checked_pose(spec_.location);
   Object::set_pose(frame);
-  const physics::PhysicsWorld& physics = world().physics();
+  const physics::PhysicsWorld& physics = physics::physics_of(*this);
   for (std::size_t i = 0; i < spec_.rays.size(); ++i) {
     const SensorRay& r = spec_.rays[i];
     const Eigen::Vector3d from = frame * r.offset;

@@ -187,7 +187,7 @@ void PhysicsWorld::add(SoftBody& sb) {
   b.updateNormals();
   world_->addSoftBody(&b);
   s->world = world_.get();
-  sb.physics_ = std::move(s);
+  sb.set_physics_state(std::move(s));
   sb.sync();
 }
 
@@ -212,10 +212,8 @@ void PhysicsWorld::sync_soft_bodies() {
 
 }  // namespace physics
 
-SoftBody::~SoftBody() = default;
-
 void SoftBody::sync() {
-  const btSoftBody& b = *physics_->body;
+  const btSoftBody& b = *physics::soft_of(*this)->body;
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   for (int n = 0; n < b.m_nodes.size(); ++n) {
     const btVector3& x = b.m_nodes[n].m_x;
@@ -231,7 +229,7 @@ void SoftBody::sync() {
 }
 
 std::vector<double> SoftBody::node_velocities() const {
-  const btSoftBody& b = *physics_->body;
+  const btSoftBody& b = *physics::soft_of(*this)->body;
   std::vector<double> out(3 * b.m_nodes.size());
   for (int n = 0; n < b.m_nodes.size(); ++n) {
     const btVector3& v = b.m_nodes[n].m_v;
@@ -247,7 +245,7 @@ void SoftBody::set_node_position(int node, const Eigen::Vector3d& position) {
   if (!position.allFinite()) {
     throw std::invalid_argument("soft body '" + name() + "': node positions must be finite");
   }
-  btSoftBody& b = *physics_->body;
+  btSoftBody& b = *physics::soft_of(*this)->body;
   btSoftBody::Node& n = b.m_nodes[node];
   n.m_x = physics::to_bullet(position);
   n.m_q = n.m_x;
@@ -258,23 +256,23 @@ void SoftBody::set_node_position(int node, const Eigen::Vector3d& position) {
 
 void SoftBody::set_node_fixed(int node, bool fixed) {
   check_node(node);
-  btSoftBody& b = *physics_->body;
+  btSoftBody& b = *physics::soft_of(*this)->body;
   if (fixed) {
     b.setMass(node, 0);
     b.m_nodes[node].m_v.setZero();
   } else {
-    b.setMass(node, physics_->node_mass);
+    b.setMass(node, physics::soft_of(*this)->node_mass);
   }
 }
 
 bool SoftBody::is_node_fixed(int node) const {
   check_node(node);
-  return physics_->body->m_nodes[node].m_im == 0;
+  return physics::soft_of(*this)->body->m_nodes[node].m_im == 0;
 }
 
 std::vector<int> SoftBody::fixed_nodes() const {
   std::vector<int> out;
-  const btSoftBody& b = *physics_->body;
+  const btSoftBody& b = *physics::soft_of(*this)->body;
   for (int n = 0; n < b.m_nodes.size(); ++n) {
     if (b.m_nodes[n].m_im == 0) out.push_back(n);
   }
@@ -282,12 +280,12 @@ std::vector<int> SoftBody::fixed_nodes() const {
 }
 
 void SoftBody::set_pose(const Eigen::Isometry3d& pose) {
-  if (!physics_) {
+  if (physics::soft_of(*this) == nullptr) {
     Object::set_pose(pose);
     return;
   }
   const btTransform move = physics::to_bullet(Eigen::Isometry3d(pose * this->pose().inverse()));
-  btSoftBody& b = *physics_->body;
+  btSoftBody& b = *physics::soft_of(*this)->body;
   for (int n = 0; n < b.m_nodes.size(); ++n) {
     b.m_nodes[n].m_x = move * b.m_nodes[n].m_x;
     b.m_nodes[n].m_q = move * b.m_nodes[n].m_q;

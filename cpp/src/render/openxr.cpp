@@ -473,7 +473,8 @@ std::vector<Frame> OpenXrSession::end_frame(const std::vector<const Camera*>& ca
   frames.resize(cameras.size());
   for (std::size_t i = 0; i < cameras.size(); ++i) {
     const render::RenderTarget& target =
-        cameras[i]->world().renderer().render_to_target(*cameras[i], kPassRgb, frames[i]);
+        static_cast<render::SceneRenderer&>(cameras[i]->world().renderer())
+            .render_to_target(*cameras[i], kPassRgb, frames[i]);
     State::Eye& eye = s.eyes[i];
     render::Context::Scope scope;
     uint32_t index = 0;

@@ -26,9 +26,32 @@ std::optional<ShaderSpec> copy_of(const ShaderSpec* spec) {
 
 }  // namespace
 
+std::unique_ptr<Renderer> make_renderer(World& world) {
+  return std::make_unique<SceneRenderer>(world);
+}
+
 SceneRenderer::SceneRenderer(World& world) : world_(world) {}
 
-SceneRenderer::~SceneRenderer() {
+SceneRenderer::~SceneRenderer() { release_all(); }
+
+void SceneRenderer::detach_all() { release_all(); }
+
+namespace {
+
+void release_mesh(GpuMesh& m) {
+  glDeleteVertexArrays(1, &m.vao);
+  if (m.legacy_vao != 0) glDeleteVertexArrays(1, &m.legacy_vao);
+  glDeleteBuffers(3, m.buffers);
+}
+
+void release_target(RenderTarget& t) {
+  glDeleteFramebuffers(1, &t.framebuffer);
+  glDeleteRenderbuffers(RenderTarget::kBuffers, t.renderbuffers);
+}
+
+}  // namespace
+
+void SceneRenderer::release_all() {
   if ((meshes_.empty() && soft_meshes_.empty() && targets_.empty() && volumes_.empty()) ||
       !Context::exists()) {
     return;
@@ -36,33 +59,86 @@ SceneRenderer::~SceneRenderer() {
   try {
     Context::Scope scope;
     volumes_.clear();
-    auto release = [](GpuMesh& m) {
-      glDeleteVertexArrays(1, &m.vao);
-      if (m.legacy_vao != 0) glDeleteVertexArrays(1, &m.legacy_vao);
-      glDeleteBuffers(3, m.buffers);
-    };
-    for (auto& entry : meshes_) release(entry.second);
-    for (auto& entry : soft_meshes_) release(entry.second);
-    for (auto& [key, t] : targets_) {
-      glDeleteFramebuffers(1, &t.framebuffer);
-      glDeleteRenderbuffers(RenderTarget::kBuffers, t.renderbuffers);
-    }
+    for (auto& entry : meshes_) release_mesh(entry.second);
+    for (auto& entry : soft_meshes_) release_mesh(entry.second);
+    for (auto& entry : targets_) release_target(entry.second);
   } catch (const Error&) {
     // The context is gone (e.g. after a fork); its objects went with it.
     for (auto& v : volumes_) v.second.release();
   }
+  volumes_.clear();
+  meshes_.clear();
+  soft_meshes_.clear();
+  targets_.clear();
 }
 
-std::optional<VolumeUpload> SceneRenderer::last_upload(const VolumeData* data) const {
+void SceneRenderer::object_removed(Object& object) {
   std::lock_guard<std::mutex> lock(volumes_mutex_);
-  auto it = volumes_.find(data);
+  released_ids_.push_back(object.id());
+  meshes_to_check_ = meshes_to_check_ || object.kind() == ObjectKind::kRigidBody;
+}
+
+void SceneRenderer::release_unused() {
+  std::vector<int> ids;
+  bool check_meshes = false;
+  {
+    std::lock_guard<std::mutex> lock(volumes_mutex_);
+    ids.swap(released_ids_);
+    check_meshes = meshes_to_check_;
+    meshes_to_check_ = false;
+    for (int id : ids) volumes_.erase(id);
+  }
+  for (int id : ids) {
+    if (auto t = targets_.find(id); t != targets_.end()) {
+      release_target(t->second);
+      targets_.erase(t);
+    }
+    if (auto m = soft_meshes_.find(id); m != soft_meshes_.end()) {
+      release_mesh(m->second);
+      soft_meshes_.erase(m);
+    }
+  }
+  // A mesh only this renderer still holds is drawn by no body any more.
+  if (!check_meshes) return;
+  for (auto it = meshes_.begin(); it != meshes_.end();) {
+    if (it->second.source.use_count() == 1) {
+      release_mesh(it->second);
+      it = meshes_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+}
+
+std::array<std::size_t, 4> SceneRenderer::resource_counts() const {
+  std::lock_guard<std::mutex> lock(volumes_mutex_);
+  return {meshes_.size(), soft_meshes_.size(), targets_.size(), volumes_.size()};
+}
+
+std::optional<VolumeUpload> SceneRenderer::last_upload(const Volume& volume) const {
+  std::lock_guard<std::mutex> lock(volumes_mutex_);
+  auto it = volumes_.find(volume.id());
   if (it == volumes_.end()) return std::nullopt;
   return it->second->last_upload();
 }
 
-void SceneRenderer::snapshot(const Camera& camera, unsigned passes, Snapshot& snapshot,
-                             Frame& frame) {
+void SceneRenderer::snapshot(const Camera& camera, unsigned passes, const PoseRequest& poses,
+                             Snapshot& snapshot, Frame& frame) {
   auto lock = world_.lock_state();
+  // Names are checked first, so a bad request leaves the frame as it was.
+  std::vector<const Object*> posed;
+  if (poses.all) {
+    for (const Object* o : world_.objects()) posed.push_back(o);
+  } else {
+    for (const std::string& name : poses.names) {
+      const Object* o = world_.find(name);
+      if (o == nullptr) {
+        throw std::invalid_argument("poses: no object named '" + name + "' in world '" +
+                                    world_.name() + "'");
+      }
+      posed.push_back(o);
+    }
+  }
   world_.graphics_update();
   take(camera, passes, snapshot);
   frame.width = camera.width();
@@ -72,12 +148,18 @@ void SceneRenderer::snapshot(const Camera& camera, unsigned passes, Snapshot& sn
   frame.camera = camera.name();
   frame.intrinsics = camera.intrinsics();
   frame.pose = camera.pose().matrix();
+  // Every capture replaces the poses: a frame refilled without asking keeps none.
+  frame.has_poses = !poses.empty();
+  frame.poses.clear();
+  for (const Object* o : posed) frame.poses.push_back({o->name(), o->id(), o->pose().matrix()});
 }
 
-void SceneRenderer::render(const Camera& camera, const CaptureBuffers& buffers, Frame& frame) {
+void SceneRenderer::render(const Camera& camera, const CaptureBuffers& buffers,
+                           const PoseRequest& poses, Frame& frame) {
   Snapshot s;
-  snapshot(camera, buffers.passes(), s, frame);
+  snapshot(camera, buffers.passes() & kRenderedPasses, poses, s, frame);
   Context::Scope scope;
+  release_unused();
   draw(s);
   read(s, buffers);
 }
@@ -85,8 +167,9 @@ void SceneRenderer::render(const Camera& camera, const CaptureBuffers& buffers, 
 const RenderTarget& SceneRenderer::render_to_target(const Camera& camera, unsigned passes,
                                                     Frame& frame) {
   Snapshot s;
-  snapshot(camera, passes, s, frame);
+  snapshot(camera, passes, PoseRequest{}, s, frame);
   Context::Scope scope;
+  release_unused();
   draw(s);
   return target_for(s);
 }
@@ -127,8 +210,11 @@ void SceneRenderer::take(const Camera& camera, unsigned passes, Snapshot& s) {
     GpuVolume* gpu = nullptr;
     {
       std::lock_guard<std::mutex> lock(volumes_mutex_);
-      auto& slot = volumes_[volume->data().get()];
-      if (!slot) slot = std::make_unique<GpuVolume>(volume->data());
+      auto& slot = volumes_[volume->id()];
+      // A volume given other data is uploaded afresh.
+      if (!slot || slot->data() != volume->data()) {
+        slot = std::make_unique<GpuVolume>(volume->data());
+      }
       gpu = slot.get();
     }
     gpu->stage(volume->iso());
@@ -262,12 +348,12 @@ void SceneRenderer::draw(const Snapshot& s) {
 
   glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
   // Only the passes asked for are written (pass i on attachment i).
-  GLenum draw_buffers[kPassCount];
-  for (int i = 0; i < kPassCount; ++i) {
+  GLenum draw_buffers[kRenderedPassCount];
+  for (int i = 0; i < kRenderedPassCount; ++i) {
     draw_buffers[i] =
         (passes & (1u << i)) ? static_cast<GLenum>(GL_COLOR_ATTACHMENT0 + i) : GL_NONE;
   }
-  glDrawBuffers(kPassCount, draw_buffers);
+  glDrawBuffers(kRenderedPassCount, draw_buffers);
   glViewport(0, 0, target.width, target.height);
   // Reversed z: clear to 0 (far), keep the greater depth.
   glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
@@ -377,13 +463,13 @@ void SceneRenderer::read(const Snapshot& s, const CaptureBuffers& buffers) {
   const struct {
     void* data;
     GLenum format, type;
-  } images[kPassCount] = {{buffers.rgb, GL_RGB, GL_UNSIGNED_BYTE},
-                          {buffers.depth, GL_RED, GL_FLOAT},
-                          {buffers.label, GL_RED_INTEGER, GL_UNSIGNED_SHORT},
-                          {buffers.instance, GL_RED_INTEGER, GL_INT},
-                          {buffers.voxel, GL_RED_INTEGER, GL_INT},
-                          {buffers.segmentation, GL_RGB, GL_UNSIGNED_BYTE}};
-  for (int i = 0; i < kPassCount; ++i) {
+  } images[kRenderedPassCount] = {{buffers.rgb, GL_RGB, GL_UNSIGNED_BYTE},
+                                  {buffers.depth, GL_RED, GL_FLOAT},
+                                  {buffers.label, GL_RED_INTEGER, GL_UNSIGNED_SHORT},
+                                  {buffers.instance, GL_RED_INTEGER, GL_INT},
+                                  {buffers.voxel, GL_RED_INTEGER, GL_INT},
+                                  {buffers.segmentation, GL_RGB, GL_UNSIGNED_BYTE}};
+  for (int i = 0; i < kRenderedPassCount; ++i) {
     if (images[i].data == nullptr) continue;
     glReadBuffer(static_cast<GLenum>(GL_COLOR_ATTACHMENT0 + i));
     glReadPixels(0, 0, target.width, target.height, images[i].format, images[i].type,

@@ -11,12 +11,14 @@
 #include <vector>
 
 #include "ambfplus/capture/frame.h"
+#include "ambfplus/render/renderer.h"
 #include "ambfplus/scene/camera.h"
 #include "ambfplus/scene/rigid_body.h"
 #include "render/light_set.h"
 
 namespace ambfplus {
 class World;
+class Volume;
 class VolumeData;
 struct MeshData;
 }  // namespace ambfplus
@@ -38,8 +40,8 @@ struct GpuMesh {
 
 /// Off-screen colour, metric-depth, id and depth-test buffers of one camera's size.
 struct RenderTarget {
-  // One colour attachment per capture pass (pass i on attachment i), then the depth test.
-  static constexpr int kBuffers = kPassCount + 1;
+  // One colour attachment per drawn pass (pass i on attachment i), then the depth test.
+  static constexpr int kBuffers = kRenderedPassCount + 1;
   GLuint framebuffer = 0;
   // colour (RGBA8), depth (R32F), label (R16UI), instance (R32I), voxel (R32I), segmentation
   // (RGBA8), depth test (D32F)
@@ -90,26 +92,37 @@ struct Snapshot {
 };
 
 /// Draws a world's bodies for its cameras into off-screen buffers and reads them back. Owns the
-/// GL objects of one world. A render copies what it needs out of the world under the world's
+/// GL objects of one world: per camera its target, per soft body and per volume their buffers
+/// (by object id), and per mesh its buffers (shared by the bodies drawing it, kept while one
+/// does). An object leaving the world queues its resources for release at the next render (GL
+/// work needs the context). A render copies what it needs out of the world under the world's
 /// state lock (World::lock_state) and draws after releasing it; GL work takes the process's
 /// context (Context::Scope).
-class SceneRenderer {
+class SceneRenderer : public Renderer {
  public:
   explicit SceneRenderer(World& world);
-  ~SceneRenderer();
+  ~SceneRenderer() override;
   SceneRenderer(const SceneRenderer&) = delete;
   SceneRenderer& operator=(const SceneRenderer&) = delete;
 
-  /// Renders camera's view into buffers (null ones are skipped) and fills frame's time, step,
-  /// intrinsics and pose, all of one simulation step.
-  void render(const Camera& camera, const CaptureBuffers& buffers, Frame& frame);
+  // System
+  const char* name() const override { return "renderer"; }
+  unsigned stages() const override { return 0; }
+  void object_removed(Object& object) override;
+  /// Releases every GL object (the world is going away).
+  void detach_all() override;
+
+  void render(const Camera& camera, const CaptureBuffers& buffers, const PoseRequest& poses,
+              Frame& frame) override;
   /// Renders camera's view (those passes) and leaves it in the camera's render target, for a
   /// window to show; fills frame as render does. Needs no Scope.
   const RenderTarget& render_to_target(const Camera& camera, unsigned passes, Frame& frame);
   /// The camera's render target as its last render_to_target left it; nullptr before one.
   const RenderTarget* last_target(const Camera& camera);
-  /// What the last upload of this volume data sent to the GPU (nullptr before its first draw).
-  std::optional<VolumeUpload> last_upload(const VolumeData* data) const;
+  /// What the last upload of this volume sent to the GPU (nullptr before its first draw).
+  std::optional<VolumeUpload> last_upload(const Volume& volume) const;
+  /// GL objects held: meshes, soft meshes, targets, volumes (for tests of their release).
+  std::array<std::size_t, 4> resource_counts() const;
 
  private:
   /// Copies the camera's view out of the world (the caller holds the world's state lock).
@@ -118,8 +131,13 @@ class SceneRenderer {
   void draw(const Snapshot& snapshot);
   /// Reads the last draw of a snapshot's camera into buffers.
   void read(const Snapshot& snapshot, const CaptureBuffers& buffers);
-  /// Copies the camera's view out of the world (under its lock) and fills frame.
-  void snapshot(const Camera& camera, unsigned passes, Snapshot& snapshot, Frame& frame);
+  /// Copies the camera's view and the poses asked for out of the world (under its lock) and
+  /// fills frame.
+  void snapshot(const Camera& camera, unsigned passes, const PoseRequest& poses, Snapshot& snapshot,
+                Frame& frame);
+  /// Frees what objects that left the world used (needs a Context::Scope).
+  void release_unused();
+  void release_all();
 
   GpuMesh& mesh_for(const std::shared_ptr<const MeshData>& mesh);
   /// The soft body's GPU mesh, its vertices refreshed from the snapshot (normals recomputed).
@@ -131,12 +149,16 @@ class SceneRenderer {
   void overlay(const Snapshot& snapshot, GLenum attachment, ShaderOf shader_of);
 
   World& world_;
-  std::map<const MeshData*, GpuMesh> meshes_;
-  std::map<int, GpuMesh> soft_meshes_;   // by soft body id; vertices change every frame
-  std::vector<float> soft_scratch_;      // positions then normals of one soft body
-  std::map<int, RenderTarget> targets_;  // by camera id
-  mutable std::mutex volumes_mutex_;     // volumes_ grows during takes, which may overlap draws
-  std::map<const VolumeData*, std::unique_ptr<GpuVolume>> volumes_;
+  std::map<const MeshData*, GpuMesh> meshes_;  // each keeps its source alive: no address reuse
+  std::map<int, GpuMesh> soft_meshes_;         // by soft body id; vertices change every frame
+  std::vector<float> soft_scratch_;            // positions then normals of one soft body
+  std::map<int, RenderTarget> targets_;        // by camera id
+  mutable std::mutex volumes_mutex_;  // volumes_ grows during takes, which may overlap draws
+  std::map<int, std::unique_ptr<GpuVolume>> volumes_;  // by volume id
+  // Ids of objects that left the world, and whether a mesh may have lost its last body;
+  // released at the next render (guarded by volumes_mutex_).
+  std::vector<int> released_ids_;
+  bool meshes_to_check_ = false;
 };
 
 }  // namespace ambfplus::render

@@ -82,6 +82,21 @@ std::vector<std::uint8_t> pack_box(const void* grid, const std::array<int, 3>& s
   return out;
 }
 
+// Writes a packed box back into a grid stored i fastest with `shape` (1 byte per element).
+void unpack_box(const std::vector<std::uint8_t>& bytes, const std::array<int, 3>& shape,
+                const VoxelBox& box, std::uint8_t* grid) {
+  const std::size_t row = static_cast<std::size_t>(box.hi[0] - box.lo[0]);
+  const std::uint8_t* src = bytes.data();
+  for (int k = box.lo[2]; k < box.hi[2]; ++k) {
+    for (int j = box.lo[1]; j < box.hi[1]; ++j, src += row) {
+      std::memcpy(
+          grid + static_cast<std::size_t>(box.lo[0]) +
+              static_cast<std::size_t>(shape[0]) * (j + static_cast<std::size_t>(shape[1]) * k),
+          src, row);
+    }
+  }
+}
+
 // Sends a packed box to a 3D texture.
 void upload_box(GLuint texture, const VoxelBox& box, GLenum format, GLenum type,
                 const std::vector<std::uint8_t>& bytes) {
@@ -157,72 +172,91 @@ void GpuVolume::stage_colors(Pending& pending) {
   staged_table_ = table.labels();
 }
 
-void GpuVolume::stage_distances(const VoxelBox& changed, double level, bool full,
-                                Pending& pending) {
-  const std::vector<std::uint8_t>& max = data_->brick_max();
-  const auto b = data_->brick_shape();
-  constexpr int B = VolumeData::kBrickSize;
-  // Bricks whose sampling footprint the change can reach.
-  VoxelBox bricks;
-  for (int a = 0; a < 3; ++a) {
-    bricks.lo[a] = std::max(0, (changed.lo[a] - VolumeData::kSmoothRadius - 1) / B);
-    bricks.hi[a] = std::min(b[a], (changed.hi[a] + VolumeData::kSmoothRadius + 1) / B + 1);
-  }
-  auto at = [&](int i, int j, int k) {
-    return static_cast<std::size_t>(i) +
-           std::size_t(b[0]) * (std::size_t(j) + std::size_t(b[1]) * k);
-  };
-  if (!full) {
-    // Removing material only empties bricks, which leaves every other distance a safe lower
-    // bound: mark emptied bricks 1 and keep the rest. A brick that filled needs the full map.
-    for (int k = bricks.lo[2]; k < bricks.hi[2] && !full; ++k)
-      for (int j = bricks.lo[1]; j < bricks.hi[1] && !full; ++j)
-        for (int i = bricks.lo[0]; i < bricks.hi[0]; ++i) {
-          const std::size_t n = at(i, j, k);
-          const bool occupied = max[n] >= level;
-          if (occupied && distances_[n] != 0) {
-            full = true;
-            break;
-          }
-          if (!occupied && distances_[n] == 0) distances_[n] = 1;
-        }
-  }
-  if (full) {
-    distances_ = brick_distances(max, b, level);
-    bricks = VoxelBox{{0, 0, 0}, b};
-  }
-  pending.bricks = {bricks, pack_box(distances_.data(), b, bricks, 1)};
-  brick_level_ = level;
-}
-
 void GpuVolume::stage(double iso) {
   const auto start = std::chrono::steady_clock::now();
   Pending pending;
   stage_colors(pending);
-  VoxelBox box;
   const bool first = revision_ < 0;
-  const bool changed = first ? true : data_->dirty_since(revision_, &box);
-  if (first) box = VoxelBox{{0, 0, 0}, data_->shape()};
+  if (first) {
+    boxes_.assign(1, VoxelBox{{0, 0, 0}, data_->shape()});
+  } else if (!data_->dirty_boxes_since(revision_, &boxes_)) {
+    boxes_.clear();
+  }
   // Bricks that may hold the surface: those whose largest value can reach the level (one step
   // of 8-bit filtering below it, so rounding never hides a surface).
-  const double level = std::max(0.0, iso * 255.0 - 1.0);
+  pending.level = std::max(0.0, iso * 255.0 - 1.0);
   const auto& n = data_->shape();
-  if (changed && !box.empty()) {
-    const int bytes = data_->label_type() == LabelType::kUInt16 ? 2 : 1;
-    pending.labels = {box, pack_box(data_->label_data(), n, box, bytes)};
-    // The smoothed field changes kSmoothRadius voxels around every changed label.
+  const auto b = data_->brick_shape();
+  const int bytes = data_->label_type() == LabelType::kUInt16 ? 2 : 1;
+  // Copies only: the data keeps its smoothed occupancy and brick maxima up to date itself.
+  const std::vector<std::uint8_t>& smoothed = data_->smoothed_occupancy();
+  const std::vector<std::uint8_t>& brick_max = data_->brick_max();
+  constexpr int B = VolumeData::kBrickSize;
+  for (const VoxelBox& box : boxes_) {
+    if (box.empty()) continue;
+    pending.labels.push_back({box, pack_box(data_->label_data(), n, box, bytes)});
+    // The smoothed field changes kSmoothRadius voxels around every changed label, and the
+    // brick maxima of the bricks whose sampling footprint (a voxel beyond) meets that.
     const VoxelBox grown = box.grown(VolumeData::kSmoothRadius).clipped(n);
-    pending.occupancy = {grown, pack_box(data_->smoothed_occupancy().data(), n, grown, 1)};
-  }
-  if (level != brick_level_ || (changed && !box.empty())) {
-    stage_distances(box, level, first || level != brick_level_, pending);
+    pending.occupancy.push_back({grown, pack_box(smoothed.data(), n, grown, 1)});
+    VoxelBox bricks;
+    for (int a = 0; a < 3; ++a) {
+      bricks.lo[a] = std::max(0, (grown.lo[a] - 1) / B);
+      bricks.hi[a] = std::min(b[a], (grown.hi[a] + 1) / B + 1);
+    }
+    pending.brick_max.push_back({bricks, pack_box(brick_max.data(), b, bricks, 1)});
   }
   revision_ = data_->revision();
-  if (!changed && pending.colors.empty() && pending.bricks.box.empty()) return;
+  const bool level_changed = pending.level != staged_level_;
+  staged_level_ = pending.level;
+  if (boxes_.empty() && pending.colors.empty() && !level_changed) return;
   pending.full = first;
   pending.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::lock_guard<std::mutex> lock(mutex_);
   pending_.push_back(std::move(pending));
+}
+
+void GpuVolume::update_distances(const Pending& p, bool full) {
+  const auto b = data_->brick_shape();
+  if (brick_max_.empty()) {
+    brick_max_.assign(static_cast<std::size_t>(b[0]) * b[1] * b[2], 0);
+    full = true;
+  }
+  for (const Box& box : p.brick_max) unpack_box(box.bytes, b, box.box, brick_max_.data());
+  const double level = p.level;
+  full = full || level != distance_level_ || distances_.size() != brick_max_.size();
+  auto at = [&](int i, int j, int k) {
+    return static_cast<std::size_t>(i) +
+           std::size_t(b[0]) * (std::size_t(j) + std::size_t(b[1]) * k);
+  };
+  // Removing material only empties bricks, which leaves every other distance a safe lower
+  // bound: mark emptied bricks 1 and keep the rest. A brick that filled needs the full map.
+  for (std::size_t n = 0; n < p.brick_max.size() && !full; ++n) {
+    const VoxelBox& bricks = p.brick_max[n].box;
+    for (int k = bricks.lo[2]; k < bricks.hi[2] && !full; ++k)
+      for (int j = bricks.lo[1]; j < bricks.hi[1] && !full; ++j)
+        for (int i = bricks.lo[0]; i < bricks.hi[0]; ++i) {
+          const std::size_t v = at(i, j, k);
+          const bool occupied = brick_max_[v] >= level;
+          if (occupied && distances_[v] != 0) {
+            full = true;
+            break;
+          }
+          if (!occupied && distances_[v] == 0) distances_[v] = 1;
+        }
+  }
+  distance_level_ = level;
+  if (full) {
+    distances_ = brick_distances(brick_max_, b, level);
+    const VoxelBox all{{0, 0, 0}, b};
+    upload_box(bricks_, all, GL_RED_INTEGER, GL_UNSIGNED_BYTE,
+               pack_box(distances_.data(), b, all, 1));
+    return;
+  }
+  for (const Box& box : p.brick_max) {
+    upload_box(bricks_, box.box, GL_RED_INTEGER, GL_UNSIGNED_BYTE,
+               pack_box(distances_.data(), b, box.box, 1));
+  }
 }
 
 void GpuVolume::upload() {
@@ -233,7 +267,8 @@ void GpuVolume::upload() {
   }
   if (pending.empty()) return;
   const auto start = std::chrono::steady_clock::now();
-  if (vao_ == 0) create_textures();
+  const bool created = vao_ == 0;
+  if (created) create_textures();
   const bool wide = data_->label_type() == LabelType::kUInt16;
   VolumeUpload stats;
   for (const Pending& p : pending) {
@@ -243,12 +278,16 @@ void GpuVolume::upload() {
       glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, 256, p.color_rows, 0, GL_RGBA, GL_UNSIGNED_BYTE,
                    p.colors.data());
     }
-    upload_box(labels_, p.labels.box, GL_RED_INTEGER, wide ? GL_UNSIGNED_SHORT : GL_UNSIGNED_BYTE,
-               p.labels.bytes);
-    upload_box(occupancy_, p.occupancy.box, GL_RED, GL_UNSIGNED_BYTE, p.occupancy.bytes);
-    upload_box(bricks_, p.bricks.box, GL_RED_INTEGER, GL_UNSIGNED_BYTE, p.bricks.bytes);
+    for (const Box& box : p.labels) {
+      upload_box(labels_, box.box, GL_RED_INTEGER, wide ? GL_UNSIGNED_SHORT : GL_UNSIGNED_BYTE,
+                 box.bytes);
+      stats.voxels += box.box.count();
+    }
+    for (const Box& box : p.occupancy) {
+      upload_box(occupancy_, box.box, GL_RED, GL_UNSIGNED_BYTE, box.bytes);
+    }
+    update_distances(p, p.full || created);
     stats.full = stats.full || p.full;
-    stats.voxels += p.labels.box.count();
     stats.seconds += p.seconds;
   }
   check_gl("uploading a volume");
@@ -327,7 +366,8 @@ namespace ambfplus {
 
 VolumeUploadStats last_volume_upload(const Volume& volume) {
   VolumeUploadStats stats;
-  const auto upload = volume.world().renderer().last_upload(volume.data().get());
+  const auto upload =
+      static_cast<render::SceneRenderer&>(volume.world().renderer()).last_upload(volume);
   if (!upload) return stats;
   stats.rendered = true;
   stats.full = upload->full;

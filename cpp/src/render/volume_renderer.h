@@ -28,10 +28,11 @@ struct VolumeUpload {
 };
 
 /// The GPU copies of one VolumeData (smoothed occupancy, labels, brick distances, label colours),
-/// brought up to date with only the box edited since the last update. Updating has two halves:
-/// stage() copies what changed out of the data while the world's state lock is held (no GL),
-/// upload() sends everything staged so far (needs a current context), so a physics thread may
-/// edit the data while the GPU works. draw() too needs a current context.
+/// brought up to date with only the boxes edited since the last update. Updating has two halves:
+/// stage() only copies what changed out of the data while the world's state lock is held (the
+/// data keeps its derived fields current itself, so nothing is computed there), upload() does
+/// everything else (brick distances, GL calls; needs a current context), so a physics thread
+/// may edit the data while the GPU side works. draw() too needs a current context.
 class GpuVolume {
  public:
   explicit GpuVolume(std::shared_ptr<VolumeData> data);
@@ -47,6 +48,7 @@ class GpuVolume {
   /// depth-tested, for the snapshot's passes (shading only with rgb).
   void draw(const Snapshot::Volume& volume, const Snapshot& snapshot);
   VolumeUpload last_upload() const;
+  const std::shared_ptr<VolumeData>& data() const { return data_; }
 
  private:
   // A box of a grid, packed (i fastest), waiting for upload().
@@ -55,27 +57,36 @@ class GpuVolume {
     std::vector<std::uint8_t> bytes;
   };
   struct Pending {
-    Box labels, occupancy, bricks;
+    std::vector<Box> labels, occupancy;
+    std::vector<Box> brick_max;        // boxes of the brick grid
     std::vector<std::uint8_t> colors;  // RGBA rows of 256 label ids; empty: unchanged
     int color_rows = 0;
+    double level = 0.0;  // 0..255 of the smoothed occupancy that counts as surface
     bool full = false;
     double seconds = 0.0;  // staging time
   };
-  void stage_distances(const VoxelBox& changed, double level, bool full, Pending& pending);
   void stage_colors(Pending& pending);
+  /// Brings the brick distances up to date with the staged brick maxima and uploads what
+  /// changed of them.
+  void update_distances(const Pending& pending, bool full);
   void create_textures();
 
   std::shared_ptr<VolumeData> data_;
   GLuint occupancy_ = 0, labels_ = 0, bricks_ = 0, colors_ = 0, vao_ = 0, vbo_ = 0;
   // Staging state (touched under the world's state lock only).
   std::int64_t revision_ = -1;
-  double brick_level_ = -1;
-  std::vector<std::uint8_t> distances_;  // the brick distances last staged
   std::vector<Label> staged_table_;
+  double staged_level_ = -1;
+  std::vector<VoxelBox> boxes_;  // scratch
   // Handed from stage() to upload(), which may run on different threads.
   mutable std::mutex mutex_;
   std::vector<Pending> pending_;
   VolumeUpload last_upload_;
+  // Upload state (touched under the GL context's scope only): the brick maxima as last staged,
+  // the distances made of them and the level they were made for.
+  std::vector<std::uint8_t> brick_max_;
+  std::vector<std::uint8_t> distances_;
+  double distance_level_ = -1;
 };
 
 }  // namespace ambfplus::render

@@ -119,7 +119,8 @@ std::vector<Frame> Window::present(const std::vector<const Camera*>& cameras, in
   std::vector<Frame> frames(cameras.size());
   std::vector<const render::RenderTarget*> targets;
   for (std::size_t i = 0; i < cameras.size(); ++i) {
-    render::SceneRenderer& renderer = cameras[i]->world().renderer();
+    render::SceneRenderer& renderer =
+        static_cast<render::SceneRenderer&>(cameras[i]->world().renderer());
     if (!rendered) {
       targets.push_back(&renderer.render_to_target(*cameras[i], kPassRgb, frames[i]));
       continue;

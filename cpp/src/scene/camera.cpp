@@ -5,7 +5,6 @@
 #include <string>
 
 #include "ambfplus/scene/world.h"
-#include "render/scene_renderer.h"
 
 namespace ambfplus {
 
@@ -82,25 +81,12 @@ void Camera::set_fov_y(double fov_y) {
   fov_y_ = fov_y;
 }
 
-const char* pass_name(int index) {
-  static const char* const kNames[kPassCount] = {"rgb",      "depth", "label",
-                                                 "instance", "voxel", "segmentation"};
-  return index >= 0 && index < kPassCount ? kNames[index] : "?";
-}
-
 void Camera::set_passes(unsigned passes) {
   if (passes == 0 || (passes & ~kAllPasses) != 0) {
-    throw std::invalid_argument("camera '" + name() +
-                                "': passes must be a non-empty set of rgb, depth, label, "
-                                "instance, voxel, segmentation");
+    throw std::invalid_argument("camera '" + name() + "': passes must be a non-empty set of " +
+                                pass_names(kAllPasses));
   }
   passes_ = passes;
-}
-
-unsigned CaptureBuffers::passes() const {
-  return (rgb ? kPassRgb : 0u) | (depth ? kPassDepth : 0u) | (label ? kPassLabel : 0u) |
-         (instance ? kPassInstance : 0u) | (voxel ? kPassVoxel : 0u) |
-         (segmentation ? kPassSegmentation : 0u);
 }
 
 Eigen::Matrix4d Camera::projection() const {
@@ -118,43 +104,6 @@ Eigen::Matrix4d Camera::projection() const {
   p(2, 3) = n * f / (f - n);
   p(3, 2) = 1;
   return p;
-}
-
-Frame Camera::capture() {
-  Frame frame;
-  capture(frame);
-  return frame;
-}
-
-void Camera::capture(Frame& frame) {
-  auto check = [&](bool empty, int h, int w, int c, int want_c, const char* what) {
-    if (!empty && (h != height_ || w != width_ || c != want_c)) {
-      throw std::invalid_argument(
-          "camera '" + name() + "': the frame's " + what + " is " + std::to_string(h) + "x" +
-          std::to_string(w) + "x" + std::to_string(c) + ", the camera makes " +
-          std::to_string(height_) + "x" + std::to_string(width_) + "x" + std::to_string(want_c));
-    }
-  };
-  // A new frame gets the camera's passes; a used one keeps its own.
-  const bool fresh = frame.rgb.empty() && frame.depth.empty() && frame.label.empty() &&
-                     frame.instance.empty() && frame.voxel.empty() && frame.segmentation.empty();
-  auto prepare = [&](auto& buffer, unsigned pass, int channels, const char* what) {
-    check(buffer.empty(), buffer.height(), buffer.width(), buffer.channels(), channels, what);
-    if (fresh && (passes_ & pass)) buffer.allocate(height_, width_, channels);
-    return buffer.data();
-  };
-  CaptureBuffers buffers;
-  buffers.rgb = prepare(frame.rgb, kPassRgb, 3, "rgb");
-  buffers.depth = prepare(frame.depth, kPassDepth, 1, "depth");
-  buffers.label = prepare(frame.label, kPassLabel, 1, "label");
-  buffers.instance = prepare(frame.instance, kPassInstance, 1, "instance");
-  buffers.voxel = prepare(frame.voxel, kPassVoxel, 1, "voxel");
-  buffers.segmentation = prepare(frame.segmentation, kPassSegmentation, 3, "segmentation");
-  capture(buffers, frame);
-}
-
-void Camera::capture(const CaptureBuffers& buffers, Frame& frame) {
-  world().renderer().render(*this, buffers, frame);
 }
 
 }  // namespace ambfplus

@@ -7,7 +7,6 @@
 
 #include "ambfplus/scene/rigid_body.h"
 #include "ambfplus/scene/world.h"
-#include "physics/physics_world.h"  // (the Bullet side it may own on the way out)
 
 namespace ambfplus {
 
@@ -53,5 +52,7 @@ void ConstraintActuator::actuate(RigidBody& body) {
 }
 
 void ConstraintActuator::update() { Object::set_pose(parent().pose() * location()); }
+
+ConstraintActuator::~ConstraintActuator() = default;
 
 }  // namespace ambfplus

@@ -5,7 +5,6 @@
 
 #include "ambfplus/scene/rigid_body.h"
 #include "ambfplus/scene/world.h"
-#include "physics/physics_world.h"  // (the constraint it may own on the way out)
 #include "util/strings.h"
 
 namespace ambfplus {
@@ -118,5 +117,7 @@ void Joint::set_damping(double damping) {
   if (!(damping >= 0)) throw std::invalid_argument("joint damping must be >= 0");
   spec_.damping = damping;
 }
+
+Joint::~Joint() = default;
 
 }  // namespace ambfplus

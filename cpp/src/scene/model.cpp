@@ -1,7 +1,6 @@
 #include "ambfplus/scene/model.h"
 
 #include "ambfplus/scene/world.h"
-#include "physics/physics_world.h"
 
 #include <stdexcept>
 #include <string>
@@ -12,29 +11,31 @@ Model::Model(World& world, std::string name) : world_(&world), name_(std::move(n
 
 Model::~Model() = default;
 
+// The world's systems hear of the object (physics builds its Bullet side and may refuse it);
+// only an object they all took is kept.
 template <typename T>
 T& Model::adopt(std::unique_ptr<T> object) {
   T& ref = *object;
   objects_.push_back(object.get());
-  world_->register_object(object.get());
+  try {
+    world_->register_object(object.get());
+  } catch (...) {
+    objects_.pop_back();
+    throw;
+  }
   owned_.push_back(std::move(object));
   return ref;
 }
 
 RigidBody& Model::add_body(const RigidBodySpec& spec) {
   const int id = world_->claim_name(spec.name, "body");
-  // The constructor loads or builds geometry and may throw, as may physics; nothing is
-  // registered before both succeed.
-  std::unique_ptr<RigidBody> body(new RigidBody(*this, spec, id));
-  world_->physics().add(*body);
-  return adopt(std::move(body));
+  // The constructor loads or builds geometry and may throw, as may physics when adopted.
+  return adopt(std::unique_ptr<RigidBody>(new RigidBody(*this, spec, id)));
 }
 
 Joint& Model::add_joint(const JointSpec& spec) {
   const int id = world_->claim_name(spec.name, "joint");
-  std::unique_ptr<Joint> joint(new Joint(*this, spec, id));
-  world_->physics().add(*joint);
-  return adopt(std::move(joint));
+  return adopt(std::unique_ptr<Joint>(new Joint(*this, spec, id)));
 }
 
 Camera& Model::add_camera(const CameraSpec& spec) {
@@ -74,17 +75,13 @@ InputDevice& Model::add_input_device(const InputDeviceSpec& spec) {
 
 SoftBody& Model::add_soft_body(const SoftBodySpec& spec) {
   const int id = world_->claim_name(spec.name, "soft body");
-  // The constructor reads the mesh and may throw; nothing is registered before physics succeeds.
-  std::unique_ptr<SoftBody> body(new SoftBody(*this, spec, id));
-  world_->physics().add(*body);
-  return adopt(std::move(body));
+  // The constructor reads the mesh and may throw, as may physics when adopted.
+  return adopt(std::unique_ptr<SoftBody>(new SoftBody(*this, spec, id)));
 }
 
 ProximitySensor& Model::add_sensor(const ProximitySensorSpec& spec) {
   const int id = world_->claim_name(spec.name, "sensor");
-  std::unique_ptr<ProximitySensor> sensor(new ProximitySensor(*this, spec, id));
-  sensor->update();
-  return adopt(std::move(sensor));
+  return adopt(std::unique_ptr<ProximitySensor>(new ProximitySensor(*this, spec, id)));
 }
 
 ConstraintActuator& Model::add_actuator(const ConstraintActuatorSpec& spec) {

@@ -6,6 +6,7 @@
 
 #include "ambfplus/scene/model.h"
 #include "ambfplus/scene/world.h"
+#include "scene/scene_systems.h"
 
 namespace ambfplus {
 
@@ -46,7 +47,7 @@ void Object::attach_to(const Object* parent, const Eigen::Isometry3d& local) {
   for (const Object* p = parent; p != nullptr; p = p->attached_to_) {
     if (p == this) throw std::invalid_argument("'" + name_ + "' cannot ride on itself");
   }
-  world().track_attached(this, parent != nullptr);
+  world().attachments().track(this, parent != nullptr);
   attached_to_ = parent;
   local_ = local;
   follow_parent();

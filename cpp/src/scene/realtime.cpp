@@ -110,6 +110,7 @@ void RealTimeLoop::start() {
     periods_.clear();
     step_cpu_.clear();
     step_wall_.clear();
+    lock_wait_.clear();
     steps_ = 0;
     error_.clear();
     scheduling_.clear();
@@ -166,7 +167,11 @@ void RealTimeLoop::run_steps() {
     }
     const double start = now();
     const double cpu = thread_cpu();
+    double waited = 0.0;
     try {
+      // The step takes the lock again (it is recursive): this measures the wait alone.
+      auto state = world_.lock_state();
+      waited = now() - start;
       world_.step(1);
     } catch (const std::exception& e) {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -184,6 +189,7 @@ void RealTimeLoop::run_steps() {
       ++steps_;
       step_cpu_.push_back(used);
       step_wall_.push_back(wall);
+      lock_wait_.push_back(waited);
     }
     previous = start;
     // Far behind (a stall): start afresh from now rather than racing to catch up.
@@ -233,6 +239,8 @@ RealTimeStats RealTimeLoop::stats() const {
     if (!step_cpu_.empty()) {
       s.step_cpu_max = *std::max_element(step_cpu_.begin(), step_cpu_.end());
       s.step_wall_max = *std::max_element(step_wall_.begin(), step_wall_.end());
+      s.lock_wait_max = *std::max_element(lock_wait_.begin(), lock_wait_.end());
+      s.lock_wait_p99 = percentile(lock_wait_, 0.99);
     }
     // Period i ends at step i + 1: the step before it ran late, or the wait for it did.
     for (std::size_t i = 0; i < periods_.size(); ++i) {

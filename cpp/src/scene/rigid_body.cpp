@@ -3,7 +3,6 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "physics/physics_world.h"  // (the Bullet body it may own on the way out)
 #include "scene/primitive_meshes.h"
 #include "util/strings.h"
 
@@ -148,5 +147,7 @@ RigidBody::RigidBody(Model& model, const RigidBodySpec& spec, int id)
                      ? load_mesh_shared(shape_.mesh, shape_.scale)
                      : std::make_shared<const MeshData>(make_primitive_mesh(shape_));
 }
+
+RigidBody::~RigidBody() = default;
 
 }  // namespace ambfplus

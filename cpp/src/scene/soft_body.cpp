@@ -9,7 +9,6 @@
 
 #include "ambfplus/errors.h"
 #include "ambfplus/io/mesh.h"
-#include "physics/physics_world.h"  // (the Bullet side it may own on the way out)
 
 namespace ambfplus {
 namespace {
@@ -243,5 +242,7 @@ void SoftBody::check_node(int node) const {
                             std::to_string(node));
   }
 }
+
+SoftBody::~SoftBody() = default;
 
 }  // namespace ambfplus

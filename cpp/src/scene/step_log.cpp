@@ -77,8 +77,23 @@ StepLog StepLog::take() {
   out.steps_.swap(steps_);
   out.times_.swap(times_);
   out.columns_.swap(columns_);
+  out.dropped_ = dropped_;
   for (const Column& c : out.columns_) columns_.push_back({c.name, c.width, {}});
   return out;
+}
+
+std::size_t StepLog::values() const {
+  std::size_t n = 0;
+  for (const Column& c : columns_) n += c.values.size();
+  return n;
+}
+
+void StepLog::drop_oldest(std::int64_t n) {
+  n = std::clamp<std::int64_t>(n, 0, rows());
+  steps_.erase(steps_.begin(), steps_.begin() + n);
+  times_.erase(times_.begin(), times_.begin() + n);
+  for (Column& c : columns_) c.values.erase(c.values.begin(), c.values.begin() + n * c.width);
+  dropped_ += n;
 }
 
 bool StepLog::logs(const Object& object) const {

@@ -1,34 +1,88 @@
 #include "ambfplus/scene/world.h"
 
 #include <algorithm>
-
-#include "ambfplus/plugin/registry.h"
-#include "physics/physics_world.h"
-
 #include <cmath>
 #include <stdexcept>
 
-#include "render/scene_renderer.h"
+#include "ambfplus/haptics/systems.h"
+#include "ambfplus/physics/physics.h"
+#include "ambfplus/plugin/registry.h"
+#include "ambfplus/render/renderer.h"
+#include "scene/scene_systems.h"
 
 namespace ambfplus {
 
-World::World(Simulator& simulator, std::string name, double time_step)
-    : simulator_(&simulator),
-      name_(std::move(name)),
-      time_step_(time_step),
-      physics_(std::make_unique<physics::PhysicsWorld>()),
-      plugins_(std::make_unique<PluginRegistry>(*this)) {
-  models_.push_back(std::unique_ptr<Model>(new Model(*this, name_)));
+const char* step_stage_name(StepStage stage) {
+  switch (stage) {
+    case StepStage::kDeviceInput:
+      return "device input";
+    case StepStage::kPhysics:
+      return "physics";
+    case StepStage::kHaptics:
+      return "haptics";
+    case StepStage::kDeviceOutput:
+      return "device output";
+    case StepStage::kAttachments:
+      return "attachments";
+    case StepStage::kActuators:
+      return "actuators";
+    case StepStage::kSensors:
+      return "sensors";
+    case StepStage::kPlugins:
+      return "plugins";
+    case StepStage::kLogging:
+      return "logging";
+  }
+  return "?";
 }
 
-// The renderer releases its GL objects before the objects it drew go away, and Bullet lets go
-// of bodies and joints before they are deleted. Plugins close first, while all is intact.
+ObjectState::~ObjectState() = default;
+System::~System() = default;
+
+World::World(Simulator& simulator, std::string name, double time_step)
+    : simulator_(&simulator), name_(std::move(name)), time_step_(time_step) {
+  models_.push_back(std::unique_ptr<Model>(new Model(*this, name_)));
+  // The order objects are announced in: physics first (it may refuse one), plugins last (they
+  // hear of an object once everything else has taken it).
+  auto physics = physics::make_physics(*this);
+  physics_ = physics.get();
+  add_system(std::move(physics));
+  add_system(haptics::make_device_system());
+  add_system(haptics::make_drill_system());
+  auto attachments = std::make_unique<scene::Attachments>();
+  attachments_ = attachments.get();
+  add_system(std::move(attachments));
+  auto renderer = render::make_renderer(*this);
+  renderer_ = renderer.get();
+  add_system(std::move(renderer));
+  auto logger = std::make_unique<scene::StepLogger>();
+  step_logger_ = logger.get();
+  add_system(std::move(logger));
+  auto plugins = std::make_unique<PluginRegistry>(*this);
+  plugins_ = plugins.get();
+  add_system(std::move(plugins));
+}
+
+// Plugins close first, while all is intact; then every system lets go of the objects (the
+// renderer its GL objects, Bullet its bodies and joints) before they are deleted.
 World::~World() {
   plugins_->close_all();
-  plugins_.reset();
-  renderer_.reset();
-  physics_->detach_all();
+  for (auto it = systems_.rbegin(); it != systems_.rend(); ++it) (*it)->detach_all();
   models_.clear();
+}
+
+void World::add_system(std::unique_ptr<System> system) {
+  if (!system) throw std::invalid_argument("world '" + name_ + "': add_system needs a system");
+  for (int s = 0; s < kStepStageCount; ++s) {
+    if (system->stages() & (1u << s)) schedule_[s].push_back(system.get());
+  }
+  systems_.push_back(std::move(system));
+}
+
+std::vector<System*> World::systems() const {
+  std::vector<System*> out;
+  for (const auto& s : systems_) out.push_back(s.get());
+  return out;
 }
 
 void World::set_gravity(const Eigen::Vector3d& g) { physics_->set_gravity(g); }
@@ -108,23 +162,17 @@ void World::remove_model(Model& model) {
                                [&](const auto& m) { return m.get() == &model; });
   if (it == models_.end()) throw std::invalid_argument("the model is not in this world");
   plugins_->close_model(model);
-  for (Object* object : model.objects()) {
-    plugins_->object_removed(*object);
-    if (step_log_ && step_log_->logs(*object)) step_log_.reset();
-  }
-  ++objects_revision_;
-  // Newest first: joints go before the bodies they hold.
+  // Newest first (joints go before the bodies they hold), each heard of by the systems in the
+  // reverse of the order they took it in, while it is whole.
   for (auto o = model.owned_.rbegin(); o != model.owned_.rend(); ++o) {
     Object* object = o->get();
-    if (auto* joint = dynamic_cast<Joint*>(object)) physics_->remove(*joint);
-    if (auto* body = dynamic_cast<RigidBody*>(object)) physics_->remove(*body);
+    for (auto sys = systems_.rbegin(); sys != systems_.rend(); ++sys) {
+      (*sys)->object_removed(*object);
+    }
     by_name_.erase(object->name());
     objects_.erase(std::find(objects_.begin(), objects_.end(), object));
-    track_attached(object, false);
   }
   while (!model.owned_.empty()) model.owned_.pop_back();
-  // Its GPU copies are keyed by addresses that may be reused.
-  renderer_.reset();
   models_.erase(it);
 }
 
@@ -138,70 +186,39 @@ int World::claim_name(const std::string& name, const char* what) {
   return next_id_;
 }
 
-void World::track_attached(Object* object, bool attached) {
-  const auto it = std::find(attached_.begin(), attached_.end(), object);
-  if (attached && it == attached_.end()) {
-    // Creation order (ids grow with it), so a child of a child follows after its parent.
-    attached_.insert(
-        std::upper_bound(attached_.begin(), attached_.end(), object,
-                         [](const Object* a, const Object* b) { return a->id() < b->id(); }),
-        object);
-  } else if (!attached && it != attached_.end()) {
-    attached_.erase(it);
-  }
-}
-
 void World::register_object(Object* object) {
   by_name_[object->name()] = object;
   objects_.push_back(object);
   next_id_ = object->id() + 1;
-  ++objects_revision_;
-  plugins_->object_added(*object);
+  std::size_t told = 0;
+  try {
+    for (; told < systems_.size(); ++told) systems_[told]->object_added(*object);
+  } catch (...) {
+    while (told-- > 0) systems_[told]->object_removed(*object);
+    by_name_.erase(object->name());
+    objects_.pop_back();
+    throw;
+  }
 }
 
 void World::step(std::int64_t n) {
   if (n < 0) throw std::invalid_argument("step count must be >= 0, got " + std::to_string(n));
-  auto lock = lock_state();  // the lists below, then one step at a time
-  std::vector<InputDevice*> devices = objects_of_kind<InputDevice>();
-  std::vector<Drill*> drills = objects_of_kind<Drill>();
-  std::vector<ProximitySensor*> sensors = objects_of_kind<ProximitySensor>();
-  std::vector<ConstraintActuator*> actuators = objects_of_kind<ConstraintActuator>();
-  std::uint64_t listed = objects_revision_;
-  lock.unlock();
   for (std::int64_t s = 0; s < n; ++s) {
-    lock.lock();
-    const bool realtime = realtime_;
-    // Polled devices sample before anything changes, so a sampler that throws leaves the world
-    // as it was.
-    if (!realtime) {
-      for (InputDevice* d : devices) {
-        Device& device = *d->device();
-        if (device.polled() && step_index_ % device.poll_every() == 0) {
-          device.poll(static_cast<double>(step_index_ + 1) * time_step_);
-        }
+    auto lock = lock_state();
+    StepContext context;
+    context.dt = time_step_;
+    context.step = step_index_ + 1;
+    context.time = static_cast<double>(context.step) * time_step_;
+    context.realtime = realtime_;
+    for (const auto& system : systems_) system->prepare(context);
+    ++step_index_;
+    for (int stage = 0; stage < kStepStageCount; ++stage) {
+      // By index: a plugin may add systems' objects (not systems) during its stage.
+      const std::vector<System*>& systems = schedule_[stage];
+      for (std::size_t i = 0; i < systems.size(); ++i) {
+        systems[i]->run(static_cast<StepStage>(stage), context);
       }
     }
-    ++step_index_;
-    // Devices first: their readings move the drills this step.
-    for (InputDevice* d : devices) d->pre_step(step_index_, time());
-    physics_->step(time_step_);
-    for (Drill* d : drills) d->tick(time_step_, step_index_);
-    for (InputDevice* d : devices) d->post_step(time_step_);
-    for (Object* o : attached_) o->follow_parent();
-    // Sensors see where everything ended up.
-    for (ConstraintActuator* a : actuators) a->update();
-    for (ProximitySensor* p : sensors) p->update();
-    plugins_->physics_update(time_step_, /*native_only=*/realtime);
-    if (step_log_) step_log_->record(step_index_, time());
-    // Plugins may add or remove objects.
-    if (objects_revision_ != listed) {
-      devices = objects_of_kind<InputDevice>();
-      drills = objects_of_kind<Drill>();
-      sensors = objects_of_kind<ProximitySensor>();
-      actuators = objects_of_kind<ConstraintActuator>();
-      listed = objects_revision_;
-    }
-    lock.unlock();
   }
 }
 
@@ -212,28 +229,24 @@ void World::start_step_log(const std::vector<const Object*>& objects) {
     }
   }
   auto lock = lock_state();
-  step_log_ = std::make_unique<StepLog>(objects);
+  step_logger_->start(objects);
 }
 
 void World::stop_step_log() {
   auto lock = lock_state();
-  step_log_.reset();
+  step_logger_->stop();
 }
 
 StepLog World::take_step_log() {
   auto lock = lock_state();
-  return step_log_ ? step_log_->take() : StepLog(std::vector<const Object*>{});
+  return step_logger_->take();
 }
+
+bool World::logging_steps() const { return step_logger_->logging(); }
 
 PluginRegistry& World::plugins() { return *plugins_; }
 
 void World::reset_plugins() { plugins_->reset(); }
-
-render::SceneRenderer& World::renderer() {
-  auto lock = lock_state();
-  if (!renderer_) renderer_ = std::make_unique<render::SceneRenderer>(*this);
-  return *renderer_;
-}
 
 void World::graphics_update() {
   auto lock = lock_state();

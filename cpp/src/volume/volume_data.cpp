@@ -143,7 +143,20 @@ void VolumeData::record(VolumeEdit edit) {
     dirty_floor_ = dirty_.front().first;
     dirty_.pop_front();
   }
+  // The edit's thread pays for what it changed; readers then only copy.
+  if (derived_ready_) update_derived_box(edit.box);
+  log_edit(std::move(edit));
+}
+
+void VolumeData::log_edit(VolumeEdit edit) {
+  edit_log_voxels_ += edit.voxels.size();
   edit_log_.push_back(std::move(edit));
+  while (edit_log_.size() > kEditLogEdits ||
+         (edit_log_voxels_ > kEditLogVoxels && edit_log_.size() > 1)) {
+    edit_log_voxels_ -= edit_log_.front().voxels.size();
+    edit_log_.pop_front();
+    ++edit_log_dropped_;
+  }
 }
 
 std::int64_t VolumeData::remove_sphere(const Eigen::Vector3d& center, double radius,
@@ -294,9 +307,41 @@ bool VolumeData::dirty_since(std::int64_t since, VoxelBox* box) const {
   return true;
 }
 
+bool VolumeData::dirty_boxes_since(std::int64_t since, std::vector<VoxelBox>* boxes,
+                                   std::size_t max_boxes) const {
+  boxes->clear();
+  if (since >= revision_) return false;
+  if (since < dirty_floor_) {
+    boxes->push_back(VoxelBox{{0, 0, 0}, shape_});
+    return true;
+  }
+  auto first = dirty_.end();
+  while (first != dirty_.begin() && std::prev(first)->first > since) --first;
+  for (auto it = first; it != dirty_.end(); ++it) {
+    const VoxelBox& box = it->second;
+    if (box.empty()) continue;
+    // Consecutive edits of a tool overlap: one box for them costs few extra voxels.
+    if (!boxes->empty()) {
+      const VoxelBox merged = boxes->back().united(box);
+      if (merged.count() <= 2 * (boxes->back().count() + box.count())) {
+        boxes->back() = merged;
+        continue;
+      }
+    }
+    boxes->push_back(box);
+  }
+  if (boxes->size() > std::max<std::size_t>(max_boxes, 1)) {
+    VoxelBox all;
+    for (const VoxelBox& b : *boxes) all = all.united(b);
+    boxes->assign(1, all);
+  }
+  return true;
+}
+
 std::deque<VolumeEdit> VolumeData::take_edit_log() {
   std::deque<VolumeEdit> out;
   out.swap(edit_log_);
+  edit_log_voxels_ = 0;
   return out;
 }
 
@@ -319,22 +364,19 @@ const std::vector<std::uint8_t>& VolumeData::brick_max() {
 }
 
 void VolumeData::update_derived() {
-  if (derived_revision_ == revision_) return;
-  VoxelBox box;
-  if (derived_revision_ < 0) {
-    smoothed_.assign(static_cast<std::size_t>(voxel_count()), 0);
-    const auto b = brick_shape();
-    bricks_.assign(static_cast<std::size_t>(b[0]) * b[1] * b[2], 0);
-    box = VoxelBox{{0, 0, 0}, shape_};
-  } else if (!dirty_since(derived_revision_, &box)) {
-    derived_revision_ = revision_;
-    return;
-  }
+  if (derived_ready_) return;
+  smoothed_.assign(static_cast<std::size_t>(voxel_count()), 0);
+  const auto b = brick_shape();
+  bricks_.assign(static_cast<std::size_t>(b[0]) * b[1] * b[2], 0);
+  derived_ready_ = true;
+  update_derived_box(VoxelBox{{0, 0, 0}, shape_});
+}
+
+void VolumeData::update_derived_box(const VoxelBox& box) {
   // A label change reaches the blurred field kSmoothRadius voxels around it.
   const VoxelBox affected = box.grown(kSmoothRadius).clipped(shape_);
   smooth_box(affected);
   update_bricks(affected);
-  derived_revision_ = revision_;
 }
 
 void VolumeData::smooth_box(const VoxelBox& r) {

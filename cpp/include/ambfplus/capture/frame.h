@@ -2,33 +2,15 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include <Eigen/Geometry>
 
 #include "ambfplus/capture/image_buffer.h"
+#include "ambfplus/capture/passes.h"
 #include "ambfplus/export.h"
 
 namespace ambfplus {
-
-/// The images a capture can render; a camera renders the ones asked for and only those.
-enum CapturePass : unsigned {
-  kPassRgb = 1u << 0,       ///< lit colour
-  kPassDepth = 1u << 1,     ///< metric z
-  kPassLabel = 1u << 2,     ///< volume label ids
-  kPassInstance = 1u << 3,  ///< object ids
-  kPassVoxel = 1u << 4,     ///< volume voxel indices
-  /// Flat colours as AMBF's preprocessing shaders draw them: the camera's preprocessing shader
-  /// where one is set, else the engine's equivalent (material ambient x light ambient for
-  /// meshes, label colours for volumes).
-  kPassSegmentation = 1u << 5,
-};
-
-/// Number of capture passes; pass i is the bit 1 << i.
-constexpr int kPassCount = 6;
-/// Every pass.
-constexpr unsigned kAllPasses = (1u << kPassCount) - 1;
-/// A pass's name as users write it: "rgb", "depth", "label", "instance", "voxel", "segmentation".
-AMBFPLUS_API const char* pass_name(int index);
 
 /// One camera capture: images plus the geometry and time they were taken at.
 ///
@@ -52,6 +34,9 @@ class AMBFPLUS_API Frame {
   /// pixel shows, -1 where no volume was hit.
   ImageBuffer<std::int32_t> voxel;
   ImageBuffer<std::uint8_t> segmentation;  ///< height x width x 3, RGB
+  /// height x width x 3: camera-frame points (x right, y down, z forward) of the pixel centres
+  /// at their depth, (0, 0, 0) where nothing was hit.
+  ImageBuffer<float> points;
 
   int width = 0;
   int height = 0;
@@ -60,6 +45,16 @@ class AMBFPLUS_API Frame {
   std::string camera;     ///< name of the camera that took it
   Eigen::Matrix3d intrinsics = Eigen::Matrix3d::Identity();
   Eigen::Matrix4d pose = Eigen::Matrix4d::Identity();  ///< world from camera (OpenCV frame)
+  /// The objects' poses asked for (PoseRequest), world from object, of the same step as the
+  /// images; every capture replaces them (none when none were asked for).
+  struct ObjectPose {
+    std::string name;
+    int id = 0;
+    Eigen::Matrix4d pose = Eigen::Matrix4d::Identity();
+  };
+  std::vector<ObjectPose> poses;
+  /// Whether this capture was asked for poses.
+  bool has_poses = false;
 };
 
 }  // namespace ambfplus

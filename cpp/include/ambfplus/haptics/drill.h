@@ -119,6 +119,9 @@ class AMBFPLUS_API Drill : public Object {
 
   /// One haptic step: cursors, force, removal. Called by World::step.
   void tick(double dt, std::int64_t step);
+  /// The world's rigid bodies changed (one was added or is about to be removed): the cursors'
+  /// mesh collider is rebuilt at the next tick (the drills system calls it).
+  void bodies_changed() { meshes_stale_ = true; }
 
   // --- State after the last tick (world frame)
   /// The force fed back to the device: the leading cursor's, N.
@@ -183,7 +186,7 @@ class AMBFPLUS_API Drill : public Object {
   std::vector<std::pair<RigidBody*, Eigen::Isometry3d>> attached_;
   MeshCollider meshes_;
   std::vector<RigidBody*> mesh_bodies_;  // part i of meshes_ is mesh_bodies_[i]
-  std::size_t objects_seen_ = 0;         // world objects when meshes_ was built
+  bool meshes_stale_ = true;             // meshes_ must be rebuilt from the world's bodies
   std::vector<DrillWaypoint> waypoints_;
   double waypoint_clock_ = 0.0;
   bool meshes_follow_goal_ = false;

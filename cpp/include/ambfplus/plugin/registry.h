@@ -11,6 +11,7 @@
 
 #include "ambfplus/export.h"
 #include "ambfplus/plugin/plugin.h"
+#include "ambfplus/scene/system.h"
 
 namespace ambfplus {
 
@@ -47,11 +48,14 @@ AMBFPLUS_API std::map<std::string, std::string> plugin_aliases();
 
 /// The plugins of one world, in call order: simulator, world, model, then object scope, and
 /// within a scope in the order they were attached. Every hook call goes through it, so a hook
-/// that throws disables its plugin (logged once) without stopping the others.
-class AMBFPLUS_API PluginRegistry {
+/// that throws disables its plugin (logged once) without stopping the others. It is the world's
+/// last system: plugins hear of objects once every other system took them, and get their
+/// physics update in the stage kPlugins (C++ plugins only under a real-time loop, whose slow
+/// thread serves the others).
+class AMBFPLUS_API PluginRegistry : public System {
  public:
   explicit PluginRegistry(World& world);
-  ~PluginRegistry();
+  ~PluginRegistry() override;
   PluginRegistry(const PluginRegistry&) = delete;
   PluginRegistry& operator=(const PluginRegistry&) = delete;
 
@@ -83,8 +87,15 @@ class AMBFPLUS_API PluginRegistry {
   void mouse_move(double x, double y);
   void mouse_scroll(double dx, double dy);
   void reset();
-  void object_added(Object& object);
-  void object_removed(Object& object);
+  void object_added(Object& object) override;
+  void object_removed(Object& object) override;
+
+  // System
+  const char* name() const override { return "plugins"; }
+  unsigned stages() const override { return stage_bit(StepStage::kPlugins); }
+  void run(StepStage stage, const StepContext& context) override {
+    physics_update(context.dt, /*native_only=*/context.realtime);
+  }
   /// Calls close() on every plugin in the reverse of call order, then destroys them.
   void close_all();
   /// Closes (reverse order) and destroys the plugins of a model and of its objects.

@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 
+#include "ambfplus/capture/capture.h"
 #include "ambfplus/capture/frame.h"
 #include "ambfplus/render/shader.h"
 #include "ambfplus/scene/object.h"
@@ -36,18 +37,6 @@ struct AMBFPLUS_API CameraSpec {
   CameraPublish publish;
 };
 
-/// Where a capture writes its images; null pointers are not captured.
-struct CaptureBuffers {
-  std::uint8_t* rgb = nullptr;           ///< height x width x 3, tightly packed
-  float* depth = nullptr;                ///< height x width, tightly packed
-  std::uint16_t* label = nullptr;        ///< height x width, tightly packed
-  std::int32_t* instance = nullptr;      ///< height x width, tightly packed
-  std::int32_t* voxel = nullptr;         ///< height x width, tightly packed
-  std::uint8_t* segmentation = nullptr;  ///< height x width x 3, tightly packed
-  /// The CapturePass bits of the non-null buffers.
-  unsigned passes() const;
-};
-
 /// A pinhole camera in the OpenCV frame (x right, y down, z forward). pose() is world from camera.
 class AMBFPLUS_API Camera : public Object {
  public:
@@ -74,7 +63,7 @@ class AMBFPLUS_API Camera : public Object {
   void set_fov_y(double fov_y);
   Eigen::Vector2d principal_point() const { return {cx_, cy_}; }
 
-  /// The passes a capture into a new frame renders (CapturePass bits; default rgb, depth, label).
+  /// The passes a capture into a new frame makes (CapturePass bits; default kDefaultPasses).
   unsigned passes() const { return passes_; }
   void set_passes(unsigned passes);
   /// AMBF's `preprocessing shaders`: what the segmentation pass draws meshes with (volumes keep
@@ -87,14 +76,18 @@ class AMBFPLUS_API Camera : public Object {
   /// OpenGL clip from camera (OpenCV frame), mapping image row 0 to the first row read back.
   Eigen::Matrix4d projection() const;
 
-  /// Renders and returns a new frame that owns its images.
-  Frame capture();
+  /// Renders and returns a new frame that owns its images (the camera's passes).
+  Frame capture(const PoseRequest& poses = {});
   /// Renders into an existing frame: its buffers are reused (filled in place) and must match
   /// this camera's size. A frame without buffers gets the camera's passes; one with buffers is
   /// refilled with exactly those. Throws std::invalid_argument on a mismatch.
-  void capture(Frame& frame);
-  /// Renders into caller-owned memory and fills frame's metadata (its buffers are left alone).
-  void capture(const CaptureBuffers& buffers, Frame& frame);
+  void capture(Frame& frame, const PoseRequest& poses = {});
+  /// Renders into caller-owned memory and fills frame's metadata and poses (its buffers are
+  /// left alone).
+  void capture(const CaptureBuffers& buffers, Frame& frame, const PoseRequest& poses = {});
+  /// Allocates in an empty frame the buffers of these passes (CapturePass bits) at this
+  /// camera's size.
+  void allocate(Frame& frame, unsigned passes) const;
 
  private:
   friend class Model;
@@ -106,7 +99,7 @@ class AMBFPLUS_API Camera : public Object {
   double near_;
   double far_;
   double cx_, cy_;
-  unsigned passes_ = kPassRgb | kPassDepth | kPassLabel;
+  unsigned passes_ = kDefaultPasses;
   std::array<float, 3> background_;
   CameraPublish publish_;
   std::optional<ShaderSpec> preprocessing_shader_;

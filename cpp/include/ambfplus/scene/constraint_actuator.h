@@ -12,7 +12,6 @@ namespace ambfplus {
 
 class RigidBody;
 namespace physics {
-struct Constraint;
 class PhysicsWorld;
 }  // namespace physics
 
@@ -65,9 +64,6 @@ class AMBFPLUS_API ConstraintActuator : public Object {
   /// Follows the parent (the world does this after each physics step).
   void update();
 
-  /// Physics internals (for the engine).
-  physics::Constraint* constraint() const { return constraint_.get(); }
-
  private:
   friend class Model;
   friend class physics::PhysicsWorld;
@@ -75,7 +71,6 @@ class AMBFPLUS_API ConstraintActuator : public Object {
 
   ConstraintActuatorSpec spec_;
   RigidBody* body_ = nullptr;
-  std::unique_ptr<physics::Constraint> constraint_;
 };
 
 }  // namespace ambfplus

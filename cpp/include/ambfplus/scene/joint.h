@@ -13,7 +13,6 @@ namespace ambfplus {
 
 class RigidBody;
 namespace physics {
-struct Constraint;
 class PhysicsWorld;
 }  // namespace physics
 
@@ -112,9 +111,6 @@ class AMBFPLUS_API Joint : public Object {
   void set_limits(std::optional<double> lower, std::optional<double> upper);
   void set_damping(double damping);
 
-  /// Physics internals (for the engine).
-  physics::Constraint* constraint() const { return constraint_.get(); }
-
  private:
   friend class Model;
   friend class physics::PhysicsWorld;
@@ -125,7 +121,6 @@ class AMBFPLUS_API Joint : public Object {
   double target_ = 0.0;
   double integral_ = 0.0;
   double effort_ = 0.0;
-  std::unique_ptr<physics::Constraint> constraint_;
 };
 
 }  // namespace ambfplus

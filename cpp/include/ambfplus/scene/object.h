@@ -1,10 +1,12 @@
 #pragma once
 
+#include <memory>
 #include <string>
 
 #include <Eigen/Geometry>
 
 #include "ambfplus/export.h"
+#include "ambfplus/scene/system.h"
 
 namespace ambfplus {
 
@@ -67,6 +69,11 @@ class AMBFPLUS_API Object {
   /// Moves an attached object to its parent's pose * local (the world calls it every step).
   void follow_parent();
 
+  /// The physics system's state of this object (a Bullet body, joint or soft body), opaque to
+  /// the scene; nullptr for objects physics does not simulate. For the engine.
+  ObjectState* physics_state() const { return physics_state_.get(); }
+  void set_physics_state(std::unique_ptr<ObjectState> state) { physics_state_ = std::move(state); }
+
  protected:
   Object(Model& model, std::string name, int id);
 
@@ -79,6 +86,7 @@ class AMBFPLUS_API Object {
   std::string identifier_;
   const Object* attached_to_ = nullptr;
   Eigen::Isometry3d local_ = Eigen::Isometry3d::Identity();
+  std::unique_ptr<ObjectState> physics_state_;
 };
 
 /// Throws std::invalid_argument unless m is a rigid transform (orthonormal rotation with det +1,

@@ -39,6 +39,9 @@ struct AMBFPLUS_API RealTimeStats {
   double step_p99 = 0.0;        ///< s of thread CPU time per step, 99th percentile
   double step_cpu_max = 0.0;    ///< s of thread CPU time of the costliest step
   double step_wall_max = 0.0;   ///< s of wall time of the longest step (lock waits included)
+  /// s the loop's thread waited for the world's state lock before a step: the longest, and the
+  /// 99th percentile (other threads hold it only to copy or change the scene).
+  double lock_wait_max = 0.0, lock_wait_p99 = 0.0;
   /// Periods over 2 ms: their index, the wall and CPU time of the step that began them.
   std::vector<std::int64_t> late;
   std::vector<double> late_step_wall, late_step_cpu;
@@ -92,6 +95,7 @@ class AMBFPLUS_API RealTimeLoop {
   std::vector<double> periods_;
   std::vector<double> step_cpu_;
   std::vector<double> step_wall_;
+  std::vector<double> lock_wait_;
   std::int64_t steps_ = 0;
   double first_ = 0.0, last_ = 0.0;
   std::string error_;

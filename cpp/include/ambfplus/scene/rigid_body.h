@@ -114,7 +114,6 @@ struct AMBFPLUS_API RigidBodySpec {
 };
 
 namespace physics {
-struct Body;
 class PhysicsWorld;
 }  // namespace physics
 
@@ -162,9 +161,6 @@ class AMBFPLUS_API RigidBody : public Object {
   /// This body and other pass through each other (AMBF's model-wide `ignore inter-collision`).
   void ignore_collisions_with(RigidBody& other);
 
-  /// Physics internals (for the engine).
-  physics::Body* physics_body() const { return physics_.get(); }
-
  private:
   friend class Model;
   friend class physics::PhysicsWorld;
@@ -178,7 +174,6 @@ class AMBFPLUS_API RigidBody : public Object {
   std::shared_ptr<const MeshData> visual_mesh_;
   Eigen::Vector3d force_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d torque_ = Eigen::Vector3d::Zero();
-  std::unique_ptr<physics::Body> physics_;
 };
 
 }  // namespace ambfplus

@@ -92,7 +92,6 @@ struct AMBFPLUS_API SoftBodySpec {
 };
 
 namespace physics {
-struct Soft;
 class PhysicsWorld;
 }  // namespace physics
 
@@ -128,9 +127,6 @@ class AMBFPLUS_API SoftBody : public Object {
   /// Moves every node rigidly so that the pose becomes this (velocities are kept).
   void set_pose(const Eigen::Isometry3d& pose) override;
 
-  /// Physics internals (for the engine).
-  physics::Soft* physics_soft() const { return physics_.get(); }
-
  private:
   friend class Model;
   friend class physics::PhysicsWorld;
@@ -142,7 +138,6 @@ class AMBFPLUS_API SoftBody : public Object {
   SoftBodySpec spec_;
   std::vector<double> positions_;
   std::vector<std::uint32_t> triangles_;
-  std::unique_ptr<physics::Soft> physics_;
 };
 
 }  // namespace ambfplus

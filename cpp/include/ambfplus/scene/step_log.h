@@ -39,6 +39,12 @@ class AMBFPLUS_API StepLog {
   StepLog take();
   /// Whether it logs this object (a removed object must stop being logged first).
   bool logs(const Object& object) const;
+  /// Values held in all columns.
+  std::size_t values() const;
+  /// Drops the n oldest rows (a log nobody drains, at its cap) and counts them.
+  void drop_oldest(std::int64_t n);
+  /// Rows dropped so far because nobody took them in time.
+  std::int64_t dropped() const { return dropped_; }
 
  private:
   StepLog() = default;
@@ -46,6 +52,7 @@ class AMBFPLUS_API StepLog {
   std::vector<std::int64_t> steps_;
   std::vector<double> times_;
   std::vector<Column> columns_;
+  std::int64_t dropped_ = 0;
 };
 
 }  // namespace ambfplus

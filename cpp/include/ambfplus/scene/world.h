@@ -13,20 +13,31 @@
 
 #include "ambfplus/export.h"
 #include "ambfplus/scene/model.h"
+#include "ambfplus/scene/state_mutex.h"
 #include "ambfplus/scene/step_log.h"
+#include "ambfplus/scene/system.h"
 
 namespace ambfplus {
 
 class Simulator;
 class PluginRegistry;
 namespace render {
-class SceneRenderer;
+class Renderer;
 }
 namespace physics {
-class PhysicsWorld;
+class Physics;
 }
+namespace scene {
+class Attachments;
+class StepLogger;
+}  // namespace scene
 
-/// The scene: models and their objects, and the simulation clock.
+/// The scene: models and their objects, the simulation clock, and the systems that step them.
+///
+/// A step runs the world's systems stage by stage (StepStage: device input, physics, haptics,
+/// device output, attachments, actuators, sensors, plugins, logging), each stage's systems in
+/// the order they were added. The world holds a physics system, devices and drills systems, the
+/// attachments of objects riding on others, a renderer, the step log and the plugin registry.
 class AMBFPLUS_API World {
  public:
   ~World();
@@ -62,8 +73,14 @@ class AMBFPLUS_API World {
   template <typename T>
   std::vector<T*> objects_of_kind() const;
 
-  /// Advances the clock by n fixed steps.
+  /// Advances the clock by n fixed steps: for each, every system's prepare() (which may cancel
+  /// the step), then the clock, then the stages.
   void step(std::int64_t n = 1);
+  /// Adds a system after those the world has: it runs in the stages it names after theirs and
+  /// hears of objects added from now on. Throws std::invalid_argument for a null system.
+  void add_system(std::unique_ptr<System> system);
+  /// The systems in the order they hear of objects and run within a stage.
+  std::vector<System*> systems() const;
   /// Fixed step, seconds.
   double time_step() const { return time_step_; }
   /// Simulation time, seconds (step_index * time_step, without accumulated rounding).
@@ -92,7 +109,7 @@ class AMBFPLUS_API World {
   void stop_step_log();
   /// The rows since the last take (empty without a log). Takes the state lock.
   StepLog take_step_log();
-  bool logging_steps() const { return static_cast<bool>(step_log_); }
+  bool logging_steps() const;
 
   /// The plugins of this world, its simulator, models and objects (cpp/README.md, "Plugins").
   PluginRegistry& plugins();
@@ -101,9 +118,10 @@ class AMBFPLUS_API World {
 
   /// Serialises changes to the scene with reads of it from other threads: each step runs under
   /// it (a real-time loop's physics thread steps while cameras capture from others), and a
-  /// capture copies what it draws under it. Recursive; hold it briefly.
-  std::unique_lock<std::recursive_mutex> lock_state() const {
-    return std::unique_lock<std::recursive_mutex>(state_mutex_);
+  /// capture copies what it draws under it. Recursive, with priority inheritance; hold it
+  /// briefly.
+  std::unique_lock<StateMutex> lock_state() const {
+    return std::unique_lock<StateMutex>(state_mutex_);
   }
 
   /// True while a RealTimeLoop steps this world: steps then leave polled devices and plugins of
@@ -113,23 +131,23 @@ class AMBFPLUS_API World {
   bool enter_realtime() { return !realtime_.exchange(true); }
   void leave_realtime() { realtime_ = false; }
 
-  /// The world's renderer (created on first use; internal to the engine).
-  render::SceneRenderer& renderer();
+  /// The world's renderer (its GPU resources; a capture draws through it).
+  render::Renderer& renderer() { return *renderer_; }
   /// Gives plugins their graphics update, once per step; every render calls it first, under
   /// lock_state() (internal to the engine).
   void graphics_update();
-  /// The world's physics (internal to the engine).
-  physics::PhysicsWorld& physics() { return *physics_; }
+  /// The world's physics.
+  physics::Physics& physics() { return *physics_; }
 
  private:
   friend class Simulator;
   friend class Model;
   World(Simulator& simulator, std::string name, double time_step);
   int claim_name(const std::string& name, const char* what);
-  // Objects riding on a parent, in creation order: the only ones a step moves after physics.
   friend class Object;
-  void track_attached(Object* object, bool attached);
+  /// Lists an object and tells the systems; if one refuses it, it is taken out again.
   void register_object(Object* object);
+  scene::Attachments& attachments() { return *attachments_; }
 
   Simulator* simulator_;
   std::string name_;
@@ -137,19 +155,20 @@ class AMBFPLUS_API World {
   std::int64_t step_index_ = 0;
   std::string name_space_ = "/ambf/env/";
   int next_id_ = 1;
-  // Before the models: it outlives their bodies and joints.
-  std::unique_ptr<physics::PhysicsWorld> physics_;
+  // Before the models: systems outlive the objects they hold state for.
+  std::vector<std::unique_ptr<System>> systems_;
+  std::vector<System*> schedule_[kStepStageCount];  // the systems of each stage, in order
+  physics::Physics* physics_ = nullptr;
+  render::Renderer* renderer_ = nullptr;
+  PluginRegistry* plugins_ = nullptr;
+  scene::Attachments* attachments_ = nullptr;
+  scene::StepLogger* step_logger_ = nullptr;
   std::vector<std::unique_ptr<Model>> models_;
   std::map<std::string, Object*> by_name_;
   std::vector<Object*> objects_;
-  std::vector<Object*> attached_;
-  std::unique_ptr<render::SceneRenderer> renderer_;
-  std::unique_ptr<PluginRegistry> plugins_;
-  std::int64_t graphics_step_ = -1;     // the step of the last graphics update
-  std::uint64_t objects_revision_ = 0;  // counts objects added and models removed
+  std::int64_t graphics_step_ = -1;  // the step of the last graphics update
   std::optional<ShaderSpec> shader_;
-  std::unique_ptr<StepLog> step_log_;
-  mutable std::recursive_mutex state_mutex_;
+  mutable StateMutex state_mutex_;
   std::atomic<bool> realtime_{false};
 };
 

@@ -147,11 +147,24 @@ class AMBFPLUS_API VolumeData {
   /// The union of the boxes edited after `since`: returns false when nothing changed, and the
   /// whole grid when the history no longer reaches back that far.
   bool dirty_since(std::int64_t since, VoxelBox* box) const;
+  /// The boxes edited after `since`, oldest first, a box merged into the one before it where
+  /// that costs few extra voxels, and all merged into their union beyond max_boxes: false when
+  /// nothing changed, the whole grid when the history no longer reaches back that far. Far-apart
+  /// edits stay apart, so a consumer copies what changed, not the box around it.
+  bool dirty_boxes_since(std::int64_t since, std::vector<VoxelBox>* boxes,
+                         std::size_t max_boxes = 64) const;
+  /// Edits kept for edit_log(): the newest kEditLogEdits, holding at most kEditLogVoxels removed
+  /// voxels in all; older ones are dropped (and counted) unless taken first.
+  static constexpr std::size_t kEditLogEdits = 4096;
+  static constexpr std::size_t kEditLogVoxels = 262144;
   const std::deque<VolumeEdit>& edit_log() const { return edit_log_; }
   /// Hands over the edit log and starts a new one.
   std::deque<VolumeEdit> take_edit_log();
+  /// Edits dropped from the log because it was full, since the volume was made.
+  std::int64_t edit_log_dropped() const { return edit_log_dropped_; }
 
-  // --- Derived fields, brought up to date on access.
+  // --- Derived fields: computed in full on first access, then kept up to date by every edit
+  // (for the edited box only, on the editing thread), so readers such as renderers only copy.
 
   /// Occupancy (label != 0) blurred by a separable binomial kernel [1 4 6 4 1] / 16, 0..255:
   /// trilinear interpolation of it gives a smooth iso-surface at 0.5 that sits on flat voxel
@@ -178,7 +191,9 @@ class AMBFPLUS_API VolumeData {
 
  private:
   void record(VolumeEdit edit);
+  void log_edit(VolumeEdit edit);
   void update_derived();
+  void update_derived_box(const VoxelBox& box);
   void smooth_box(const VoxelBox& box);
   void update_bricks(const VoxelBox& box);
 
@@ -197,10 +212,12 @@ class AMBFPLUS_API VolumeData {
   std::deque<std::pair<std::int64_t, VoxelBox>> dirty_;  // recent edits, oldest first
   std::int64_t dirty_floor_ = 0;  // edits at or before this revision are no longer listed
   std::deque<VolumeEdit> edit_log_;
+  std::size_t edit_log_voxels_ = 0;
+  std::int64_t edit_log_dropped_ = 0;
 
   std::vector<std::uint8_t> smoothed_;
   std::vector<std::uint8_t> bricks_;
-  std::int64_t derived_revision_ = -1;
+  bool derived_ready_ = false;  // smoothed_ and bricks_ computed (then kept up to date)
 };
 
 }  // namespace ambfplus

@@ -1,0 +1,41 @@
+#include "scene/scene_systems.h"
+
+#include <algorithm>
+
+#include "ambfplus/scene/object.h"
+
+namespace ambfplus::scene {
+
+void Attachments::track(Object* object, bool attached) {
+  const auto it = std::find(riders_.begin(), riders_.end(), object);
+  if (attached && it == riders_.end()) {
+    riders_.insert(
+        std::upper_bound(riders_.begin(), riders_.end(), object,
+                         [](const Object* a, const Object* b) { return a->id() < b->id(); }),
+        object);
+  } else if (!attached && it != riders_.end()) {
+    riders_.erase(it);
+  }
+}
+
+void Attachments::run(StepStage, const StepContext&) {
+  for (Object* o : riders_) o->follow_parent();
+}
+
+void StepLogger::object_removed(Object& object) {
+  if (log_ && log_->logs(object)) log_.reset();
+}
+
+void StepLogger::run(StepStage, const StepContext& context) {
+  if (!log_) return;
+  log_->record(context.step, context.time);
+  if (log_->values() > kMaxValues) log_->drop_oldest(log_->rows() / 2);
+}
+
+void StepLogger::start(const std::vector<const Object*>& objects) {
+  log_ = std::make_unique<StepLog>(objects);
+}
+
+StepLog StepLogger::take() { return log_ ? log_->take() : StepLog(std::vector<const Object*>{}); }
+
+}  // namespace ambfplus::scene

@@ -3,7 +3,8 @@ that analysis scripts written for it read it. The layout is the one in
 ``shared/reference/original-recording.md``, section 5.2.
 
 Files: ``OUT/YYYYmmdd_HHMMSS.hdf5``, a new file every ``chunk_size`` (500) camera samples,
-named by the recording's start time plus the simulation time of the file's first sample.
+named by the recording's start time plus the simulation time of the file's first sample (a
+second later than the previous file's name where two would fall in the same second).
 Each holds::
 
     metadata_v3/camera_intrinsic     float64 3x3   the left camera's K (ambfplus's cx, cy)
@@ -167,15 +168,16 @@ class OriginalLayout:
             start = datetime.fromisoformat(self.rec.created)
         except (TypeError, ValueError):
             start = datetime(1970, 1, 1, tzinfo=timezone.utc)
-        names, seen = [], set()
+        names, last = [], None
         for a, _ in self.chunks():
             t = self._sample_time(a) if self.samples else 0.0
-            base = (start + timedelta(seconds=float(t))).strftime("%Y%m%d_%H%M%S")
-            name, n = f"{base}.hdf5", 1
-            while name in seen:  # files less than a second apart
-                name, n = f"{base}_{n}.hdf5", n + 1
-            seen.add(name)
-            names.append(name)
+            when = (start + timedelta(seconds=float(t))).replace(microsecond=0)
+            if last is not None and when <= last:
+                # A file less than a second after the previous one is named a second later, so
+                # that names stay unique and in order.
+                when = last + timedelta(seconds=1)
+            names.append(when.strftime("%Y%m%d_%H%M%S") + ".hdf5")
+            last = when
         return names
 
     def _sample_time(self, index: int) -> float:

@@ -19,12 +19,12 @@ channels a client subscribed to:
 - ``/<drill>/wrench`` (geometry_msgs/WrenchStamped): the force fed back to the device, world
   axes;
 - ``/<drill>/critical`` (diagnostic_msgs/DiagnosticArray): every critical structure's distance
-  from the burr, nearest first (level WARN under 2 mm, ERROR once one was cut).
+  from the burr, nearest first (level WARN under 2 mm, ERROR at 0).
 
 Stamps are simulation time. The physics loop (``ambfplus.RealTimeLoop``) never waits for the
-server: images are captured as any other thread captures (the world's lock is held only to copy
-what is drawn), the drill's state is copied under the lock in microseconds, and encoding and
-sending happen off the lock; a slow client loses its oldest messages (the SDK's per-client
+server's Python: images are captured as any other thread captures (the engine holds the world's
+lock only to copy what it draws, with the poses TF needs), the drill's force and distances are
+two reads under the lock, and encoding and sending happen off the lock; a slow client loses its oldest messages (the SDK's per-client
 backlog), it never stalls the publisher. It listens on 127.0.0.1 unless ``host`` says
 otherwise. Needs ``pip install "ambfplus[foxglove]"``.
 """
@@ -98,7 +98,9 @@ class FoxgloveServer:
         self._thread: threading.Thread | None = None
         self._stop = threading.Event()
         self._error: BaseException | None = None
-        self._critical_cut: set[str] = set()
+        # Objects whose pose /tf carries, chosen once.
+        self._posed_objects = [o for o in world.objects if o.kind in ("body", "volume", "drill")]
+        self._posed = [o.name for o in self._posed_objects]
 
     # Life cycle -------------------------------------------------------------------------------
 
@@ -198,34 +200,35 @@ class FoxgloveServer:
         self.stats.messages += 1
 
     def publish(self) -> None:
-        """One tick: the state under the lock (copies), then images, then encoding and sending."""
-        state = self._snapshot()
+        """One tick: images (with the poses the engine copied for them), the drill's state,
+        then encoding and sending, all off the world's lock but for two reads."""
+        frames = {}
+        for camera in self.cameras:
+            passes = [p for p, topic in (("rgb", f"/{camera.name}/image_rect_color"),
+                                         ("depth", f"/{camera.name}/depth/image_rect"))
+                      if (p == "rgb" or self.depth) and self._wanted(topic)]  # fmt: skip
+            if passes:
+                frames[camera.name] = camera.capture(passes=passes, poses=True)
+        state = self._snapshot(frames)
         t = nanoseconds(state["time"])
         transforms = [transform(t, WORLD, child, pose) for child, pose in state["poses"]]
         for camera in self.cameras:
-            image_topic = f"/{camera.name}/image_rect_color"
-            depth_topic = f"/{camera.name}/depth/image_rect"
-            passes = []
-            if self._wanted(image_topic):
-                passes.append("rgb")
-            if self.depth and self._wanted(depth_topic):
-                passes.append("depth")
             frame_id = frame_name(camera.name, "camera")
-            if passes:
-                frame = camera.capture(passes=passes)
+            frame = frames.get(camera.name)
+            if frame is not None:
                 frame_time = nanoseconds(frame.time)
-                transforms.append(transform(frame_time, WORLD, frame_id, frame.pose))
-                if "rgb" in passes:
-                    self._send(image_topic, frame_time,
-                               image_message(frame_time, frame_id, frame.rgb, "rgb8"))  # fmt: skip
-                if "depth" in passes:
-                    self._send(depth_topic, frame_time,
-                               image_message(frame_time, frame_id, frame.depth, "32FC1"))  # fmt: skip
-            else:
-                transforms.append(transform(t, WORLD, frame_id, state["cameras"][camera.name][0]))
+                for pass_name, topic, encoding in (
+                    ("rgb", f"/{camera.name}/image_rect_color", "rgb8"),
+                    ("depth", f"/{camera.name}/depth/image_rect", "32FC1"),
+                ):  # fmt: skip
+                    image = getattr(frame, pass_name, None)
+                    if image is not None:
+                        self._send(topic, frame_time,
+                                   image_message(frame_time, frame_id, image, encoding))  # fmt: skip
+            pose, intrinsics = state["cameras"][camera.name]
+            transforms.append(transform(t, WORLD, frame_id, pose))
             info_topic = f"/{camera.name}/camera_info"
             if self._wanted(info_topic):
-                _, intrinsics = state["cameras"][camera.name]
                 self._send(info_topic, t, camera_info(t, frame_id, camera.width, camera.height,
                                                       intrinsics))  # fmt: skip
         if self._wanted("/tf"):
@@ -244,39 +247,47 @@ class FoxgloveServer:
         if self._wanted(critical_topic):
             self._send(critical_topic, t, self._critical(t, state))
 
-    def _snapshot(self) -> dict:
-        """Copies of the state this tick publishes, taken together under the world's lock."""
+    def _snapshot(self, frames: dict) -> dict:
+        """The state this tick publishes. With a captured frame, its time and the poses the
+        engine copied for it under the lock (no Python runs under the world's lock, where a
+        thread that lost the GIL would hold the physics thread up); else a few reads under the
+        lock. The drill's force and distances are two reads under the lock."""
         world, drill = self.world, self.drill
-        with world.lock():
+        frame = next(iter(frames.values()), None)
+        if frame is not None:
+            poses = frame.poses
             state = {
-                "time": world.time,
-                "cameras": {c.name: (np.array(c.pose), np.array(c.intrinsics))
-                            for c in self.cameras},  # fmt: skip
-                "poses": [(o.name, np.array(o.pose)) for o in world.objects
-                          if o.kind in ("body", "volume", "drill")],  # fmt: skip
+                "time": frame.time,
+                "poses": [(n, poses[n]) for n in self._posed if n in poses],
+                "cameras": {c.name: (frames[c.name].pose if c.name in frames else poses[c.name],
+                                     c.intrinsics) for c in self.cameras},  # fmt: skip
             }
-            if drill is not None:
-                state["force"] = [float(v) for v in drill.force]
-                state["distances"] = dict(drill.critical_distances)
-                state["events"] = [e for e in drill.events if e["kind"] == "critical"]
+        else:
+            with world.lock():
+                state = {
+                    "time": world.time,
+                    "poses": [(o.name, o.pose) for o in self._posed_objects],
+                    "cameras": {c.name: (c.pose, c.intrinsics) for c in self.cameras},
+                }
+        if drill is not None:
+            with world.lock():
+                force, distances = drill.force, drill.critical_distances
+            state["force"] = [float(v) for v in force]
+            state["distances"] = distances
         return state
 
     def _critical(self, t: int, state: dict) -> dict:
-        for event in state["events"]:
-            self._critical_cut.add(str(event["label"]))
         statuses = []
         for name, distance in sorted(state["distances"].items(), key=lambda kv: kv[1]):
-            level = DIAGNOSTIC_WARN if distance < WARN_DISTANCE else DIAGNOSTIC_OK
+            level = DIAGNOSTIC_OK
+            if distance <= 0.0:
+                level = DIAGNOSTIC_ERROR  # the burr is in it
+            elif distance < WARN_DISTANCE:
+                level = DIAGNOSTIC_WARN
             statuses.append({
                 "level": level, "name": name, "message": f"{distance * 1000:.2f} mm",
                 "hardware_id": self.drill.name,
                 "values": [{"key": "distance_m", "value": repr(float(distance))}],
-            })  # fmt: skip
-        if self._critical_cut:
-            statuses.append({
-                "level": DIAGNOSTIC_ERROR, "name": "cut", "hardware_id": self.drill.name,
-                "message": f"critical structure cut (labels {sorted(self._critical_cut)})",
-                "values": [{"key": "labels", "value": ",".join(sorted(self._critical_cut))}],
             })  # fmt: skip
         return {"header": header(t, self.drill.name), "status": statuses}
 

@@ -41,6 +41,7 @@ point for an off-axis rig, so P projects points of the left optical frame into t
 
 from __future__ import annotations
 
+import functools
 import heapq
 import json
 from collections.abc import Iterator
@@ -199,14 +200,23 @@ def camera_points(frame) -> np.ndarray:
     if frame.points is not None:
         points = np.array(frame.points, dtype=np.float32)
     else:
-        h, w = depth.shape
-        k = frame.intrinsics
-        cols, rows = np.meshgrid(np.arange(w) + 0.5, np.arange(h) + 0.5)
-        x = ((cols - k[0, 2]) / k[0, 0]) * depth
-        y = ((rows - k[1, 2]) / k[1, 1]) * depth
-        points = np.stack([x, y, depth], axis=-1).astype(np.float32)
+        rays = _rays(depth.shape, tuple(np.asarray(frame.intrinsics).ravel()))
+        points = rays * depth[..., None]
     points[depth <= 0] = np.nan
     return points
+
+
+@functools.lru_cache(maxsize=8)
+def _rays(shape: tuple[int, int], k: tuple) -> np.ndarray:
+    """(H, W, 3) float32 rays (z = 1) through the pixel centres (c + 0.5, r + 0.5)."""
+    h, w = shape
+    x = ((np.arange(w) + 0.5 - k[2]) / k[0]).astype(np.float32)
+    y = ((np.arange(h) + 0.5 - k[5]) / k[4]).astype(np.float32)
+    rays = np.ones((h, w, 3), np.float32)
+    rays[..., 0] = x[None, :]
+    rays[..., 1] = y[:, None]
+    rays.setflags(write=False)
+    return rays
 
 
 class RosExport:

@@ -33,6 +33,11 @@ bridge process over UDP on loopback, forces sent back every step; see ``ambfplus
 adds a foot pedal's buttons (``--pedal-map drill=0,clutch=1,burr=2``: held spins the burr, held
 clutches, pressed takes the next burr). The keyboard's Space and C keep working with any device.
 
+``--foxglove [PORT]`` serves the session live over the Foxglove WebSocket protocol (port 8765 by
+default, loopback unless ``--foxglove-host`` says otherwise, ``--foxglove-rate`` messages per
+second, 10 by default): the camera, its calibration, TF, the drill's force and the nearest
+critical structure (``ambfplus.export.live``; needs ``ambfplus[foxglove]``).
+
 The status line shows the burr, whether it spins, the control mode, the distance to the nearest
 critical structure (a warning under 2 mm or when one is cut), and the graphics and physics
 rates. ``--record`` writes the session (every step's drill state, the keyboard's readings and
@@ -133,10 +138,17 @@ def parse_args(argv: list[str] | None) -> tuple[argparse.Namespace, list[str]]:
                    help="serve the session live over the Foxglove WebSocket protocol (default "
                    "port 8765): camera, calibration, TF, drill force, nearest critical "
                    "structure")  # fmt: skip
-    p.add_argument("--foxglove-host", default="127.0.0.1",
-                   help="the address the live view listens on (default: loopback only)")
-    p.add_argument("--foxglove-rate", type=float, default=10.0,
-                   help="live view messages per second (default 10)")
+    p.add_argument(
+        "--foxglove-host",
+        default="127.0.0.1",
+        help="the address the live view listens on (default: loopback only)",
+    )
+    p.add_argument(
+        "--foxglove-rate",
+        type=float,
+        default=10.0,
+        help="live view messages per second (default 10)",
+    )
     p.add_argument("--seconds", type=float, help="quit after this many seconds")
     p.add_argument("--status", type=Path, help="write the status (JSON) here as it changes")
     p.add_argument("--latency-log", type=Path, help="log key-to-screen latencies (JSON lines)")

@@ -24,14 +24,13 @@ pytest.importorskip("mcap_ros2", reason='needs pip install "ambfplus[export]"')
 pytest.importorskip("rosbags", reason='needs pip install "ambfplus[export]"')
 pytest.importorskip("pycocotools", reason='needs pip install "ambfplus[export]"')
 
+from conftest import pixel_rays  # noqa: E402
 from mcap.reader import make_reader  # noqa: E402
 from mcap_ros2.decoder import DecoderFactory  # noqa: E402
 from rosbags.highlevel import AnyReader  # noqa: E402
 from rosbags.typesys import Stores, get_typestore  # noqa: E402
 
 from ambfplus.export import ExportError, MissingExtra, export  # noqa: E402
-
-from conftest import pixel_rays  # noqa: E402
 
 # pycocotools 2.0.11 warns under NumPy 2 when decoding; the masks are right.
 pytestmark = pytest.mark.filterwarnings("ignore:__array__ implementation:DeprecationWarning")
@@ -260,7 +259,9 @@ def check_tf(rec, by_topic) -> None:
     steps = rec.steps
     for body in ("drill", "burr", "shaft", "handle"):
         for time, pose in zip(steps["time"][::37], steps[f"{body}.pose"][::37]):
-            worst = max(worst, np.abs(lookup(transforms, body, int(round(time * 1e9))) - pose).max())
+            worst = max(
+                worst, np.abs(lookup(transforms, body, int(round(time * 1e9))) - pose).max()
+            )
     volume = next(e for e in rec.legend.values() if e["kind"] == "volume")
     assert np.abs(lookup(transforms, volume["name"], 0) - np.array(volume["pose"])).max() <= 1e-9
     assert worst <= 1e-9, worst

@@ -148,7 +148,9 @@ def progress_bar(total: int, description: str, enabled: bool | None, unit: str =
         if enabled:
             require("export", "tqdm")
         return _NoBar()
-    return tqdm(total=total, desc=description, unit=unit, disable=None if enabled is None else False)
+    return tqdm(
+        total=total, desc=description, unit=unit, disable=None if enabled is None else False
+    )
 
 
 class _NoBar:

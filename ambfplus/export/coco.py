@@ -170,8 +170,12 @@ def write_coco(recording, out: Path, bar, *, images: bool = True) -> dict:
             annotations += export.annotations(frame, image_id, len(annotations) + 1)
             bar.update(1)
         document = {
-            "info": {**info, "camera": stream.camera, "stream": stream.name,
-                     "warnings": export.warnings},  # fmt: skip
+            "info": {
+                **info,
+                "camera": stream.camera,
+                "stream": stream.name,
+                "warnings": export.warnings,
+            },  # fmt: skip
             "licenses": [],
             "images": image_entries,
             "annotations": annotations,

@@ -24,9 +24,9 @@ channels a client subscribed to:
 Stamps are simulation time. The physics loop (``ambfplus.RealTimeLoop``) never waits for the
 server's Python: images are captured as any other thread captures (the engine holds the world's
 lock only to copy what it draws, with the poses TF needs), the drill's force and distances are
-two reads under the lock, and encoding and sending happen off the lock; a slow client loses its oldest messages (the SDK's per-client
-backlog), it never stalls the publisher. It listens on 127.0.0.1 unless ``host`` says
-otherwise. Needs ``pip install "ambfplus[foxglove]"``.
+two reads under the lock, and encoding and sending happen off the lock; a slow client loses
+its oldest messages (the SDK's per-client backlog), it never stalls the publisher. It listens
+on 127.0.0.1 unless ``host`` says otherwise. Needs ``pip install "ambfplus[foxglove]"``.
 """
 
 from __future__ import annotations
@@ -223,8 +223,8 @@ class FoxgloveServer:
                 ):  # fmt: skip
                     image = getattr(frame, pass_name, None)
                     if image is not None:
-                        self._send(topic, frame_time,
-                                   image_message(frame_time, frame_id, image, encoding))  # fmt: skip
+                        body = image_message(frame_time, frame_id, image, encoding)
+                        self._send(topic, frame_time, body)
             pose, intrinsics = state["cameras"][camera.name]
             transforms.append(transform(t, WORLD, frame_id, pose))
             info_topic = f"/{camera.name}/camera_info"
@@ -259,8 +259,13 @@ class FoxgloveServer:
             state = {
                 "time": frame.time,
                 "poses": [(n, poses[n]) for n in self._posed if n in poses],
-                "cameras": {c.name: (frames[c.name].pose if c.name in frames else poses[c.name],
-                                     c.intrinsics) for c in self.cameras},  # fmt: skip
+                "cameras": {
+                    c.name: (
+                        frames[c.name].pose if c.name in frames else poses[c.name],
+                        c.intrinsics,
+                    )
+                    for c in self.cameras
+                },  # fmt: skip
             }
         else:
             with world.lock():

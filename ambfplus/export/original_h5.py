@@ -259,7 +259,7 @@ class OriginalLayout:
             group.create_dataset(name, shape=(b - a,) + column.shape[1:], dtype=dtype,
                                  chunks=(1,) + column.shape[1:], compression="gzip")  # fmt: skip
         for i in range(a, b):
-            for name, column, side, convert, dtype in datasets:
+            for name, column, side, convert, _ in datasets:
                 group[name][i - a] = convert(np.asarray(column[int(self.samples[i][side])]))
             bar.update(1)
         for name, poses in self._sample_poses(left_rows).items():
@@ -284,6 +284,10 @@ class OriginalLayout:
         if volume is not None and "pose" in entry and volume not in self._logged_poses():
             row = pose_vector(np.asarray(entry["pose"], dtype=np.float64))
             out[self.names[volume]] = np.tile(row, (len(left_rows), 1))
+        elif volume is not None and volume not in self._logged_poses():
+            note = f"the legend has no pose of volume {volume}: no pose_{self.names[volume]}"
+            if note not in self.warnings:
+                self.warnings.append(note)
         return out
 
     def _logged_poses(self) -> dict[str, np.ndarray]:

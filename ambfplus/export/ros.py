@@ -239,6 +239,10 @@ class RosExport:
             if "depth" not in stream.passes and self.point_clouds:
                 self.warnings.append(f"stream {name} has no depth: no point cloud for it")
         removed = self.rec.removed
+        for name, entry in self.names.items():
+            if entry.get("kind") == "volume" and "pose" not in entry:
+                self.warnings.append(f"the legend has no pose of volume {name}: no transform "
+                                     "from world to it")  # fmt: skip
         if len(removed["step"]) and self._volume_geometry(removed["volume"]) is None:
             raise ExportError(
                 f"{self.rec.path}: the removal log's volume {removed['volume']!r} has no "
@@ -331,8 +335,11 @@ class RosExport:
                 for s in self.rec.cameras.values()
             },
             **{n: f"{self._kind(n)} {n}" for n in self._pose_columns()},
-            **{n: f"volume {n} (centred on its grid; voxel (i, j, k) centre at (i + 0.5) s - "
-               "D / 2 along x, y, z)" for n in self._static_poses()},  # fmt: skip
+            **{
+                n: f"volume {n} (centred on its grid; voxel (i, j, k) centre at (i + 0.5) s - "
+                "D / 2 along x, y, z)"
+                for n in self._static_poses()
+            },  # fmt: skip
         }
         return {
             **export_conventions(self.rec),
@@ -629,7 +636,9 @@ class Rosbag2Sink:
         )  # fmt: skip
         self._connections = {
             topic: self._writer.add_connection(
-                topic, msgtype, typestore=self._store,
+                topic,
+                msgtype,
+                typestore=self._store,
                 offered_qos_profiles=[latched] if topic == "/tf_static" else [],
             )  # fmt: skip
             for topic, msgtype in topics.items()

@@ -137,8 +137,8 @@ def _live_round(seconds: float, serve: bool, capturing: bool) -> dict:
     camera.look_at((0.05, -0.1, 0.1), (0, 0, 0))
     hit = volume.raycast((0.0, 0.0, 0.05), (0.0, 0.0, -1.0))
     into = -hit["normal"] / np.linalg.norm(hit["normal"])
-    drill.goal = ambfplus.make_pose(hit["position"] - into * (drill.burr_radius + 0.002),
-                                    rotation=ambfplus.rotation_between((1, 0, 0), -into))  # fmt: skip
+    start = hit["position"] - into * (drill.burr_radius + 0.002)
+    drill.goal = ambfplus.make_pose(start, rotation=ambfplus.rotation_between((1, 0, 0), -into))
     hand = ambfplus.SimulatedDevice()
     world.add_input_device("hand", hand, drill)
     camera.capture()
@@ -203,8 +203,11 @@ def foxglove_live(args):
                 "rounds": rounds,
                 "what": "1 kHz loop drilling the ear phantom 256^3"
                 + (", a 640x480 camera capturing in a thread" if capturing else ", headless")
-                + (", the Foxglove live view (640x480 camera) serving a subscribed client at "
-                   "10 Hz" if serve else ""),
+                + (
+                    ", the Foxglove live view (640x480 camera) serving a subscribed client at 10 Hz"
+                    if serve
+                    else ""
+                ),
             }
             if capturing:
                 line["capture_frames_per_s"] = round(

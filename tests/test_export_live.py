@@ -110,3 +110,34 @@ def test_the_live_view_says_when_its_port_is_taken():
     with FoxgloveServer(world, [], port=0) as first:
         with pytest.raises(RuntimeError, match=f"cannot listen on 127.0.0.1:{first.port}"):
             FoxgloveServer(world, [], port=first.port).start()
+
+
+def test_the_launcher_serves_its_session_live(fixtures, tmp_path):
+    """ambfplus-launch --foxglove: the original drilling scene, headless, advertises its camera,
+    calibration, TF and the drill's channels to a client."""
+    import re
+    import subprocess
+    import sys
+
+    launch = fixtures / "volumetric_drilling" / "launch.yaml"
+    process = subprocess.Popen(
+        [sys.executable, "-m", "ambfplus.launcher", str(launch), "-l", "0,2", "-g", "false",
+         "--seconds", "20", "--foxglove", "0"],
+        cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True,
+    )  # fmt: skip
+    try:
+        url = None
+        for line in process.stdout:
+            found = re.search(r"live view on (ws://127\.0\.0\.1:\d+)", line)
+            if found:
+                url = found.group(1)
+                break
+        assert url is not None, "the launcher did not start its live view"
+        with websockets_client.connect(url, subprotocols=[SUBPROTOCOL]) as connection:
+            topics = set()
+            while not {"/main_camera/image_rect_color", "/drill/wrench"} <= topics:
+                topics |= {c["topic"] for c in receive_json(connection, "advertise")["channels"]}
+        assert {"/main_camera/camera_info", "/tf", "/drill/critical"} <= topics
+    finally:
+        process.terminate()
+        process.wait(timeout=30)

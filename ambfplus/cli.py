@@ -1,5 +1,5 @@
-"""The ``ambfplus`` command line: ``demo``, ``convert``, ``launch``, ``validate``, ``info`` (and
-``--cmake-dir``, the folder of the CMake package C++ plugins build against)."""
+"""The ``ambfplus`` command line: ``demo``, ``convert``, ``launch``, ``validate``, ``export``,
+``info`` (and ``--cmake-dir``, the folder of the CMake package C++ plugins build against)."""
 
 from __future__ import annotations
 
@@ -232,6 +232,36 @@ def run_validate(args: argparse.Namespace) -> int:
     return 0 if report.ok else 1
 
 
+def run_export(args: argparse.Namespace) -> int:
+    """Exports a recording or a dataset folder; errors are one line naming what is wrong."""
+    from .export import ExportError, MissingExtra, export
+    from .recording_schema import RecordingError
+
+    options = {}
+    if args.to in ("mcap", "rosbag2"):
+        options["point_clouds"] = not args.no_points
+    if args.to == "mcap":
+        options["compression"] = None if args.compression == "none" else args.compression
+    if args.to == "original-h5":
+        options["chunk_size"] = args.chunk_size
+    if args.to == "coco":
+        options["images"] = not args.no_images
+    try:
+        results = export(args.source, args.out, args.to, force=args.force,
+                         progress=False if args.quiet else None, **options)  # fmt: skip
+    except (ExportError, RecordingError, MissingExtra) as error:
+        print(f"ambfplus export: {error}", file=sys.stderr)
+        return 1
+    results = results if isinstance(results, list) else [results]
+    for result in results:
+        line = result.to_dict()
+        if not args.verbose:
+            line.pop("topics", None)
+            line.pop("messages", None)
+        print(json.dumps(line))
+    return 0
+
+
 class _PrintCmakeDir(argparse.Action):
     """--cmake-dir: prints the folder and exits, as --version does."""
 
@@ -326,12 +356,34 @@ def main(argv: list[str] | None = None) -> int:
     )
     validate.add_argument("recording", type=Path, help="the recording's head file (name.h5)")
     validate.add_argument("--json", action="store_true", help="print the report as JSON")
+    exporter = commands.add_parser(
+        "export",
+        help="export a recording or a dataset folder to MCAP or rosbag2 (ROS 2 messages), the "
+        "original system's HDF5 layout or COCO masks",
+    )
+    exporter.add_argument("source", type=Path, help="a recording (name.h5) or a dataset folder")
+    exporter.add_argument("--to", required=True, metavar="FORMAT",
+                          help="mcap, rosbag2, original-h5 or coco")  # fmt: skip
+    exporter.add_argument("out", type=Path, help="the output file (mcap) or folder")
+    exporter.add_argument("--force", action="store_true", help="replace an existing output")
+    exporter.add_argument("--quiet", action="store_true", help="no progress bar")
+    exporter.add_argument("--verbose", action="store_true", help="print message counts")
+    exporter.add_argument("--no-points", action="store_true",
+                          help="mcap/rosbag2: no point clouds")  # fmt: skip
+    exporter.add_argument("--compression", default="zstd", choices=("zstd", "lz4", "none"),
+                          help="mcap: chunk compression")  # fmt: skip
+    exporter.add_argument("--chunk-size", type=int, default=500,
+                          help="original-h5: samples per file (the original's 500)")  # fmt: skip
+    exporter.add_argument("--no-images", action="store_true",
+                          help="coco: annotations only, no PNG frames")  # fmt: skip
     commands.add_parser("info", help="print the version and the OpenGL device")
     args = parser.parse_args(argv)
     if args.command == "validate":
         return run_validate(args)
     if args.command == "launch":
         return run_launch(args)
+    if args.command == "export":
+        return run_export(args)
     if args.command == "demo":
         return run_demo(args.out, args.width, args.height, args.resolution, args.every)
     if args.command == "replay":

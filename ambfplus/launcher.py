@@ -33,6 +33,11 @@ bridge process over UDP on loopback, forces sent back every step; see ``ambfplus
 adds a foot pedal's buttons (``--pedal-map drill=0,clutch=1,burr=2``: held spins the burr, held
 clutches, pressed takes the next burr). The keyboard's Space and C keep working with any device.
 
+``--foxglove [PORT]`` serves the session live over the Foxglove WebSocket protocol (port 8765 by
+default, loopback unless ``--foxglove-host`` says otherwise, ``--foxglove-rate`` messages per
+second, 10 by default): the camera, its calibration, TF, the drill's force and the nearest
+critical structure (``ambfplus.export.live``; needs ``ambfplus[foxglove]``).
+
 The status line shows the burr, whether it spins, the control mode, the distance to the nearest
 critical structure (a warning under 2 mm or when one is cut), and the graphics and physics
 rates. ``--record`` writes the session (every step's drill state, the keyboard's readings and
@@ -129,6 +134,21 @@ def parse_args(argv: list[str] | None) -> tuple[argparse.Namespace, list[str]]:
                    help="which pedal buttons spin the burr (held), clutch (held) and take the "
                    "next burr (pressed)")  # fmt: skip
     p.add_argument("--record", type=Path, help="record the session to this HDF5 file")
+    p.add_argument("--foxglove", nargs="?", type=int, const=8765, metavar="PORT",
+                   help="serve the session live over the Foxglove WebSocket protocol (default "
+                   "port 8765): camera, calibration, TF, drill force, nearest critical "
+                   "structure")  # fmt: skip
+    p.add_argument(
+        "--foxglove-host",
+        default="127.0.0.1",
+        help="the address the live view listens on (default: loopback only)",
+    )
+    p.add_argument(
+        "--foxglove-rate",
+        type=float,
+        default=10.0,
+        help="live view messages per second (default 10)",
+    )
     p.add_argument("--seconds", type=float, help="quit after this many seconds")
     p.add_argument("--status", type=Path, help="write the status (JSON) here as it changes")
     p.add_argument("--latency-log", type=Path, help="log key-to-screen latencies (JSON lines)")
@@ -313,6 +333,31 @@ class Session:
         self.recorder = None
         if args.record is not None:
             self.start_recording(args.record)
+        self.live = None
+        self.live_options = None
+        if args.foxglove is not None:
+            self.live_options = {"port": args.foxglove, "host": args.foxglove_host,
+                                 "rate": args.foxglove_rate}  # fmt: skip
+
+    def start_live(self) -> None:
+        """Starts the Foxglove live view (--foxglove), once the real-time loop runs."""
+        if self.live_options is None:
+            return
+        from .export import MissingExtra
+        from .export.live import FoxgloveServer
+
+        try:
+            self.live = FoxgloveServer(self.world, [self.camera], drill=self.drill,
+                                       **self.live_options).start()  # fmt: skip
+        except (MissingExtra, RuntimeError) as error:
+            raise SystemExit(f"ambfplus-launch: --foxglove: {error}") from None
+        print(f"ambfplus-launch: live view on {self.live.url} at {self.live.rate:g} Hz "
+              "(Foxglove: open a WebSocket connection)", flush=True)  # fmt: skip
+
+    def stop_live(self) -> None:
+        if self.live is not None:
+            self.live.stop()
+            self.live = None
 
     def start_recording(self, path: Path) -> None:
         from .recording import Recorder
@@ -457,12 +502,14 @@ def run_headless(args: argparse.Namespace, plugin_args: list[str]) -> int:
     try:
         with session.loop:
             print(f"ambfplus-launch: headless; physics: {session.loop.scheduling}", flush=True)
+            session.start_live()
             while args.seconds is None or time.perf_counter() - started < args.seconds:
                 time.sleep(0.1)
                 session.drain()
     except KeyboardInterrupt:
         pass
     finally:
+        session.stop_live()
         session.drain()
         if session.recorder is not None:
             session.recorder.close()
@@ -539,6 +586,7 @@ def run_window(glfw, args: argparse.Namespace, plugin_args: list[str]) -> int:
     with session.loop:
         print(f"ambfplus-launch: {camera.name} in a {window_size[0]}x{window_size[1]} window "
               f"({views.mode}); physics: {session.loop.scheduling}", flush=True)  # fmt: skip
+        session.start_live()
         while not glfw.window_should_close(window):
             glfw.poll_events()
             now = time.perf_counter()
@@ -573,6 +621,7 @@ def run_window(glfw, args: argparse.Namespace, plugin_args: list[str]) -> int:
                 if current != last_status:
                     args.status.write_text(json.dumps(current))
                     last_status = current
+    session.stop_live()
     session.drain()
     if session.recorder is not None:
         session.recorder.close()

@@ -924,7 +924,9 @@ def _attr_text(value) -> str:
 
 def world_legend(world) -> dict:
     """``ambfplus.stereo.legend(world)`` plus each volume's grid shape, dimensions and voxel
-    size, which map a ``voxel`` image's index to (i, j, k)."""
+    size, which map a ``voxel`` image's index to (i, j, k), and its pose (world-from-volume,
+    as the recording starts), which places removed voxels in the world; drills add their burr
+    diameters (m), which give the ``burr`` index of the step log a size."""
     out = object_legend(world)
     for volume in world.volumes:
         data = volume.data
@@ -932,5 +934,8 @@ def world_legend(world) -> dict:
             shape=tuple(int(n) for n in data.shape),
             dimensions=[float(d) for d in data.dimensions],
             voxel_size=[float(d) for d in data.voxel_size],
+            pose=np.asarray(volume.pose, dtype=np.float64).tolist(),
         )
+    for drill in world.drills:
+        out[drill.id]["burr_diameters"] = [float(d) for d in drill.burr_diameters]
     return out

@@ -119,7 +119,9 @@ def drilling_phantom(
             "baseline": baseline, "working_distance": working_distance,
         },
     }  # fmt: skip
-    return Scene(world, drill, rig, "hand", {"drill_button": 0}, [drill, rig.left], spec)
+    # The drill's bodies are logged too: exports give every body a pose at every step.
+    logged = [drill, rig.left, burr, stem, handle]
+    return Scene(world, drill, rig, "hand", {"drill_button": 0}, logged, spec)
 
 
 def orbit_view(t: float, distance: float = 0.25) -> tuple[np.ndarray, np.ndarray]:

@@ -1,0 +1,684 @@
+"""A recording as ROS 2 messages, written to MCAP (``mcap`` + ``mcap-ros2-support``) or to a
+rosbag2 folder with MCAP storage (``rosbags``). Both hold the same topics and messages.
+
+Topics (``S`` is a camera stream, e.g. ``rig_left``; ``D`` a drill; ``V`` the drilled volume):
+
+==============================  ===========================  ==================================
+topic                           type                         content
+==============================  ===========================  ==================================
+``/S/image_rect_color``         sensor_msgs/Image            rgb8
+``/S/depth/image_rect``         sensor_msgs/Image            32FC1, metres along the optical
+                                                             axis, 0 where nothing was hit
+``/S/label/image``              sensor_msgs/Image            16UC1 anatomy label ids (0 = none)
+``/S/instance/image``           sensor_msgs/Image            32SC1 object ids (0 = background)
+``/S/voxel/image``              sensor_msgs/Image            32SC1 voxel index, -1 = none
+``/S/segmentation/image``       sensor_msgs/Image            rgb8 flat segmentation colours
+``/S/camera_info``              sensor_msgs/CameraInfo       K, P in ROS's pixel convention
+``/S/points``                   sensor_msgs/PointCloud2      organised, optical frame: x y z
+                                                             (float32, NaN where no hit), rgb
+                                                             (packed float32), instance (int32),
+                                                             label (uint16)
+``/tf``                         tf2_msgs/TFMessage           world -> cameras (at their frames),
+                                                             bodies and drills (every step)
+``/tf_static``                  tf2_msgs/TFMessage           world -> volumes
+``/D/wrench``                   geometry_msgs/WrenchStamped  force fed back to the device (N),
+                                                             world axes; torque 0
+``/drilling/removed_voxels``    sensor_msgs/PointCloud2      voxels removed in a step: x y z
+                                                             (centres, volume frame V), i j k,
+                                                             label
+``/drilling/events``            diagnostic_msgs/             critical-structure events of a
+                                DiagnosticArray              step (name, label, voxel, step)
+==============================  ===========================  ==================================
+
+Conventions: header stamps and log times are simulation time (nanoseconds since the session
+started, not Unix time). Camera frames are optical frames ``<camera>_optical_frame`` (x right, y
+down, z forward). CameraInfo follows ROS: pixel centres at integer coordinates, so
+``cx_ros = cx - 0.5`` and ``cy_ros = cy - 0.5`` from ambfplus's intrinsics (which centre pixel
+(r, c) at (c + 0.5, r + 0.5)); R is the identity (views are rectified), no distortion; a
+stereo rig's right camera has P[0, 3] = Tx = -fx * baseline and its own, shifted principal
+point for an off-axis rig, so P projects points of the left optical frame into the right image.
+"""
+
+from __future__ import annotations
+
+import functools
+import heapq
+import json
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ._common import (
+    ExportError,
+    StepClock,
+    export_conventions,
+    frame_name,
+    nanoseconds,
+    quaternion_xyzw,
+    require,
+)
+
+WORLD = "world"
+TYPESTORE = "ROS2_JAZZY"  # the message definitions (ROS 2 Jazzy's; unchanged since Humble)
+
+# pass -> (topic suffix, ROS encoding)
+IMAGE_TOPICS = {
+    "rgb": ("image_rect_color", "rgb8"),
+    "depth": ("depth/image_rect", "32FC1"),
+    "label": ("label/image", "16UC1"),
+    "instance": ("instance/image", "32SC1"),
+    "voxel": ("voxel/image", "32SC1"),
+    "segmentation": ("segmentation/image", "rgb8"),
+}
+IMAGE = "sensor_msgs/msg/Image"
+CAMERA_INFO = "sensor_msgs/msg/CameraInfo"
+POINT_CLOUD = "sensor_msgs/msg/PointCloud2"
+TF = "tf2_msgs/msg/TFMessage"
+WRENCH = "geometry_msgs/msg/WrenchStamped"
+DIAGNOSTICS = "diagnostic_msgs/msg/DiagnosticArray"
+# sensor_msgs/PointField datatypes
+FLOAT32, INT32, UINT16 = 7, 5, 4
+DIAGNOSTIC_WARN, DIAGNOSTIC_ERROR = 1, 2
+
+
+@dataclass(order=True)
+class Message:
+    """One message to write: when (ns of simulation time), where and what (a dict tree whose
+    arrays are NumPy arrays, converted for each writer)."""
+
+    time: int
+    order: int
+    topic: str = field(compare=False)
+    msgtype: str = field(compare=False)
+    body: dict = field(compare=False)
+
+
+def header(time_ns: int, frame: str) -> dict:
+    return {"stamp": {"sec": time_ns // 10**9, "nanosec": time_ns % 10**9}, "frame_id": frame}
+
+
+def image_message(time_ns: int, frame: str, array: np.ndarray, encoding: str) -> dict:
+    """A sensor_msgs/Image of an (H, W) or (H, W, C) array, little-endian."""
+    array = np.ascontiguousarray(array)
+    height, width = array.shape[:2]
+    return {
+        "header": header(time_ns, frame),
+        "height": height,
+        "width": width,
+        "encoding": encoding,
+        "is_bigendian": 0,
+        "step": array.strides[0],
+        "data": array.reshape(-1).view(np.uint8),
+    }
+
+
+def ros_intrinsics(intrinsics: np.ndarray) -> np.ndarray:
+    """ambfplus's K (pixel centres at +0.5) as ROS's K (pixel centres at integers)."""
+    k = np.array(intrinsics, dtype=np.float64)
+    k[0, 2] -= 0.5
+    k[1, 2] -= 0.5
+    return k
+
+
+def camera_info(time_ns, frame, width, height, intrinsics, tx: float = 0.0) -> dict:
+    """A sensor_msgs/CameraInfo: rectified, no distortion; tx = -fx * baseline for the right
+    camera of a stereo pair (0 otherwise)."""
+    k = ros_intrinsics(intrinsics)
+    p = np.zeros((3, 4))
+    p[:, :3] = k
+    p[0, 3] = tx
+    return {
+        "header": header(time_ns, frame),
+        "height": int(height),
+        "width": int(width),
+        "distortion_model": "plumb_bob",
+        "d": np.zeros(5),
+        "k": k.reshape(-1),
+        "r": np.eye(3).reshape(-1),
+        "p": p.reshape(-1),
+        "binning_x": 0,
+        "binning_y": 0,
+        "roi": {"x_offset": 0, "y_offset": 0, "height": 0, "width": 0, "do_rectify": False},
+    }
+
+
+def transform(time_ns: int, parent: str, child: str, pose: np.ndarray) -> dict:
+    """A geometry_msgs/TransformStamped: child's pose in parent (parent-from-child)."""
+    q = quaternion_xyzw(pose[:3, :3])
+    t = pose[:3, 3]
+    return {
+        "header": header(time_ns, parent),
+        "child_frame_id": child,
+        "transform": {
+            "translation": {"x": float(t[0]), "y": float(t[1]), "z": float(t[2])},
+            "rotation": {"x": float(q[0]), "y": float(q[1]), "z": float(q[2]), "w": float(q[3])},
+        },
+    }
+
+
+def point_cloud(time_ns: int, frame: str, columns: dict, height: int, width: int) -> dict:
+    """A sensor_msgs/PointCloud2 from named columns (x, y, z, rgb, instance, label; each of
+    height * width values), packed in that order."""
+    kinds = {"x": ("<f4", FLOAT32), "y": ("<f4", FLOAT32), "z": ("<f4", FLOAT32),
+             "rgb": ("<f4", FLOAT32), "i": ("<i4", INT32), "j": ("<i4", INT32),
+             "k": ("<i4", INT32), "instance": ("<i4", INT32), "label": ("<u2", UINT16)}  # fmt: skip
+    names = [n for n in kinds if n in columns]
+    dtype = np.dtype([(n, kinds[n][0]) for n in names])
+    packed = np.empty(height * width, dtype=dtype)
+    fields = []
+    for name in names:
+        packed[name] = np.asarray(columns[name]).reshape(-1)
+        fields.append({"name": name, "offset": dtype.fields[name][1],
+                       "datatype": kinds[name][1], "count": 1})  # fmt: skip
+    has_nan = any(np.isnan(packed[n]).any() for n in ("x", "y", "z") if n in names)
+    return {
+        "header": header(time_ns, frame),
+        "height": height,
+        "width": width,
+        "fields": fields,
+        "is_bigendian": False,
+        "point_step": dtype.itemsize,
+        "row_step": dtype.itemsize * width,
+        "data": packed.view(np.uint8),
+        "is_dense": not has_nan,
+    }
+
+
+def packed_rgb(rgb: np.ndarray) -> np.ndarray:
+    """RGB uint8 (..., 3) as PCL's packed float32 (0x00RRGGBB reinterpreted)."""
+    rgb = rgb.astype(np.uint32)
+    packed = (rgb[..., 0] << 16) | (rgb[..., 1] << 8) | rgb[..., 2]
+    return packed.view(np.float32)
+
+
+def camera_points(frame) -> np.ndarray:
+    """(H, W, 3) camera-frame points of a recorded frame: its points pass where recorded, else
+    depth back-projected through its intrinsics (pixel centres at +0.5); NaN where no hit."""
+    depth = np.asarray(frame.depth, dtype=np.float32)
+    if frame.points is not None:
+        points = np.array(frame.points, dtype=np.float32)
+    else:
+        rays = _rays(depth.shape, tuple(np.asarray(frame.intrinsics).ravel()))
+        points = rays * depth[..., None]
+    points[depth <= 0] = np.nan
+    return points
+
+
+@functools.lru_cache(maxsize=8)
+def _rays(shape: tuple[int, int], k: tuple) -> np.ndarray:
+    """(H, W, 3) float32 rays (z = 1) through the pixel centres (c + 0.5, r + 0.5)."""
+    h, w = shape
+    x = ((np.arange(w) + 0.5 - k[2]) / k[0]).astype(np.float32)
+    y = ((np.arange(h) + 0.5 - k[5]) / k[4]).astype(np.float32)
+    rays = np.ones((h, w, 3), np.float32)
+    rays[..., 0] = x[None, :]
+    rays[..., 1] = y[:, None]
+    rays.setflags(write=False)
+    return rays
+
+
+class RosExport:
+    """Turns a recording into time-ordered ROS 2 messages (see the module docstring)."""
+
+    def __init__(self, recording, *, point_clouds: bool = True) -> None:
+        self.rec = recording
+        self.point_clouds = point_clouds
+        self.clock = StepClock(recording)
+        self.legend = recording.legend
+        self.names = {entry.get("name"): entry for entry in self.legend.values()}
+        self.warnings: list[str] = []
+        self._stereo = self._stereo_partners()
+        self._check()
+
+    # What is in it ---------------------------------------------------------------------------
+
+    def _check(self) -> None:
+        for name, stream in self.rec.cameras.items():
+            if "depth" not in stream.passes and self.point_clouds:
+                self.warnings.append(f"stream {name} has no depth: no point cloud for it")
+        removed = self.rec.removed
+        for name, entry in self.names.items():
+            if entry.get("kind") == "volume" and "pose" not in entry:
+                self.warnings.append(f"the legend has no pose of volume {name}: no transform "
+                                     "from world to it")  # fmt: skip
+        if len(removed["step"]) and self._volume_geometry(removed["volume"]) is None:
+            raise ExportError(
+                f"{self.rec.path}: the removal log's volume {removed['volume']!r} has no "
+                "dimensions and shape in the legend, so its voxels cannot be placed (record "
+                "with Recorder.set_legend(world))"
+            )
+
+    def _stereo_partners(self) -> dict:
+        """stream -> (left stream, rig name) for the right stream of each rig, with the
+        baseline of each of its frames."""
+        partners = {}
+        for rig_name, rig in self.rec.rigs.items():
+            right = rig.right.name
+            baselines = np.full(len(rig.right), np.nan)
+            baselines[np.asarray(rig.right_index[:], dtype=np.int64)] = rig.baseline[:]
+            partners[right] = (rig.left.name, rig_name, baselines)
+        return partners
+
+    def _volume_geometry(self, name):
+        entry = self.names.get(name)
+        if not entry or "dimensions" not in entry or "shape" not in entry:
+            return None
+        return np.asarray(entry["dimensions"], float), np.asarray(entry["shape"], int)
+
+    def _camera_frame(self, stream) -> str:
+        return frame_name(stream.camera, "camera")
+
+    def _pose_columns(self) -> dict[str, np.ndarray]:
+        """Step-log pose columns of objects other than recorded cameras: name -> (N, 4, 4)."""
+        filmed = {s.camera for s in self.rec.cameras.values()}
+        out = {}
+        for column, values in self.rec.steps.items():
+            if not column.endswith(".pose") or values.ndim != 3 or values.shape[1:] != (4, 4):
+                continue
+            name = column[: -len(".pose")]
+            if name in filmed:
+                continue  # cameras are placed where their frames were taken
+            out[name] = values
+        return out
+
+    def _kind(self, name: str) -> str:
+        return (self.names.get(name) or {}).get("kind", "body")
+
+    def topics(self) -> dict[str, str]:
+        """topic -> message type, for everything this export writes."""
+        out = {}
+        for name, stream in self.rec.cameras.items():
+            for pass_name in stream.passes:
+                if pass_name in IMAGE_TOPICS:
+                    out[f"/{name}/{IMAGE_TOPICS[pass_name][0]}"] = IMAGE
+            out[f"/{name}/camera_info"] = CAMERA_INFO
+            if self.point_clouds and "depth" in stream.passes:
+                out[f"/{name}/points"] = POINT_CLOUD
+        if self.rec.cameras or self._pose_columns():
+            out["/tf"] = TF
+        if self._static_poses():
+            out["/tf_static"] = TF
+        for drill in self._drills():
+            out[f"/{drill}/wrench"] = WRENCH
+        if len(self.rec.removed["step"]):
+            out["/drilling/removed_voxels"] = POINT_CLOUD
+        if self.rec.events:
+            out["/drilling/events"] = DIAGNOSTICS
+        return out
+
+    def _drills(self) -> list[str]:
+        steps = self.rec.steps
+        return [
+            n for n in self.names
+            if self._kind(n) == "drill" and f"{n}.force" in steps
+        ]  # fmt: skip
+
+    def _static_poses(self) -> dict[str, np.ndarray]:
+        """Volumes whose pose the legend holds and the step log does not: fixed."""
+        logged = self._pose_columns()
+        return {
+            name: np.asarray(entry["pose"], dtype=np.float64)
+            for name, entry in self.names.items()
+            if entry.get("kind") == "volume" and "pose" in entry and name not in logged
+        }
+
+    def describe(self) -> dict:
+        """The export's own metadata: conventions, topics, frames, legend, warnings."""
+        topics = self.topics()
+        frames = {
+            WORLD: "the simulation's world frame (right-handed, z up)",
+            **{
+                self._camera_frame(s): f"optical frame of camera {s.camera} (OpenCV axes: x "
+                "right, y down, z forward)"
+                for s in self.rec.cameras.values()
+            },
+            **{n: f"{self._kind(n)} {n}" for n in self._pose_columns()},
+            **{
+                n: f"volume {n} (centred on its grid; voxel (i, j, k) centre at (i + 0.5) s - "
+                "D / 2 along x, y, z)"
+                for n in self._static_poses()
+            },  # fmt: skip
+        }
+        return {
+            **export_conventions(self.rec),
+            "message_definitions": f"ROS 2 ({TYPESTORE} type store of rosbags)",
+            "time_stamps": "header stamps and log times are simulation time in nanoseconds",
+            "pixel_convention": "CameraInfo K and P centre pixels on integers (ROS, OpenCV): "
+            "cx_ros = cx_ambfplus - 0.5, cy_ros = cy_ambfplus - 0.5",
+            "stereo": "the right camera's P has Tx = -fx * baseline and its own principal "
+            "point (shifted for an off-axis rig); P maps left-optical-frame points to right "
+            "pixels",
+            "encodings": "rgb8 colour and segmentation; 32FC1 depth in metres (0 = no hit); "
+            "16UC1 label ids; 32SC1 instance ids and voxel indices (-1 = none)",
+            "point_clouds": "organised, optical frame, NaN where nothing was hit; rgb packed "
+            "0x00RRGGBB as float32",
+            "wrench": "the force the drill feeds back to the device (N), world axes; torque 0",
+            "topics": json.dumps(topics, sort_keys=True),
+            "frames": json.dumps(frames, sort_keys=True),
+            "legend": json.dumps({str(k): v for k, v in self.legend.items()}, sort_keys=True),
+            "recording_metadata": json.dumps(self.rec.metadata, sort_keys=True, default=str),
+            "warnings": json.dumps(self.warnings),
+        }
+
+    def frames(self) -> int:
+        return sum(len(s) for s in self.rec.cameras.values())
+
+    # The messages ----------------------------------------------------------------------------
+
+    def messages(self) -> Iterator[Message]:
+        """Every message, in order of simulation time."""
+        sources = [self._camera_messages(s) for s in self.rec.cameras.values()]
+        sources += [self._camera_tf(), self._step_tf(), self._static_tf(), self._wrenches(),
+                    self._removed(), self._events()]  # fmt: skip
+        return heapq.merge(*sources)
+
+    def _camera_messages(self, stream) -> Iterator[Message]:
+        frame_id = self._camera_frame(stream)
+        partner = self._stereo.get(stream.name)
+        for index in range(len(stream)):
+            frame = stream[index]
+            t = nanoseconds(frame.time)
+            for pass_name in stream.passes:
+                if pass_name not in IMAGE_TOPICS:
+                    continue
+                suffix, encoding = IMAGE_TOPICS[pass_name]
+                body = image_message(t, frame_id, getattr(frame, pass_name), encoding)
+                yield Message(t, 1, f"/{stream.name}/{suffix}", IMAGE, body)
+            tx = 0.0
+            if partner is not None:
+                baseline = partner[2][index]
+                if np.isnan(baseline):
+                    raise ExportError(
+                        f"{self.rec.path}: frame {index} of {stream.name} (the right camera of "
+                        f"rig {partner[1]}) belongs to no stereo pair; its P has no baseline"
+                    )
+                tx = -frame.intrinsics[0, 0] * baseline
+            body = camera_info(t, frame_id, frame.width, frame.height, frame.intrinsics, tx)
+            yield Message(t, 1, f"/{stream.name}/camera_info", CAMERA_INFO, body)
+            if self.point_clouds and frame.depth is not None:
+                yield Message(t, 1, f"/{stream.name}/points", POINT_CLOUD,
+                              self._cloud(t, frame_id, frame))  # fmt: skip
+
+    def _cloud(self, t: int, frame_id: str, frame) -> dict:
+        points = camera_points(frame)
+        h, w = points.shape[:2]
+        columns = {"x": points[..., 0], "y": points[..., 1], "z": points[..., 2]}
+        if frame.rgb is not None:
+            columns["rgb"] = packed_rgb(frame.rgb)
+        if frame.instance is not None:
+            columns["instance"] = frame.instance
+        if frame.label is not None:
+            columns["label"] = frame.label
+        return point_cloud(t, frame_id, columns, h, w)
+
+    def _camera_tf(self) -> Iterator[Message]:
+        """world -> each camera's optical frame at the times its frames were taken (one
+        message per time, holding every camera filmed then)."""
+        by_time: dict[int, list] = {}
+        for stream in self.rec.cameras.values():
+            times, poses = stream.time[:], stream.pose[:]
+            for time, pose in zip(times, poses):
+                by_time.setdefault(nanoseconds(time), []).append((self._camera_frame(stream),
+                                                                  pose))  # fmt: skip
+        for t in sorted(by_time):
+            transforms = [transform(t, WORLD, child, pose) for child, pose in by_time[t]]
+            yield Message(t, 0, "/tf", TF, {"transforms": transforms})
+
+    def _step_tf(self) -> Iterator[Message]:
+        columns = self._pose_columns()
+        if not columns:
+            return
+        steps = self.rec.steps
+        times = steps["time"]
+        names = sorted(columns)
+        for row in range(len(times)):
+            t = nanoseconds(times[row])
+            transforms = [
+                transform(t, WORLD, frame_name(n, self._kind(n)), columns[n][row]) for n in names
+            ]
+            yield Message(t, 0, "/tf", TF, {"transforms": transforms})
+
+    def _static_tf(self) -> Iterator[Message]:
+        poses = self._static_poses()
+        if poses:
+            transforms = [transform(0, WORLD, name, pose) for name, pose in sorted(poses.items())]
+            yield Message(0, 0, "/tf_static", TF, {"transforms": transforms})
+
+    def _wrenches(self) -> Iterator[Message]:
+        steps = self.rec.steps
+        drills = self._drills()
+        if not drills:
+            return
+        times = steps["time"]
+        forces = {d: steps[f"{d}.force"] for d in drills}
+        for row in range(len(times)):
+            t = nanoseconds(times[row])
+            for drill in drills:
+                f = forces[drill][row]
+                body = {
+                    "header": header(t, WORLD),
+                    "wrench": {
+                        "force": {"x": float(f[0]), "y": float(f[1]), "z": float(f[2])},
+                        "torque": {"x": 0.0, "y": 0.0, "z": 0.0},
+                    },
+                }
+                yield Message(t, 2, f"/{drill}/wrench", WRENCH, body)
+
+    def _removed(self) -> Iterator[Message]:
+        removed = self.rec.removed
+        if not len(removed["step"]):
+            return
+        volume = removed["volume"]
+        dimensions, shape = self._volume_geometry(volume)
+        size = dimensions / shape
+        steps = removed["step"]
+        bounds = np.flatnonzero(np.diff(steps)) + 1
+        starts, stops = np.r_[0, bounds], np.r_[bounds, len(steps)]
+        times = self.clock(steps[starts])
+        for start, stop, time in zip(starts, stops, times):
+            voxels = removed["voxel"][start:stop].astype(np.int64)
+            centres = (voxels + 0.5) * size - dimensions / 2
+            columns = {"x": centres[:, 0], "y": centres[:, 1], "z": centres[:, 2],
+                       "i": voxels[:, 0], "j": voxels[:, 1], "k": voxels[:, 2],
+                       "label": removed["label"][start:stop]}  # fmt: skip
+            t = nanoseconds(time)
+            yield Message(t, 3, "/drilling/removed_voxels", POINT_CLOUD,
+                          point_cloud(t, volume, columns, 1, stop - start))  # fmt: skip
+
+    def _events(self) -> Iterator[Message]:
+        events = self.rec.events
+        if not events:
+            return
+        volume = self.rec.removed["volume"]
+        labels = (self.names.get(volume) or {}).get("labels", {})
+        by_step: dict[int, list] = {}
+        for event in events:
+            by_step.setdefault(event["step"], []).append(event)
+        for step in sorted(by_step):
+            t = nanoseconds(self.clock([step])[0])
+            statuses = []
+            for event in by_step[step]:
+                name = (labels.get(event["label"]) or {}).get("name", f"label {event['label']}")
+                voxel = event["voxel"]
+                statuses.append({
+                    "level": DIAGNOSTIC_ERROR if event["kind"] == "critical" else DIAGNOSTIC_WARN,
+                    "name": event["kind"],
+                    "message": f"{event['kind']}: {name} (label {event['label']}) at voxel "
+                    f"{tuple(voxel)}",
+                    "hardware_id": volume or "",
+                    "values": [{"key": k, "value": str(v)} for k, v in (
+                        ("step", step), ("kind", event["kind"]), ("label", event["label"]),
+                        ("label_name", name), ("voxel_i", voxel[0]), ("voxel_j", voxel[1]),
+                        ("voxel_k", voxel[2]))],
+                })  # fmt: skip
+            yield Message(t, 4, "/drilling/events", DIAGNOSTICS,
+                          {"header": header(t, volume or WORLD), "status": statuses})  # fmt: skip
+
+
+# Writers --------------------------------------------------------------------------------------
+
+
+def typestore():
+    """rosbags' type store of the message definitions used here."""
+    typesys = require("export", "rosbags.typesys")
+    return typesys.get_typestore(getattr(typesys.Stores, TYPESTORE))
+
+
+def for_mcap_ros2(value):
+    """A message tree as mcap-ros2-support's encoder takes it: uint8 arrays as bytes, other
+    arrays as lists."""
+    if isinstance(value, dict):
+        return {k: for_mcap_ros2(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [for_mcap_ros2(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return value.tobytes() if value.dtype == np.uint8 else value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+_NUMPY_TYPES = {"bool": np.bool_, "byte": np.uint8, "char": np.uint8, "int8": np.int8,
+                "uint8": np.uint8, "int16": np.int16, "uint16": np.uint16, "int32": np.int32,
+                "uint32": np.uint32, "int64": np.int64, "uint64": np.uint64,
+                "float32": np.float32, "float64": np.float64}  # fmt: skip
+
+
+def for_rosbags(store, value, msgtype: str):
+    """A message tree as a rosbags message object of the type store."""
+    _, fields = store.fielddefs[msgtype]
+    values = {}
+    for name, (node, detail) in fields:
+        raw = value.get(name) if isinstance(value, dict) else None
+        values[name] = _rosbags_field(store, node.name, detail, raw)
+    return store.types[msgtype](**values)
+
+
+def _rosbags_field(store, node: str, detail, raw):
+    if node == "BASE":
+        kind = detail[0]
+        if kind == "string":
+            return "" if raw is None else str(raw)
+        return _NUMPY_TYPES[kind](0 if raw is None else raw).item()
+    if node == "NAME":
+        return for_rosbags(store, raw or {}, detail)
+    (inner, inner_detail), _ = detail
+    if inner.name == "BASE" and inner_detail[0] != "string":
+        dtype = _NUMPY_TYPES[inner_detail[0]]
+        if raw is None:
+            return np.empty(0, dtype)
+        return np.frombuffer(raw, dtype) if isinstance(raw, bytes) else np.asarray(raw, dtype)
+    return [_rosbags_field(store, inner.name, inner_detail, item) for item in (raw or [])]
+
+
+class McapSink:
+    """Writes messages to an MCAP file with ROS 2 CDR encoding (mcap-ros2-support)."""
+
+    def __init__(self, path: Path, compression: str | None = "zstd") -> None:
+        writer_module, mcap_writer = require("export", "mcap_ros2.writer", "mcap.writer")
+        kinds = {"zstd": "ZSTD", "lz4": "LZ4", None: "NONE"}
+        if compression not in kinds:
+            raise ExportError(f"MCAP compression is zstd, lz4 or None, not {compression!r}")
+        self._file = open(path, "wb")  # noqa: SIM115 (closed by close())
+        self._writer = writer_module.Writer(
+            self._file,
+            chunk_size=4 * 1024 * 1024,
+            compression=getattr(mcap_writer.CompressionType, kinds[compression]),
+        )
+        self._store = typestore()
+        self._schemas: dict[str, object] = {}
+        self._sequence: dict[str, int] = {}
+
+    def write(self, message: Message) -> None:
+        schema = self._schemas.get(message.msgtype)
+        if schema is None:
+            text, _ = self._store.generate_msgdef(message.msgtype, ros_version=2)
+            schema = self._schemas[message.msgtype] = self._writer.register_msgdef(
+                message.msgtype, text
+            )
+        sequence = self._sequence.get(message.topic, 0)
+        self._sequence[message.topic] = sequence + 1
+        self._writer.write_message(message.topic, schema, for_mcap_ros2(message.body),
+                                   log_time=message.time, publish_time=message.time,
+                                   sequence=sequence)  # fmt: skip
+
+    def close(self, metadata: dict[str, str]) -> None:
+        try:
+            self._writer.add_metadata("ambfplus", metadata)
+            self._writer.finish()
+        finally:
+            self._file.close()
+
+    def abort(self) -> None:
+        self._file.close()
+
+
+class Rosbag2Sink:
+    """Writes messages to a rosbag2 folder (metadata.yaml + MCAP storage, zstd chunks) with
+    rosbags, which also serialises them (CDR)."""
+
+    def __init__(self, path: Path, topics: dict[str, str]) -> None:
+        rosbag2, interfaces = require("export", "rosbags.rosbag2", "rosbags.interfaces")
+        self._store = typestore()
+        self._writer = rosbag2.Writer(path, version=9,
+                                      storage_plugin=rosbag2.StoragePlugin.MCAP)  # fmt: skip
+        self._writer.set_compression(rosbag2.CompressionMode.STORAGE,
+                                     rosbag2.CompressionFormat.ZSTD)  # fmt: skip
+        self._writer.open()
+        # /tf_static is latched in ROS 2 (transient local): players must republish it.
+        latched = interfaces.Qos(
+            interfaces.QosHistory.KEEP_LAST, 1, interfaces.QosReliability.RELIABLE,
+            interfaces.QosDurability.TRANSIENT_LOCAL, interfaces.QosTime(0, 0),
+            interfaces.QosTime(0, 0), interfaces.QosLiveliness.AUTOMATIC,
+            interfaces.QosTime(0, 0), False,
+        )  # fmt: skip
+        self._connections = {
+            topic: self._writer.add_connection(
+                topic,
+                msgtype,
+                typestore=self._store,
+                offered_qos_profiles=[latched] if topic == "/tf_static" else [],
+            )  # fmt: skip
+            for topic, msgtype in topics.items()
+        }
+
+    def write(self, message: Message) -> None:
+        body = for_rosbags(self._store, message.body, message.msgtype)
+        data = self._store.serialize_cdr(body, message.msgtype)
+        self._writer.write(self._connections[message.topic], message.time, data)
+
+    def close(self, metadata: dict[str, str]) -> None:
+        for key, value in metadata.items():
+            self._writer.set_custom_data(f"ambfplus.{key}", value)
+        self._writer.close()
+
+    def abort(self) -> None:
+        self._writer.abort()
+
+
+def write_ros(recording, out: Path, kind: str, bar, *, point_clouds: bool = True,
+              compression: str | None = "zstd") -> dict:  # fmt: skip
+    """Writes a recording as an MCAP file (kind "mcap") or a rosbag2 folder ("rosbag2") at
+    ``out`` (a path that does not exist yet); returns counts per topic."""
+    export = RosExport(recording, point_clouds=point_clouds)
+    topics = export.topics()
+    if kind == "mcap":
+        sink = McapSink(out, compression)
+    else:
+        sink = Rosbag2Sink(out, topics)
+    counts = {topic: 0 for topic in topics}
+    frame_topics = {f"/{name}/camera_info" for name in recording.cameras}
+    try:
+        for message in export.messages():
+            sink.write(message)
+            counts[message.topic] += 1
+            if message.topic in frame_topics:
+                bar.update(1)
+    except BaseException:
+        sink.abort()
+        raise
+    sink.close(export.describe())
+    return {"topics": topics, "messages": counts, "warnings": export.warnings,
+            "frames": export.frames()}  # fmt: skip

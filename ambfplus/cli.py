@@ -1,5 +1,6 @@
 """The ``ambfplus`` command line: ``demo``, ``convert``, ``launch``, ``validate``, ``export``,
-``info`` (and ``--cmake-dir``, the folder of the CMake package C++ plugins build against)."""
+``info``, ``doctor`` (and ``--cmake-dir``, the folder of the CMake package C++ plugins build
+against)."""
 
 from __future__ import annotations
 
@@ -377,6 +378,12 @@ def main(argv: list[str] | None = None) -> int:
     exporter.add_argument("--no-images", action="store_true",
                           help="coco: annotations only, no PNG frames")  # fmt: skip
     commands.add_parser("info", help="print the version and the OpenGL device")
+    doctor = commands.add_parser(
+        "doctor",
+        help="what the engine finds on this machine (renderer, EGL devices and drivers, optional "
+        "libraries, extras) and what to install for what is missing; exits 1 if it cannot render",
+    )
+    doctor.add_argument("--json", action="store_true", help="print the checks as JSON")
     args = parser.parse_args(argv)
     if args.command == "validate":
         return run_validate(args)
@@ -402,6 +409,10 @@ def main(argv: list[str] | None = None) -> int:
             )
         )
         return 0
+    if args.command == "doctor":
+        from .doctor import main as doctor
+
+        return doctor(as_json=args.json)
     if args.command == "info":
         print(json.dumps({"version": __version__, "gl": gl_info()}, indent=2))
         return 0

@@ -8,6 +8,12 @@ find_package(Eigen3 3.3 REQUIRED NO_MODULE)
 add_library(ambfplus_dep_eigen INTERFACE)
 target_link_libraries(ambfplus_dep_eigen INTERFACE Eigen3::Eigen)
 add_library(ambfplus::dep_eigen ALIAS ambfplus_dep_eigen)
+# Its licence travels with the headers the package installs (Debian's copyright file).
+find_file(AMBFPLUS_EIGEN_LICENSE copyright PATHS /usr/share/doc/libeigen3-dev NO_DEFAULT_PATH)
+if(SKBUILD AND NOT AMBFPLUS_EIGEN_LICENSE)
+  message(WARNING "Eigen's licence file (Debian: /usr/share/doc/libeigen3-dev/copyright) not "
+    "found: the package installs Eigen's headers without it")
+endif()
 
 # assimp: mesh files.
 find_package(assimp REQUIRED)

@@ -1,0 +1,375 @@
+"""The self-contained wheel (.ci/build-wheel): its manylinux tag, every shared object resolving
+inside the wheel or to the system libraries a wheel may use, licences for what it bundles, a C++
+plugin built against it, and a fresh Debian root filesystem with no compiler and no -dev package
+where an unprivileged user installs it offline, checks it with `ambfplus doctor` and records the
+demo.
+
+The wheel is built once per session from this repository (about a minute on a warm build tree),
+or taken from AMBFPLUS_WHEEL. The root filesystem test needs root, debootstrap and the Debian
+mirror apt uses; it skips with the reason where any is missing."""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import time
+import urllib.request
+import zipfile
+from pathlib import Path
+
+import pytest
+from wheel_tools import (
+    REPO,
+    download_wheelhouse,
+    glibc_version,
+    install_into_new_venv,
+    wheel_or_build,
+)
+
+auditwheel = pytest.importorskip("auditwheel", reason="needs auditwheel (pip: ambfplus[test])")
+elftools = pytest.importorskip("elftools", reason="needs pyelftools (comes with auditwheel)")
+from elftools.elf.dynamic import DynamicSection  # noqa: E402
+from elftools.elf.elffile import ELFFile  # noqa: E402
+
+# The GL vendor-neutral dispatch libraries: the system's (the driver sits behind them).
+GL_DISPATCH = {"libEGL.so.1", "libOpenGL.so.0", "libGL.so.1"}
+# What the engine needs bundled (original file names, before auditwheel's hash).
+MUST_BUNDLE = ("libBulletDynamics", "libBulletCollision", "libBulletSoftBody", "libLinearMath",
+               "libassimp", "libyaml-cpp", "libopencv_core", "libopencv_imgproc",
+               "libopencv_imgcodecs", "libepoxy")  # fmt: skip
+# The packages the issue allows in the root filesystem: Python, glvnd and Mesa's drivers.
+ROOTFS_PACKAGES = ("python3", "python3-venv", "libegl1", "libopengl0", "libegl-mesa0",
+                   "libgl1-mesa-dri")  # fmt: skip
+SIM_UID = 4242
+
+
+@pytest.fixture(scope="session")
+def wheel(tmp_path_factory) -> Path:
+    if not os.environ.get("AMBFPLUS_WHEEL") and not (REPO / ".ci" / "build-wheel").is_file():
+        pytest.skip("no wheel: set AMBFPLUS_WHEEL or run from the repository (.ci/build-wheel)")
+    return wheel_or_build(tmp_path_factory.mktemp("wheel"))
+
+
+@pytest.fixture(scope="session")
+def unpacked(wheel, tmp_path_factory) -> Path:
+    folder = tmp_path_factory.mktemp("unpacked")
+    with zipfile.ZipFile(wheel) as archive:
+        archive.extractall(folder)
+    return folder
+
+
+@pytest.fixture(scope="session")
+def auditwheel_show(wheel):
+    """`auditwheel show` started at once (it takes a minute) and collected when needed."""
+    process = subprocess.Popen(
+        [sys.executable, "-m", "auditwheel", "show", str(wheel)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+    )
+    yield process
+    if process.poll() is None:
+        process.kill()
+        process.wait()
+
+
+def platform_tag(wheel: Path) -> str:
+    """The platform tag of a wheel's file name."""
+    return wheel.name[: -len(".whl")].split("-")[-1]
+
+
+def policy_whitelist(tag: str) -> set[str]:
+    """The libraries auditwheel's policy for this tag lets a wheel take from the system."""
+    policies = json.loads(
+        (Path(auditwheel.__file__).parent / "policy" / "manylinux-policy.json").read_text()
+    )
+    name = re.sub(r"_x86_64$", "", tag)
+    (policy,) = [p for p in policies if p["name"] == name or name in p.get("aliases", [])]
+    return set(policy["lib_whitelist"])
+
+
+def elf_dependencies(path: Path) -> tuple[list[str], list[str]]:
+    """The NEEDED entries and the RUNPATH (or RPATH) folders of an ELF file."""
+    needed, paths = [], []
+    with open(path, "rb") as f:
+        for section in ELFFile(f).iter_sections():
+            if isinstance(section, DynamicSection):
+                for tag in section.iter_tags():
+                    if tag.entry.d_tag == "DT_NEEDED":
+                        needed.append(tag.needed)
+                    elif tag.entry.d_tag == "DT_RUNPATH":
+                        paths += tag.runpath.split(":")
+                    elif tag.entry.d_tag == "DT_RPATH":
+                        paths += tag.rpath.split(":")
+    return needed, paths
+
+
+def shared_objects(folder: Path) -> list[Path]:
+    found = []
+    for path in sorted(folder.rglob("*.so*")):
+        if path.is_file() and path.read_bytes()[:4] == b"\x7fELF":
+            found.append(path)
+    return found
+
+
+def test_auditwheel_reports_the_manylinux_tag_of_the_file_name(wheel, auditwheel_show):
+    output, _ = auditwheel_show.communicate(timeout=900)
+    assert auditwheel_show.returncode == 0, output
+    match = re.search(r'consistent\s+with\s+the\s+following\s+platform\s+tag:\s+"([^"]+)"', output)
+    assert match, output
+    assert match.group(1).startswith("manylinux_"), output
+    assert match.group(1) == platform_tag(wheel)
+
+
+def test_every_shared_object_resolves_inside_the_wheel_or_to_allowed_system_libraries(
+    wheel, unpacked
+):
+    # glibc's own loader is part of glibc, which the policy's list names by its libraries.
+    allowed = policy_whitelist(platform_tag(wheel)) | GL_DISPATCH | {"ld-linux-x86-64.so.2"}
+    objects = shared_objects(unpacked)
+    assert len(objects) > 50, "the wheel bundles its libraries"
+    outside: dict[str, set[str]] = {}
+    for elf in objects:
+        needed, runpath = elf_dependencies(elf)
+        folders = [Path(p.replace("$ORIGIN", str(elf.parent))).resolve() for p in runpath]
+        for name in needed:
+            inside = [f / name for f in folders if (f / name).is_file()]
+            if inside:
+                assert inside[0].resolve().is_relative_to(unpacked.resolve()), (elf, name)
+                continue
+            outside.setdefault(name, set()).add(elf.name)
+    not_allowed = {name: users for name, users in outside.items() if name not in allowed}
+    assert not not_allowed, f"needed from the system but not allowed there: {not_allowed}"
+    # The engine's own libraries are found through $ORIGIN, never from the system.
+    assert "libambfplus.so" not in outside
+    bundled = [p.name for p in (unpacked / "ambfplus.libs").iterdir()]
+    for library in MUST_BUNDLE:
+        assert any(re.match(rf"{re.escape(library)}-[0-9a-f]{{8}}\.", b) for b in bundled), library
+    assert not [b for b in bundled if b.split("-")[0] in {"libEGL", "libOpenGL", "libGL"}]
+
+
+def test_every_bundled_library_comes_with_its_licence(unpacked):
+    (dist_info,) = unpacked.glob("ambfplus-*.dist-info")
+    licences = dist_info / "licenses" / "third_party"
+    manifest = json.loads((licences / "third_party.json").read_text())
+    listed = {entry["file"]: entry for entry in manifest["libraries"]}
+    bundled = {f"ambfplus.libs/{p.name}" for p in (unpacked / "ambfplus.libs").iterdir()}
+    assert bundled == set(listed)
+    for entry in listed.values():
+        text = (dist_info / "licenses" / entry["license_file"]).read_text(errors="replace")
+        assert "Copyright" in text or "copyright" in text, entry["license_file"]
+    # Eigen's headers ship for plugins, with their licence.
+    assert (unpacked / "ambfplus" / "include" / "eigen3" / "Eigen" / "Core").is_file()
+    assert "MPL" in (licences / "eigen3.copyright").read_text()
+
+
+@pytest.fixture(scope="session")
+def host_venv(wheel, tmp_path_factory) -> Path:
+    """A venv without the machine's packages, the wheel installed in it offline."""
+    folder = tmp_path_factory.mktemp("wheel_venv")
+    try:
+        wheelhouse = download_wheelhouse(
+            wheel, folder / "wheelhouse", sys.version_info[:2], glibc_version()
+        )
+    except RuntimeError as error:
+        pytest.skip(f"cannot download the wheel's dependencies: {error}")
+    python, _ = install_into_new_venv(folder / "venv", wheel, wheelhouse)
+    return python
+
+
+def test_a_cpp_plugin_builds_against_the_installed_wheel(host_venv, tmp_path):
+    cmake, compiler = shutil.which("cmake"), shutil.which("c++") or shutil.which("g++")
+    if cmake is None or compiler is None:
+        pytest.skip("building a plugin needs cmake and a C++ compiler")
+    # Run from elsewhere: in the repository, `-m ambfplus` would find the source folder.
+    printed = subprocess.run(
+        [str(host_venv), "-m", "ambfplus", "--cmake-dir"],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+    )
+    assert printed.returncode == 0, printed.stderr
+    cmake_dir = printed.stdout.strip()
+    site = Path(cmake_dir).parents[1]
+    assert Path(cmake_dir).is_relative_to(host_venv.parents[1])
+    build = tmp_path / "build"
+    subprocess.run([cmake, "-S", str(REPO / "plugins" / "body_spinner"), "-B", str(build),
+                    f"-Dambfplus_DIR={cmake_dir}", "-DCMAKE_BUILD_TYPE=Release",
+                    "-DCMAKE_EXPORT_COMPILE_COMMANDS=ON"],
+                   check=True, capture_output=True)  # fmt: skip
+    built = subprocess.run([cmake, "--build", str(build), "-j2"], capture_output=True, text=True)
+    assert built.returncode == 0, built.stdout + built.stderr
+    # Eigen comes from the wheel, not from a system -dev package.
+    command = json.loads((build / "compile_commands.json").read_text())[0]["command"]
+    assert f"{site}/ambfplus/include/eigen3" in command, command
+    assert "/usr/include/eigen3" not in command
+    plugin = build / "libbody_spinner.so"
+    # Loaded into the wheel's engine, it turns a body a quarter turn in a simulated second.
+    script = f"""
+import numpy as np, ambfplus
+world = ambfplus.World()
+ball = world.add_body("ball", "box", size=(0.1, 0.2, 0.3), mass=1.0)
+world.load_plugin({str(plugin)!r}, ball)
+world.step(1000)
+print(np.round(ball.pose[:3, :3], 6).tolist())
+"""
+    result = subprocess.run([str(host_venv), "-c", script], capture_output=True, text=True,
+                            cwd=tmp_path)  # fmt: skip
+    assert result.returncode == 0, result.stderr
+    rotation = json.loads(result.stdout.strip().splitlines()[-1])
+    quarter = [[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]
+    assert max(abs(a - b) for r, q in zip(rotation, quarter) for a, b in zip(r, q)) < 1e-2
+
+
+# The root filesystem test.
+
+
+def debian_mirror() -> tuple[str, str]:
+    """(mirror URL, release codename) of the main Debian archive apt uses here."""
+    codename = ""
+    for line in Path("/etc/os-release").read_text().splitlines():
+        if line.startswith("VERSION_CODENAME="):
+            codename = line.split("=", 1)[1].strip('"')
+    sources = [Path("/etc/apt/sources.list"), *sorted(Path("/etc/apt/sources.list.d").glob("*"))]
+    for source in sources:
+        if not source.is_file():
+            continue
+        text = source.read_text()
+        # deb822 stanzas (URIs: / Suites:) and one-line entries (deb URI suite components).
+        for stanza in re.split(r"\n\s*\n", text):
+            fields = dict(re.findall(r"^(\w[\w-]*):\s*(.*)$", stanza, flags=re.MULTILINE))
+            if (
+                "deb" in fields.get("Types", "").split()
+                and codename in fields.get("Suites", "").split()
+            ):
+                return fields["URIs"].split()[0].rstrip("/"), codename
+        for match in re.finditer(r"^deb\s+(?:\[[^\]]*\]\s+)?(\S+)\s+(\S+)", text, re.MULTILINE):
+            if match.group(2) == codename:
+                return match.group(1).rstrip("/"), codename
+    raise LookupError(f"no apt source for the Debian release {codename!r}")
+
+
+def mounts_below(root: Path) -> list[str]:
+    """Mount points at or under `root` (from /proc/self/mounts)."""
+    prefix = str(root.resolve())
+    points = [line.split()[1] for line in Path("/proc/self/mounts").read_text().splitlines()]
+    return [p for p in points if p == prefix or p.startswith(prefix + "/")]
+
+
+@pytest.fixture
+def rootfs(tmp_path):
+    """A minimal Debian root filesystem of this machine's release, made by debootstrap with
+    only Python, glvnd and Mesa's drivers; /proc mounted while the test runs."""
+    if os.geteuid() != 0:
+        pytest.skip("making a root filesystem (debootstrap, chroot) needs root")
+    if shutil.which("debootstrap") is None:
+        pytest.skip("needs debootstrap (Debian: apt-get install debootstrap)")
+    try:
+        mirror, codename = debian_mirror()
+        urllib.request.urlopen(f"{mirror}/dists/{codename}/Release", timeout=15).close()
+    except (LookupError, OSError) as error:
+        pytest.skip(f"no Debian mirror to make a root filesystem from: {error}")
+    root = tmp_path / "root"
+    # Downloaded packages are kept under build/ (rebuildable), so a second run skips downloads.
+    cache = REPO / "build" / "debootstrap-cache"
+    cache.mkdir(parents=True, exist_ok=True)
+    made = subprocess.run(
+        ["debootstrap", "--variant=minbase", f"--include={','.join(ROOTFS_PACKAGES)}",
+         f"--cache-dir={cache}", codename, str(root), mirror],
+        capture_output=True, text=True,
+    )  # fmt: skip
+    if made.returncode != 0:
+        log = root / "debootstrap" / "debootstrap.log"
+        detail = log.read_text()[-3000:] if log.is_file() else made.stderr[-3000:]
+        pytest.fail(f"debootstrap failed:\n{detail}")
+    try:
+        subprocess.run(["mount", "-t", "proc", "proc", str(root / "proc")], check=True)
+        subprocess.run(["mount", "-t", "tmpfs", "-o", "size=256m", "shm", str(root / "dev/shm")],
+                       check=True)  # fmt: skip
+        subprocess.run(["chroot", str(root), "useradd", "--create-home", "--uid", str(SIM_UID),
+                        "sim"], check=True)  # fmt: skip
+        yield root
+    finally:
+        for point in sorted(mounts_below(root), key=len, reverse=True):
+            subprocess.run(["umount", point], check=False)
+        left = mounts_below(root)
+        if left:  # never delete through a mount
+            pytest.fail(f"could not unmount {left}")
+        shutil.rmtree(root, ignore_errors=True)
+
+
+def as_sim(root: Path, command: str, env: dict[str, str] | None = None, timeout: float = 600):
+    """Runs a shell command in the root filesystem as the unprivileged user `sim`, in a network
+    namespace of its own (loopback only), so nothing there can reach the network."""
+    environment = {"HOME": "/home/sim", "USER": "sim", "PATH": "/home/sim/venv/bin:/usr/bin:/bin",
+                   "LANG": "C.UTF-8", **(env or {})}  # fmt: skip
+    settings = [f"{key}={value}" for key, value in environment.items()]
+    return subprocess.run(
+        ["unshare", "--net", "chroot", f"--userspec={SIM_UID}:{SIM_UID}", str(root),
+         "/usr/bin/env", "-i", *settings, "/bin/sh", "-c", f"cd /home/sim && {command}"],
+        capture_output=True, text=True, timeout=timeout,
+    )  # fmt: skip
+
+
+def test_the_wheel_installs_and_records_the_demo_in_a_minimal_debian_as_a_user(
+    wheel, rootfs, tmp_path
+):
+    root = rootfs
+    # Nothing to build with: no compiler, no headers of the engine's libraries.
+    assert not (root / "usr/bin/gcc").exists() and not (root / "usr/bin/c++").exists()
+    assert not (root / "usr/include/eigen3").exists() and not (root / "usr/include/bullet").exists()
+    versions = (
+        "import platform as p, sys; print(*sys.version_info[:2], *p.libc_ver()[1].split('.'))"
+    )
+    python = subprocess.run(
+        ["chroot", str(root), "python3", "-c", versions], capture_output=True, text=True, check=True
+    ).stdout.split()
+    python_version, glibc = (int(python[0]), int(python[1])), (int(python[2]), int(python[3]))
+    dist = root / "dist"
+    dist.mkdir()
+    try:
+        download_wheelhouse(wheel, dist, python_version, glibc)
+    except RuntimeError as error:
+        pytest.skip(f"cannot download the wheel's dependencies for the root filesystem: {error}")
+    shutil.copy(wheel, dist)
+
+    start = time.perf_counter()
+    installed = as_sim(root, "python3 -m venv venv && venv/bin/pip install -q --no-index "
+                             f"--find-links /dist /dist/{wheel.name}")  # fmt: skip
+    assert installed.returncode == 0, installed.stdout + installed.stderr
+    print(f"install in the root filesystem: {time.perf_counter() - start:.1f} s")
+
+    # Every shared object of the installed package finds all it needs there.
+    ldd = as_sim(root, "for f in $(find venv/lib -name '*.so*' -path '*ambfplus*'); do "
+                       "ldd $f | sed \"s|^|$f: |\"; done")  # fmt: skip
+    assert ldd.returncode == 0, ldd.stderr
+    assert "not found" not in ldd.stdout, [x for x in ldd.stdout.splitlines() if "not found" in x]
+    assert ldd.stdout.count("=>") > 100
+
+    # doctor: no EGL driver visible -> says so, says how to fix it, exits 1; with Mesa's -> 0.
+    empty = as_sim(root, "ambfplus doctor", env={"__EGL_VENDOR_LIBRARY_DIRS": "/nonexistent"})
+    assert empty.returncode == 1, empty.stdout + empty.stderr
+    assert "no EGL driver is installed" in empty.stdout
+    assert "apt-get install libegl-mesa0 libgl1-mesa-dri" in empty.stdout
+    assert "cannot render here" in empty.stdout
+    doctor = as_sim(root, "ambfplus doctor")
+    assert doctor.returncode == 0, doctor.stdout + doctor.stderr
+    assert "self-contained wheel" in doctor.stdout and "llvmpipe" in doctor.stdout
+
+    demo = as_sim(root, "ambfplus demo --out demo --width 320 --height 240 --every 100")
+    assert demo.returncode == 0, demo.stdout + demo.stderr
+    checked = as_sim(root, "ambfplus validate demo/session.h5")
+    assert checked.returncode == 0, checked.stdout + checked.stderr
+    frame = json.loads((root / "home/sim/demo/frame.json").read_text())
+    assert frame["recording"]["frames"] > 0 and frame["recording"]["voxels_removed"] > 0
+    assert "llvmpipe" in frame["gl"]["renderer"]
+    # The recording made inside validates with this machine's own package as well.
+    here = subprocess.run(
+        [sys.executable, "-m", "ambfplus", "validate", str(root / "home/sim/demo/session.h5")],
+        capture_output=True, text=True, cwd=tmp_path,
+    )  # fmt: skip
+    assert here.returncode == 0, here.stdout + here.stderr

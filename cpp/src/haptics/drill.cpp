@@ -1,4 +1,5 @@
 #include "ambfplus/haptics/drill.h"
+#include "ambfplus/errors.h"
 
 #include <time.h>
 #include <algorithm>
@@ -30,31 +31,30 @@ constexpr double kPi = 3.14159265358979323846;
 Drill::Drill(Model& model, const DrillSpec& spec, int id)
     : Object(model, spec.name, id), volume_(spec.volume), spec_(spec), burr_(spec.burr) {
   const std::string who = "drill '" + spec.name + "': ";
-  if (volume_ == nullptr) throw std::invalid_argument(who + "needs a volume to drill");
+  if (volume_ == nullptr) throw ArgumentError(who + "needs a volume to drill");
   if (&volume_->world() != &model.world()) {
-    throw std::invalid_argument(who + "its volume must be in the same world");
+    throw ArgumentError(who + "its volume must be in the same world");
   }
-  if (spec_.burr_diameters.empty()) throw std::invalid_argument(who + "needs at least one burr");
+  if (spec_.burr_diameters.empty()) throw ArgumentError(who + "needs at least one burr");
   for (double d : spec_.burr_diameters) {
-    if (!(d > 0)) throw std::invalid_argument(who + "burr diameters must be > 0");
+    if (!(d > 0)) throw ArgumentError(who + "burr diameters must be > 0");
   }
   if (spec_.cursors < 1 || spec_.cursors > 16) {
-    throw std::invalid_argument(who + "cursors must be 1..16, got " +
-                                std::to_string(spec_.cursors));
+    throw ArgumentError(who + "cursors must be 1..16, got " + std::to_string(spec_.cursors));
   }
-  if (!(spec_.spacing > 0)) throw std::invalid_argument(who + "cursor spacing must be > 0");
+  if (!(spec_.spacing > 0)) throw ArgumentError(who + "cursor spacing must be > 0");
   if (spec_.shaft_radii.empty()) {
     for (int i = 1; i < spec_.cursors; ++i) spec_.shaft_radii.push_back(0.00065 + 0.0001 * (i - 1));
   }
   if (static_cast<int>(spec_.shaft_radii.size()) != spec_.cursors - 1) {
-    throw std::invalid_argument(who + "needs " + std::to_string(spec_.cursors - 1) +
-                                " shaft radii, got " + std::to_string(spec_.shaft_radii.size()));
+    throw ArgumentError(who + "needs " + std::to_string(spec_.cursors - 1) + " shaft radii, got " +
+                        std::to_string(spec_.shaft_radii.size()));
   }
   if (spec_.voxels_per_step.size() != spec_.burr_diameters.size()) {
-    throw std::invalid_argument(who + "voxels_per_step needs one count per burr");
+    throw ArgumentError(who + "voxels_per_step needs one count per burr");
   }
   if (!(spec_.max_force > 0) || spec_.damping < 0 || spec_.soft_start < 0) {
-    throw std::invalid_argument(who + "max_force must be > 0, damping and soft_start >= 0");
+    throw ArgumentError(who + "max_force must be > 0, damping and soft_start >= 0");
   }
   set_stiffness(spec_.stiffness);
   set_cutting_rate(spec_.cutting_rate);
@@ -82,19 +82,18 @@ Drill::Drill(Model& model, const DrillSpec& spec, int id)
 Drill::~Drill() = default;
 
 void Drill::set_goal(const Eigen::Isometry3d& goal) {
-  if (!goal.matrix().allFinite()) throw std::invalid_argument("drill goal must be finite");
+  if (!goal.matrix().allFinite()) throw ArgumentError("drill goal must be finite");
   goal_ = goal;
 }
 
 void Drill::set_speed(double speed) {
-  if (!(speed >= 0.0 && speed <= 1.0)) throw std::invalid_argument("drill speed must be in 0..1");
+  if (!(speed >= 0.0 && speed <= 1.0)) throw ArgumentError("drill speed must be in 0..1");
   speed_ = speed;
 }
 
 void Drill::set_burr(int index) {
   if (index < 0 || index >= static_cast<int>(spec_.burr_diameters.size())) {
-    throw std::invalid_argument("burr index must be 0.." +
-                                std::to_string(spec_.burr_diameters.size() - 1));
+    throw ArgumentError("burr index must be 0.." + std::to_string(spec_.burr_diameters.size() - 1));
   }
   burr_ = index;
   if (!cursors_.empty()) cursors_[0].set_radius(burr_radius());
@@ -102,35 +101,32 @@ void Drill::set_burr(int index) {
 
 void Drill::set_voxels_per_step(int burr, int count) {
   if (burr < 0 || burr >= static_cast<int>(spec_.voxels_per_step.size()) || count < 1) {
-    throw std::invalid_argument("voxels per step: burr must be 0.." +
-                                std::to_string(spec_.voxels_per_step.size() - 1) +
-                                " and count >= 1");
+    throw ArgumentError("voxels per step: burr must be 0.." +
+                        std::to_string(spec_.voxels_per_step.size() - 1) + " and count >= 1");
   }
   spec_.voxels_per_step[burr] = count;
 }
 
 void Drill::set_stiffness(double k) {
-  if (!(k > 0) || !std::isfinite(k)) throw std::invalid_argument("stiffness must be > 0 N/m");
+  if (!(k > 0) || !std::isfinite(k)) throw ArgumentError("stiffness must be > 0 N/m");
   spec_.stiffness = k;
 }
 
 void Drill::set_cutting_rate(double rate) {
-  if (!(rate >= 0) || !std::isfinite(rate))
-    throw std::invalid_argument("cutting rate must be >= 0");
+  if (!(rate >= 0) || !std::isfinite(rate)) throw ArgumentError("cutting rate must be >= 0");
   spec_.cutting_rate = rate;
 }
 
 void Drill::set_hardness(std::uint16_t label, double hardness) {
-  if (!(hardness > 0) || !std::isfinite(hardness))
-    throw std::invalid_argument("hardness must be > 0");
+  if (!(hardness > 0) || !std::isfinite(hardness)) throw ArgumentError("hardness must be > 0");
   hardness_[label] = hardness;
 }
 
 void Drill::set_waypoints(const std::vector<DrillWaypoint>& waypoints) {
   double last = 0;
   for (const DrillWaypoint& w : waypoints) {
-    if (!(w.time >= last)) throw std::invalid_argument("waypoint times must not decrease from 0");
-    if (!(w.speed >= 0 && w.speed <= 1)) throw std::invalid_argument("waypoint speed must be 0..1");
+    if (!(w.time >= last)) throw ArgumentError("waypoint times must not decrease from 0");
+    if (!(w.speed >= 0 && w.speed <= 1)) throw ArgumentError("waypoint speed must be 0..1");
     checked_pose(w.pose);
     last = w.time;
   }

@@ -1,4 +1,5 @@
 #include "ambfplus/haptics/input_device.h"
+#include "ambfplus/errors.h"
 
 #include <algorithm>
 #include <stdexcept>
@@ -11,13 +12,13 @@ namespace ambfplus {
 InputDevice::InputDevice(Model& model, const InputDeviceSpec& spec, int id)
     : Object(model, spec.name, id), spec_(spec) {
   const std::string who = "input device '" + spec.name + "': ";
-  if (!spec_.device) throw std::invalid_argument(who + "needs a device");
-  if (spec_.drill == nullptr) throw std::invalid_argument(who + "needs a drill to drive");
+  if (!spec_.device) throw ArgumentError(who + "needs a device");
+  if (spec_.drill == nullptr) throw ArgumentError(who + "needs a drill to drive");
   if (!(spec_.workspace_scale > 0)) {
-    throw std::invalid_argument(who + "workspace scale must be > 0");
+    throw ArgumentError(who + "workspace scale must be > 0");
   }
   if (!(spec_.max_force >= 0) || !(spec_.force_scale >= 0)) {
-    throw std::invalid_argument(who + "max force and force scale must be >= 0");
+    throw ArgumentError(who + "max force and force scale must be >= 0");
   }
 }
 

@@ -71,7 +71,7 @@ PluginRegistry::~PluginRegistry() = default;
 
 Plugin* PluginRegistry::load(const PluginSpec& spec, const PluginSite& site) {
   if (site.world != world_) {
-    throw std::invalid_argument("a plugin can only be attached to this world or what it holds");
+    throw ArgumentError("a plugin can only be attached to this world or what it holds");
   }
   const std::string name =
       spec.name.empty() ? std::filesystem::path(spec.filename).stem().string() : spec.name;
@@ -83,13 +83,13 @@ Plugin* PluginRegistry::load(const PluginSpec& spec, const PluginSite& site) {
 
 Plugin* PluginRegistry::attach(std::shared_ptr<Plugin> plugin, const std::string& name,
                                const std::string& file, const PluginSite& site, bool native) {
-  if (!plugin) throw std::invalid_argument("no plugin to attach");
+  if (!plugin) throw ArgumentError("no plugin to attach");
   const bool complete = site.simulator != nullptr && site.world == world_ &&
                         (site.scope < PluginScope::kModel || site.model != nullptr) &&
                         (site.scope != PluginScope::kObject || site.object != nullptr);
   if (!complete) {
-    throw std::invalid_argument("plugin '" + name + "': its site is not in this world or lacks " +
-                                "its " + plugin_scope_name(site.scope));
+    throw ArgumentError("plugin '" + name + "': its site is not in this world or lacks " + "its " +
+                        plugin_scope_name(site.scope));
   }
   plugin->site_ = site;
   plugin->name_ = name;

@@ -466,9 +466,9 @@ std::vector<Frame> OpenXrSession::end_frame(const std::vector<const Camera*>& ca
   }
   if (cameras.size() != s.views.size()) {
     finish();
-    throw std::invalid_argument("OpenXR: end_frame needs a camera per eye (" +
-                                std::to_string(s.views.size()) + "), got " +
-                                std::to_string(cameras.size()));
+    throw ArgumentError("OpenXR: end_frame needs a camera per eye (" +
+                        std::to_string(s.views.size()) + "), got " +
+                        std::to_string(cameras.size()));
   }
   frames.resize(cameras.size());
   for (std::size_t i = 0; i < cameras.size(); ++i) {

@@ -1,4 +1,5 @@
 #include "ambfplus/scene/realtime.h"
+#include "ambfplus/errors.h"
 
 #include <pthread.h>
 #include <sched.h>
@@ -85,10 +86,10 @@ double percentile(std::vector<double> v, double q) {
 RealTimeLoop::RealTimeLoop(World& world, const RealTimeOptions& options)
     : world_(world), options_(options) {
   if (!(options.rate > 0 && options.rate <= 100000)) {
-    throw std::invalid_argument("real-time loop: rate must be in (0, 100000] steps/s");
+    throw ArgumentError("real-time loop: rate must be in (0, 100000] steps/s");
   }
   if (!(options.poll_rate > 0 && options.poll_rate <= options.rate)) {
-    throw std::invalid_argument("real-time loop: poll_rate must be in (0, rate]");
+    throw ArgumentError("real-time loop: poll_rate must be in (0, rate]");
   }
 }
 
@@ -101,9 +102,9 @@ RealTimeLoop::~RealTimeLoop() {
 }
 
 void RealTimeLoop::start() {
-  if (running_) throw std::logic_error("the real-time loop is already running");
+  if (running_) throw StateError("the real-time loop is already running");
   if (!world_.enter_realtime()) {
-    throw std::logic_error("world '" + world_.name() + "' already has a running real-time loop");
+    throw StateError("world '" + world_.name() + "' already has a running real-time loop");
   }
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -136,7 +137,7 @@ void RealTimeLoop::stop() {
   if (!error_.empty()) {
     const std::string error = error_;
     error_.clear();
-    throw std::runtime_error("real-time loop stopped by an error in a step: " + error);
+    throw StateError("real-time loop stopped by an error in a step: " + error);
   }
 }
 

@@ -1,4 +1,5 @@
 #include "ambfplus/volume/volume_data.h"
+#include "ambfplus/errors.h"
 
 #include <algorithm>
 #include <cmath>
@@ -60,8 +61,8 @@ std::size_t label_bytes(LabelType t) { return t == LabelType::kUInt8 ? 1 : 2; }
 
 void check_table_fits(const LabelTable& table, LabelType type) {
   if (type == LabelType::kUInt8 && table.max_id() > 255) {
-    throw std::invalid_argument("label id " + std::to_string(table.max_id()) +
-                                " does not fit a uint8 label grid (use uint16)");
+    throw ArgumentError("label id " + std::to_string(table.max_id()) +
+                        " does not fit a uint8 label grid (use uint16)");
   }
 }
 
@@ -72,9 +73,9 @@ VolumeData::VolumeData(const std::array<int, 3>& shape, const Eigen::Vector3d& d
     : shape_(shape), dimensions_(dimensions), label_type_(type), table_(std::move(table)) {
   for (int a = 0; a < 3; ++a) {
     if (shape_[a] <= 0 || shape_[a] > 8192) {
-      throw std::invalid_argument("volume shape must be 1..8192 voxels per axis, got " +
-                                  std::to_string(shape_[0]) + "x" + std::to_string(shape_[1]) +
-                                  "x" + std::to_string(shape_[2]));
+      throw ArgumentError("volume shape must be 1..8192 voxels per axis, got " +
+                          std::to_string(shape_[0]) + "x" + std::to_string(shape_[1]) + "x" +
+                          std::to_string(shape_[2]));
     }
   }
   set_dimensions(dimensions);
@@ -85,7 +86,7 @@ VolumeData::VolumeData(const std::array<int, 3>& shape, const Eigen::Vector3d& d
 
 void VolumeData::set_dimensions(const Eigen::Vector3d& dimensions) {
   if (!(dimensions.minCoeff() > 0.0) || !dimensions.allFinite()) {
-    throw std::invalid_argument("volume dimensions must be positive metres");
+    throw ArgumentError("volume dimensions must be positive metres");
   }
   dimensions_ = dimensions;
 }
@@ -162,7 +163,7 @@ void VolumeData::log_edit(VolumeEdit edit) {
 std::int64_t VolumeData::remove_sphere(const Eigen::Vector3d& center, double radius,
                                        bool only_removable) {
   if (!(radius >= 0.0) || !center.allFinite()) {
-    throw std::invalid_argument("remove_sphere needs a finite centre and a radius >= 0");
+    throw ArgumentError("remove_sphere needs a finite centre and a radius >= 0");
   }
   const Eigen::Vector3d s = voxel_size();
   const Eigen::Vector3d u = to_voxel_units(center);
@@ -212,7 +213,7 @@ std::vector<std::uint16_t> VolumeData::remove_voxels(const std::vector<std::arra
       const auto& v = voxels[n];
       if (v[0] < 0 || v[1] < 0 || v[2] < 0 || v[0] >= shape_[0] || v[1] >= shape_[1] ||
           v[2] >= shape_[2]) {
-        throw std::invalid_argument("remove_voxels: voxel outside the grid");
+        throw ArgumentError("remove_voxels: voxel outside the grid");
       }
       auto& l = p[linear_index(v[0], v[1], v[2])];
       old[n] = l;
@@ -230,7 +231,7 @@ std::vector<std::uint16_t> VolumeData::remove_voxels(const std::vector<std::arra
 
 std::int64_t VolumeData::set_region(const VoxelBox& region, std::uint16_t label) {
   if (label_type_ == LabelType::kUInt8 && label > 255) {
-    throw std::invalid_argument("label " + std::to_string(label) + " does not fit a uint8 grid");
+    throw ArgumentError("label " + std::to_string(label) + " does not fit a uint8 grid");
   }
   const VoxelBox box = region.clipped(shape_);
   std::int64_t changed = 0;
@@ -472,7 +473,7 @@ VolumeHit VolumeData::raycast(const Eigen::Vector3d& origin, const Eigen::Vector
   update_derived();
   VolumeHit result;
   const double norm = direction.norm();
-  if (!(norm > 0.0)) throw std::invalid_argument("raycast needs a non-zero direction");
+  if (!(norm > 0.0)) throw ArgumentError("raycast needs a non-zero direction");
   const Eigen::Vector3d d = direction / norm;
   const Eigen::Vector3d s = voxel_size();
   const Eigen::Vector3d u0 = to_voxel_units(origin);

@@ -62,7 +62,7 @@ class AMBFPLUS_API PluginRegistry : public System {
   /// Finds and loads a plugin (search order in cpp/README.md, "Plugins"), attaches it to site
   /// and calls its init(). Returns it, or nullptr when init() returned < 1 (it is dropped).
   /// Throws PluginError naming the file and every path tried, dlerror()'s message, or both ABI
-  /// versions; std::invalid_argument for a site of another world.
+  /// versions; ArgumentError for a site of another world.
   Plugin* load(const PluginSpec& spec, const PluginSite& site);
   /// Attaches a plugin made elsewhere as load does; native is false for plugins of another
   /// language (a Python object's adapter), whose physics updates a real-time loop decimates.

@@ -63,7 +63,7 @@ class AMBFPLUS_API RealTimeLoop {
   RealTimeLoop(const RealTimeLoop&) = delete;
   RealTimeLoop& operator=(const RealTimeLoop&) = delete;
 
-  /// Starts the threads; throws std::logic_error if running or if the world has another loop.
+  /// Starts the threads; throws StateError if running or if the world has another loop.
   void start();
   /// Stops after the step in progress and joins the threads. A step that threw ends the loop;
   /// stop() then throws its error again.

@@ -49,7 +49,7 @@ class AMBFPLUS_API World {
 
   /// The model that holds objects added to the world directly.
   Model& default_model() { return *models_.front(); }
-  /// Creates an empty model. Throws std::invalid_argument if the name is taken.
+  /// Creates an empty model. Throws ArgumentError if the name is taken.
   Model& add_model(const std::string& name);
   /// Models in creation order, the default model first.
   std::vector<Model*> models() const;
@@ -77,7 +77,7 @@ class AMBFPLUS_API World {
   /// the step), then the clock, then the stages.
   void step(std::int64_t n = 1);
   /// Adds a system after those the world has: it runs in the stages it names after theirs and
-  /// hears of objects added from now on. Throws std::invalid_argument for a null system.
+  /// hears of objects added from now on. Throws ArgumentError for a null system.
   void add_system(std::unique_ptr<System> system);
   /// The systems in the order they hear of objects and run within a stage.
   std::vector<System*> systems() const;
@@ -102,7 +102,7 @@ class AMBFPLUS_API World {
   void set_shader(std::optional<ShaderSpec> shader) { shader_ = std::move(shader); }
 
   /// Starts logging every step's state of these objects (replacing a log in progress); the
-  /// log's rows are taken with take_step_log(). Throws std::invalid_argument for an object of
+  /// log's rows are taken with take_step_log(). Throws ArgumentError for an object of
   /// another world.
   void start_step_log(const std::vector<const Object*>& objects);
   /// Stops logging; rows not taken are dropped.

@@ -66,7 +66,7 @@ struct AMBFPLUS_API VolumeHit {
 /// In "voxel units" u = (p + D/2) / s a voxel covers [i, i + 1) with its centre at i + 0.5.
 class AMBFPLUS_API VolumeData {
  public:
-  /// A grid of zeros. Throws std::invalid_argument for a non-positive shape or dimension, or a
+  /// A grid of zeros. Throws ArgumentError for a non-positive shape or dimension, or a
   /// table whose ids do not fit the label type.
   VolumeData(const std::array<int, 3>& shape, const Eigen::Vector3d& dimensions, LabelType type,
              LabelTable table);
@@ -76,12 +76,12 @@ class AMBFPLUS_API VolumeData {
   const std::array<int, 3>& shape() const { return shape_; }
   std::int64_t voxel_count() const;
   const Eigen::Vector3d& dimensions() const { return dimensions_; }
-  /// Resizes the physical box (metres, full extents); throws std::invalid_argument if not > 0.
+  /// Resizes the physical box (metres, full extents); throws ArgumentError if not > 0.
   void set_dimensions(const Eigen::Vector3d& dimensions);
   Eigen::Vector3d voxel_size() const;
   LabelType label_type() const { return label_type_; }
   const LabelTable& label_table() const { return table_; }
-  /// Replaces the table; throws std::invalid_argument if an id does not fit the label type.
+  /// Replaces the table; throws ArgumentError if an id does not fit the label type.
   void set_label_table(LabelTable table);
 
   /// The label grid (1 or 2 bytes per voxel, by label_type()). Writes through it are not seen by

@@ -21,9 +21,9 @@ from torch.utils.data import DataLoader, Dataset, IterableDataset, get_worker_in
 
 from .. import RenderError, ScriptedDevice
 from ..recording import Recorder, open_recording
+from ..scenarios import CameraPath, DrillScript
 from ..scenes import Scene, drilling_phantom
 from .samples import OPTIONAL_PASSES, REQUIRED_PASSES, stereo_sample
-from .scenarios import CameraPath, DrillScript
 
 SCENARIOS = ("camera", "drilling", "mixed")
 DEFAULT_PASSES = REQUIRED_PASSES + OPTIONAL_PASSES
@@ -178,8 +178,7 @@ class SimulatorStereoDataset(IterableDataset):
             scene.drill.volume.reset()
         if kind == "drilling":
             seconds = self.episode_frames * self.capture_every * world.time_step
-            while script.busy_until < world.time + seconds:
-                script.plunge(max(world.time, script.busy_until))
+            script.plunge_until(world.time + seconds, now=world.time)
         return CameraPath.random(rng, moving=kind == "camera")
 
     def _recorder(self, worker: int, scene: Scene) -> Recorder | None:

@@ -153,6 +153,7 @@ def _generate(spec: DatasetSpec, out: Path, executor: Executor, progress: bool) 
                         f"last time: {event.reason.strip()}"
                     )
             run["status"] = "complete"
+            shutil.rmtree(out / PARTIAL, ignore_errors=True)  # every worker has stopped
         except BaseException:
             run["status"] = "failed"
             raise

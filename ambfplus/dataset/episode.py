@@ -171,6 +171,12 @@ def _replace_rgb(frame, rgb: np.ndarray) -> dict:
     return out
 
 
+def partial_folder(out, index: int, attempt: int) -> Path:
+    """Where attempt `attempt` at episode `index` records its shard before it is complete (the
+    executor deletes it when the attempt fails)."""
+    return Path(out) / PARTIAL / f"{shard_name(index)[:-3]}.attempt{attempt}"
+
+
 def run_episode(spec_data: dict, out, index: int, attempt: int = 0, worker: str = "") -> dict:
     """Makes episode `index`'s shard in dataset folder `out`: recorded under ``.partial/``,
     validated, then moved into ``shards/`` (its parts first, its head last). Returns the
@@ -180,7 +186,7 @@ def run_episode(spec_data: dict, out, index: int, attempt: int = 0, worker: str 
     started, cpu_started = time.perf_counter(), time.process_time()
     out = Path(out)
     name = shard_name(index)
-    partial = out / PARTIAL / f"{name[:-3]}.{socket.gethostname()}.{os.getpid()}.{attempt}"
+    partial = partial_folder(out, index, attempt)
     shutil.rmtree(partial, ignore_errors=True)
     partial.mkdir(parents=True)
     head = partial / name

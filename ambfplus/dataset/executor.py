@@ -5,6 +5,7 @@ an episode is tried at most ``retries + 1`` times."""
 
 from __future__ import annotations
 
+import shutil
 from collections.abc import Iterator
 from dataclasses import dataclass
 
@@ -50,6 +51,13 @@ class Executor:
             raise ValueError(f"the episode timeout must be > 0 s, got {timeout}")
         self.retries = int(retries)
         self.timeout = timeout
+
+    @staticmethod
+    def discard(out, index: int, attempt: int) -> None:
+        """Deletes what a failed attempt left under .partial/ (its worker is gone)."""
+        from .episode import partial_folder
+
+        shutil.rmtree(partial_folder(out, index, attempt), ignore_errors=True)
 
     def connect(self) -> None:
         """Reaches the workers' side before anything is written (nothing to do locally)."""

@@ -103,6 +103,7 @@ class LocalExecutor(Executor):
 
     def run(self, spec_data: dict, out, todo: list[int]) -> Iterator:
         queue = deque((index, 0) for index in todo)
+        self._out = out
         slots: list[_Slot] = []
         try:
             slots = [self._start(spec_data, str(out)) for _ in range(min(self.workers, len(queue)))]
@@ -140,6 +141,7 @@ class LocalExecutor(Executor):
             yield from self._failed(index, attempt, payload, queue)
 
     def _failed(self, index: int, attempt: int, reason: str, queue: deque) -> Iterator:
+        self.discard(self._out, index, attempt)
         if attempt >= self.retries:
             yield Failed(index, attempt + 1, reason)
             return

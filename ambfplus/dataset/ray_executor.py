@@ -17,6 +17,7 @@ import socket
 import time
 from collections import deque
 from collections.abc import Iterator
+from pathlib import Path
 
 from .executor import Done, Executor, Failed, Retry
 
@@ -104,14 +105,21 @@ class RayExecutor(Executor):
         options = {"log_to_driver": False, "logging_level": logging.WARNING, **self.init_options}
         if self.address == "local":
             options.setdefault("include_dashboard", False)
-            ray.init(**options)
         else:
-            try:
-                ray.init(address=self.address, **options)
-            except ConnectionError as error:
-                raise ConnectionError(
-                    f"cannot connect to a Ray cluster at {self.address!r}: {error}"
-                ) from None
+            options["address"] = self.address
+        # Ray puts the driver's current folder first on its workers' sys.path: from a source
+        # checkout, that would shadow the installed package (which has the engine) with the
+        # bare sources. Connect from a folder that holds no Python packages.
+        here = os.getcwd()
+        os.chdir("/")
+        try:
+            ray.init(**options)
+        except ConnectionError as error:
+            raise ConnectionError(
+                f"cannot connect to a Ray cluster at {self.address!r}: {error}"
+            ) from None
+        finally:
+            os.chdir(here)
         self._ray = ray
         self._resources = ray.cluster_resources()
 
@@ -133,6 +141,7 @@ class RayExecutor(Executor):
             num_cpus=self.cpus, num_gpus=self.gpus, max_retries=0
         )
         spec_ref = ray.put(spec_data)
+        out = Path(out).resolve()  # workers run elsewhere
         queue = deque((index, 0) for index in todo)
         slots = max(1.0, self._resources.get("CPU", 1.0) / max(self.cpus, 1e-9))
         window = max(2, int(2 * slots))  # keep every worker busy without flooding the queue
@@ -156,6 +165,7 @@ class RayExecutor(Executor):
                 if ref in cancelled:
                     reason = f"took more than {self.timeout} s and was cancelled"
                     cancelled.discard(ref)
+                self.discard(out, index, attempt)
                 if attempt >= self.retries:
                     yield Failed(index, attempt + 1, reason)
                     return

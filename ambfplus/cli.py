@@ -246,6 +246,7 @@ def run_generate(args: argparse.Namespace) -> int:
         report = generate(
             args.spec, args.out, workers=args.workers, ray=args.ray, retries=args.retries,
             timeout=args.timeout, progress=not args.quiet,
+            ray_options={"cpus": args.ray_cpus, "gpus": args.ray_gpus},
         )  # fmt: skip
     except (ValueError, OSError, ImportError, GenerateError) as error:  # SpecError included
         print(f"error: {error}", file=sys.stderr)
@@ -386,6 +387,15 @@ def main(argv: list[str] | None = None) -> int:
         metavar="ADDRESS",
         help="run on a Ray cluster instead: host:port, ray://host:port, auto (this machine's "
         'cluster) or local (a new one); needs pip install "ambfplus[ray]"',
+    )
+    generate.add_argument(
+        "--ray-cpus", type=float, default=1.0, help="CPUs each Ray task asks for (default 1)"
+    )
+    generate.add_argument(
+        "--ray-gpus",
+        type=float,
+        default=0.0,
+        help="GPUs each Ray task asks for (default 0); a task given a GPU renders on it",
     )
     generate.add_argument(
         "--retries", type=int, default=3, help="attempts after the first per episode"

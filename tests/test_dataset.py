@@ -52,9 +52,12 @@ def shard_bytes(folder: Path) -> dict[str, bytes]:
     return {p.name: p.read_bytes() for p in sorted((folder / "shards").iterdir())}
 
 
-def cli(*args, **options) -> subprocess.Popen:
-    """The ambfplus command, run from outside the source tree (which has no engine)."""
-    return subprocess.Popen([sys.executable, "-m", "ambfplus", *args], cwd="/", **options)
+def start_generate(spec, out, *options) -> subprocess.Popen:
+    """`ambfplus generate` with 2 local workers in a process of its own, run from outside the
+    source tree (which has no engine)."""
+    command = ["generate", str(spec), "--out", str(out), "--workers", "2", "--quiet", *options]
+    return subprocess.Popen([sys.executable, "-m", "ambfplus", *command], cwd="/",
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)  # fmt: skip
 
 
 def run_cli(*args) -> subprocess.CompletedProcess:
@@ -135,6 +138,25 @@ def test_ray_without_the_extra_says_what_to_install(monkeypatch, tmp_path):
     with pytest.raises(ImportError, match=r'pip install "ambfplus\[ray\]"'):
         generate(BASE_SPEC, tmp_path / "out", ray="auto", progress=False)
     assert not (tmp_path / "out").exists()
+
+
+def test_ray_gpu_ids_choose_the_engines_cuda_device():
+    from ambfplus.dataset.ray_executor import select_gpu
+
+    environ = {"CUDA_VISIBLE_DEVICES": "2,3"}  # as Ray sets it: the ordinal is the position
+    assert select_gpu(["3"], environ) == "1" and environ["AMBFPLUS_CUDA_DEVICE"] == "1"
+    environ = {}
+    assert select_gpu([2], environ) == "2" and environ["AMBFPLUS_CUDA_DEVICE"] == "2"
+    environ = {"AMBFPLUS_EGL_DEVICE": "1"}  # a device the user chose stays chosen
+    assert select_gpu([0], environ) is None and "AMBFPLUS_CUDA_DEVICE" not in environ
+    assert select_gpu([], {}) is None
+
+
+def test_the_example_spec_is_valid():
+    spec = load_spec(Path(__file__).resolve().parents[1] / "examples" / "dataset_spec.yaml")
+    assert spec.episodes == 6 and len(spec.data["anatomies"]) == 2
+    kinds = {sample_episode(spec, i).scenario["kind"] for i in range(spec.episodes)}
+    assert kinds <= {"camera", "drilling", "mixed"} and len(kinds) >= 2
 
 
 def test_the_cli_reports_a_bad_spec_without_a_traceback(tmp_path):
@@ -219,19 +241,7 @@ def test_killed_workers_are_replaced_and_their_episodes_redone(
     dataset_spec, reference_dataset, tmp_path
 ):
     out = tmp_path / "data"
-    driver = cli(
-        "generate",
-        str(dataset_spec),
-        "--out",
-        str(out),
-        "--workers",
-        "2",
-        "--quiet",
-        "--retries",
-        "6",
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-    )
+    driver = start_generate(dataset_spec, out, "--retries", "6")
     killed, rng = [], random.Random(18)
     while driver.poll() is None and len(killed) < 4:
         time.sleep(rng.uniform(0.3, 1.2))
@@ -253,17 +263,7 @@ def test_killed_workers_are_replaced_and_their_episodes_redone(
 
 def test_a_killed_driver_resumes_to_the_same_dataset(dataset_spec, reference_dataset, tmp_path):
     out = tmp_path / "data"
-    driver = cli(
-        "generate",
-        str(dataset_spec),
-        "--out",
-        str(out),
-        "--workers",
-        "2",
-        "--quiet",
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-    )
+    driver = start_generate(dataset_spec, out)
     deadline = time.monotonic() + 120
     while time.monotonic() < deadline and len(read_manifest(out)[0]) < 4:
         time.sleep(0.05)

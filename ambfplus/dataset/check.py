@@ -3,7 +3,6 @@ and ``dataset_info`` (``ambfplus dataset info DIR``)."""
 
 from __future__ import annotations
 
-import hashlib
 import json
 from collections import Counter
 from dataclasses import dataclass, field
@@ -11,7 +10,7 @@ from pathlib import Path
 
 from .driver import ENVIRONMENT
 from .episode import PARTIAL, SHARDS
-from .manifest import read_manifest
+from .manifest import read_manifest, shard_checksum
 
 
 @dataclass
@@ -123,16 +122,11 @@ def _check_shard(folder: Path, record: dict, match_images: bool) -> list[str]:
     absent = [str(f.relative_to(folder)) for f in files if not f.is_file()]
     if absent:
         return [f"{name}: missing files {absent}"]
-    digest, size = hashlib.sha256(), 0
-    for file in files:
-        with open(file, "rb") as f:
-            for block in iter(lambda f=f: f.read(1 << 20), b""):
-                digest.update(block)
-                size += len(block)
+    digest, size = shard_checksum(files)
     problems = []
     if size != record["bytes"]:
         problems.append(f"{name}: {size} bytes on disk, the manifest says {record['bytes']}")
-    if digest.hexdigest() != record["sha256"]:
+    if digest != record["sha256"]:
         problems.append(f"{name}: checksum differs from the manifest's (the files changed)")
     shard = validate(files[0], match_images=match_images)
     problems += [f"{name}: {c.name}: {c.detail}" for c in shard.failed]

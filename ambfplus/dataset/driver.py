@@ -133,8 +133,9 @@ def _generate(spec: DatasetSpec, out: Path, executor: Executor, progress: bool) 
         writer = ManifestWriter(out)
         made = frames = retries = 0
         renderers: set[str] = set()
+        events = executor.run(spec.data, out, todo)
         try:
-            for event in executor.run(spec.data, out, todo):
+            for event in events:
                 if isinstance(event, Done):
                     record = event.record
                     if record["episode"] in records:
@@ -154,10 +155,11 @@ def _generate(spec: DatasetSpec, out: Path, executor: Executor, progress: bool) 
                     )
             run["status"] = "complete"
             shutil.rmtree(out / PARTIAL, ignore_errors=True)  # every worker has stopped
-        except BaseException:
-            run["status"] = "failed"
+        except BaseException as error:
+            run["status"] = "interrupted" if isinstance(error, KeyboardInterrupt) else "failed"
             raise
         finally:
+            events.close()  # stops the workers
             writer.close()
             bar.close()
             rewrite_manifest(out, list(records.values()))

@@ -20,6 +20,7 @@ from ..scenarios import DrillScript
 from ..scenes import anatomy_data, drilling_scene
 from ..session import record_session
 from ..stereo import StereoFrame
+from .manifest import shard_checksum
 from .sampling import EpisodePlan, jitter_label_colors, sample_episode
 from .spec import SCHEMA_VERSION, spec_hash
 
@@ -196,12 +197,7 @@ def run_episode(spec_data: dict, out, index: int, attempt: int = 0, worker: str 
         failed = "; ".join(f"{c.name}: {c.detail}" for c in report.failed)
         raise EpisodeError(f"episode {index}: its shard does not validate: {failed}")
     files = [head] + [p for _, p in find_parts(head)]
-    digest, size = hashlib.sha256(), 0
-    for file in files:
-        with open(file, "rb") as f:
-            for block in iter(lambda f=f: f.read(1 << 20), b""):
-                digest.update(block)
-                size += len(block)
+    digest, size = shard_checksum(files)
     shards = out / SHARDS
     shards.mkdir(exist_ok=True)
     for file in files[1:] + files[:1]:  # the head last: it names a complete shard
@@ -214,7 +210,7 @@ def run_episode(spec_data: dict, out, index: int, attempt: int = 0, worker: str 
         "scenario": summary["scenario"],
         "frames": summary["frames"],
         "bytes": size,
-        "sha256": digest.hexdigest(),
+        "sha256": digest,
         "file": f"{SHARDS}/{name}",
         "parts": [f"{SHARDS}/{file.name}" for file in files[1:]],
         "version": __version__,

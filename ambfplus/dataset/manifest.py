@@ -14,6 +14,7 @@ how a run went, which differ between runs of the same spec (``RUN_FIELDS``).
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 from pathlib import Path
@@ -33,6 +34,17 @@ REQUIRED_FIELDS = (
     "parts",
     "version",
 )
+
+
+def shard_checksum(files) -> tuple[str, int]:
+    """(SHA-256 hex digest, bytes) of a shard's files read in order: head, then parts."""
+    digest, size = hashlib.sha256(), 0
+    for file in files:
+        with open(file, "rb") as f:
+            for block in iter(lambda f=f: f.read(1 << 20), b""):
+                digest.update(block)
+                size += len(block)
+    return digest.hexdigest(), size
 
 
 def without_run_fields(record: dict) -> dict:

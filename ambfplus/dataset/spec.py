@@ -426,66 +426,36 @@ def _appearance(value, where: _Where) -> dict:
     out = {}
     if "lights" in value:
         out["lights"] = _lights(value["lights"], where.at("lights"))
-    if "labels" in value:
-        labels = _mapping(value["labels"], where.at("labels"), "label colours")
-        _keys(labels, where.at("labels"), optional=("color_jitter",))
-        out["labels"] = {
-            "color_jitter": _varying(
-                labels.get("color_jitter", 0),
-                where.at("labels").at("color_jitter"),
-                lambda v, w: _number(v, w, 0, 255),
-            )
-        }
-    if "material" in value:
-        out["material"] = _material(value["material"], where.at("material"), jitter=False)
-    if "drill" in value:
-        out["drill"] = _material(value["drill"], where.at("drill"), jitter=True)
     if "background" in value:
         out["background"] = _varying(value["background"], where.at("background"), _unit, size=3)
-    if "intrinsics" in value:
-        intrinsics = _mapping(value["intrinsics"], where.at("intrinsics"), "intrinsics jitter")
-        _keys(
-            intrinsics, where.at("intrinsics"), optional=("fov_y_jitter", "principal_point_jitter")
-        )
-        out["intrinsics"] = {
-            "fov_y_jitter": _varying(
-                intrinsics.get("fov_y_jitter", 0.0),
-                where.at("intrinsics").at("fov_y_jitter"),
-                lambda v, w: _number(v, w, 0, 0.5),
-            ),
-            "principal_point_jitter": _varying(
-                intrinsics.get("principal_point_jitter", 0.0),
-                where.at("intrinsics").at("principal_point_jitter"),
-                _non_negative,
-            ),
-        }
-    if "noise" in value:
-        noise = _mapping(value["noise"], where.at("noise"), "sensor noise")
-        _keys(noise, where.at("noise"), optional=("rgb_sigma",))
-        out["noise"] = {
-            "rgb_sigma": _varying(
-                noise.get("rgb_sigma", 0.0),
-                where.at("noise").at("rgb_sigma"),
-                lambda v, w: _number(v, w, 0, 128),
-            )
-        }
+    shininess = (None, lambda v, w: _number(v, w, 1, 1024))
+    sections = {
+        "labels": ("label colours", {"color_jitter": (0.0, lambda v, w: _number(v, w, 0, 255))}),
+        "material": ("the anatomy's material", {"specular": (None, _unit),
+                                                "shininess": shininess}),
+        "drill": ("the drill's material", {"color_jitter": (0.0, _unit), "specular": (None, _unit),
+                                           "shininess": shininess}),
+        "intrinsics": ("intrinsics jitter", {
+            "fov_y_jitter": (0.0, lambda v, w: _number(v, w, 0, 0.5)),
+            "principal_point_jitter": (0.0, _non_negative)}),
+        "noise": ("sensor noise", {"rgb_sigma": (0.0, lambda v, w: _number(v, w, 0, 128))}),
+    }  # fmt: skip
+    for key, (what, fields) in sections.items():
+        if key in value:
+            out[key] = _section(value[key], where.at(key), what, fields)
     return out
 
 
-def _material(value, where: _Where, jitter: bool) -> dict:
-    _mapping(value, where, "material")
-    optional = ("specular", "shininess") + (("color_jitter",) if jitter else ())
-    _keys(value, where, optional=optional)
-    out = {}
-    if "specular" in value:
-        out["specular"] = _varying(value["specular"], where.at("specular"), _unit)
-    if "shininess" in value:
-        out["shininess"] = _varying(
-            value["shininess"], where.at("shininess"), lambda v, w: _number(v, w, 1, 1024)
-        )
-    if "color_jitter" in value:
-        out["color_jitter"] = _varying(value["color_jitter"], where.at("color_jitter"), _unit)
-    return out
+def _section(value, where: _Where, what: str, fields: dict) -> dict:
+    """A mapping of varying numbers: `fields` maps each key to (default, check); a key whose
+    default is None is left out unless given."""
+    _mapping(value, where, what)
+    _keys(value, where, optional=tuple(fields))
+    return {
+        key: _varying(value.get(key, default), where.at(key), check)
+        for key, (default, check) in fields.items()
+        if key in value or default is not None
+    }
 
 
 def _lights(value, where: _Where) -> dict:

@@ -5,6 +5,9 @@
 //   ambfplus.RenderError    (Error, RuntimeError)
 //   ambfplus.PluginError    (Error, RuntimeError)
 //   ambfplus.ArgumentError  (Error, ValueError)        a value a caller gave cannot be used
+//   ambfplus.ArgumentTypeError (ArgumentError, TypeError) a value of the wrong type, or a keyword
+//                                                      option that does not exist
+//   ambfplus.NotFound       (Error, KeyError)          a name or key that names nothing
 //   ambfplus.OutOfRange     (Error, IndexError)        an index outside what it indexes
 //   ambfplus.StateError     (Error, RuntimeError)      a call that does not fit the state
 //   ambfplus.ResourceError  (Error, OSError)           a socket, port or device file
@@ -35,6 +38,8 @@ PyObject* g_asset_not_found = nullptr;
 PyObject* g_render_error = nullptr;
 PyObject* g_plugin_error = nullptr;
 PyObject* g_argument_error = nullptr;
+PyObject* g_argument_type_error = nullptr;
+PyObject* g_not_found = nullptr;
 PyObject* g_out_of_range = nullptr;
 PyObject* g_state_error = nullptr;
 PyObject* g_resource_error = nullptr;
@@ -70,6 +75,9 @@ void register_errors(pybind11::module_& m) {
   g_render_error = make_exception(m, "RenderError", pair(g_error, PyExc_RuntimeError).ptr());
   g_plugin_error = make_exception(m, "PluginError", pair(g_error, PyExc_RuntimeError).ptr());
   g_argument_error = make_exception(m, "ArgumentError", pair(g_error, PyExc_ValueError).ptr());
+  g_argument_type_error =
+      make_exception(m, "ArgumentTypeError", pair(g_argument_error, PyExc_TypeError).ptr());
+  g_not_found = make_exception(m, "NotFound", pair(g_error, PyExc_KeyError).ptr());
   g_out_of_range = make_exception(m, "OutOfRange", pair(g_error, PyExc_IndexError).ptr());
   g_state_error = make_exception(m, "StateError", pair(g_error, PyExc_RuntimeError).ptr());
   g_resource_error = make_exception(m, "ResourceError", pair(g_error, PyExc_OSError).ptr());
@@ -87,8 +95,12 @@ void register_errors(pybind11::module_& m) {
       raise_with(g_render_error, e.what());
     } catch (const PluginError& e) {
       raise_with(g_plugin_error, e.what());
+    } catch (const ArgumentTypeError& e) {
+      raise_with(g_argument_type_error, e.what());
     } catch (const ArgumentError& e) {
       raise_with(g_argument_error, e.what());
+    } catch (const NotFound& e) {
+      raise_with(g_not_found, e.what());
     } catch (const OutOfRange& e) {
       raise_with(g_out_of_range, e.what());
     } catch (const StateError& e) {

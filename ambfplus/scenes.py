@@ -96,9 +96,10 @@ def _drill_over(world: World, volume, tip, metal: dict | None = None, handle: di
     shaft = np.array([-0.3, 0.45, 1.0]) / np.linalg.norm([-0.3, 0.45, 1.0])
     start = make_pose(tip, rotation=rotation_between((1, 0, 0), shaft))
     drill = world.add_drill("drill", volume, burr=3, pose=start)
-    for body in add_drill(world, tip=tip, direction=shaft, metal=metal, handle=handle):
+    bodies = add_drill(world, tip=tip, direction=shaft, metal=metal, handle=handle)
+    for body in bodies:
         drill.attach(body, np.linalg.inv(start) @ body.pose)
-    return drill
+    return drill, list(bodies)
 
 
 @dataclass
@@ -133,7 +134,7 @@ def drilling_phantom(
     for light in DEFAULT_LIGHTS:
         world.add_light(**light)
     volume = world.add_volume("anatomy", phantom(resolution, seed), pose=np.eye(4))
-    drill = _drill_over(world, volume, tip=(0.0, 0.0, 0.022))
+    drill, bodies = _drill_over(world, volume, tip=(0.0, 0.0, 0.022))
     rig = StereoRig(
         world, "rig", baseline=baseline, width=width, height=height, fov_y=paper_fov(height),
         near=0.01, far=2.0, working_distance=working_distance,
@@ -147,7 +148,7 @@ def drilling_phantom(
         },
     }  # fmt: skip
     # The drill's bodies are logged too: exports give every body a pose at every step.
-    logged = [drill, rig.left, burr, stem, handle]
+    logged = [drill, rig.left, *bodies]
     return Scene(world, drill, rig, "hand", {"drill_button": 0}, logged, spec)
 
 
@@ -184,7 +185,9 @@ def drilling_scene(
     data = anatomy_data(anatomy, label_colors)
     volume = world.add_volume("anatomy", data, pose=np.eye(4), **(volume_material or {}))
     surface = _surface_height(volume, data)
-    drill = _drill_over(world, volume, (0.0, 0.0, surface + 0.010), drill_metal, drill_handle)
+    drill, bodies = _drill_over(
+        world, volume, (0.0, 0.0, surface + 0.010), drill_metal, drill_handle
+    )
     rig = StereoRig(
         world, "rig", baseline=baseline, width=width, height=height,
         fov_y=paper_fov(height) if fov_y is None else fov_y, near=0.01, far=2.0,
@@ -206,7 +209,9 @@ def drilling_scene(
             "drill_handle": drill_handle,
         },
     }  # fmt: skip
-    scene = Scene(world, drill, rig, "hand", {"drill_button": 0}, [drill, rig.left], spec)
+    # The drill's bodies are logged too: exports give every body a pose at every step.
+    logged = [drill, rig.left, *bodies]
+    scene = Scene(world, drill, rig, "hand", {"drill_button": 0}, logged, spec)
     scene.target = target
     return scene
 

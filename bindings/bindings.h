@@ -60,6 +60,9 @@ std::shared_ptr<T> handle(T* p) {
   return std::shared_ptr<T>(p->world().simulator().shared_from_this(), p);
 }
 
+/// ambfplus.PluginError, the Python class (set when the module is made).
+PyObject* plugin_error_type();
+
 /// An object as its most derived Python class (None for nullptr).
 pybind11::object to_python(Object* o);
 

@@ -64,6 +64,8 @@ void raise_with(PyObject* type, const std::string& message, const char* filename
 
 }  // namespace
 
+PyObject* plugin_error_type() { return g_plugin_error; }
+
 void register_errors(pybind11::module_& m) {
   g_error = make_exception(m, "Error", PyExc_Exception);
   auto pair = [](PyObject* a, PyObject* b) {

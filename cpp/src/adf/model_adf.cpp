@@ -16,7 +16,7 @@
 #include "adf/adf_internal.h"
 #include "ambfplus/adf/volume_adf.h"
 #include "ambfplus/errors.h"
-#include "ambfplus/plugin/plugin.h"
+#include "ambfplus/plugin/registry.h"
 #include "ambfplus/scene/constraint_actuator.h"
 #include "ambfplus/scene/proximity_sensor.h"
 #include "ambfplus/scene/soft_body.h"

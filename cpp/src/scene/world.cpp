@@ -111,6 +111,12 @@ Object* World::find(const std::string& name) const {
 
 std::vector<Object*> World::objects() const { return objects_; }
 
+Object* World::object_with_id(int id) const {
+  const auto it = std::lower_bound(objects_.begin(), objects_.end(), id,
+                                   [](const Object* o, int wanted) { return o->id() < wanted; });
+  return it != objects_.end() && (*it)->id() == id ? *it : nullptr;
+}
+
 std::vector<Object*> World::lookup(const std::string& query, std::optional<ObjectKind> kind) const {
   std::vector<Object*> exact, partial;
   if (query.empty()) return exact;

@@ -2,6 +2,7 @@
 #include "ambfplus/errors.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -102,6 +103,48 @@ Eigen::Vector3d VolumeData::voxel_size() const {
 void VolumeData::set_label_table(LabelTable table) {
   check_table_fits(table, label_type_);
   table_ = std::move(table);
+}
+
+void VolumeData::name_labels_from(const LabelTable& named) {
+  check_table_fits(named, label_type_);
+  std::vector<std::uint16_t> to(static_cast<std::size_t>(table_.max_id()) + 1, 0);
+  for (const Label& l : table_.labels()) to[l.id] = named.nearest(l.color);
+  visit_labels(label_type_, labels_.data(), [&](auto* grid) {
+    using T = std::remove_pointer_t<decltype(grid)>;
+    const std::size_t n = static_cast<std::size_t>(voxel_count());
+    for (std::size_t v = 0; v < n; ++v) {
+      if (grid[v] != 0 && grid[v] < to.size()) grid[v] = static_cast<T>(to[grid[v]]);
+    }
+  });
+  table_ = named;
+  mark_dirty(VoxelBox{{0, 0, 0}, shape_});
+  commit();
+}
+
+void VolumeData::mark_critical_structures() {
+  std::vector<Label> labels = table_.labels();
+  if (std::any_of(labels.begin(), labels.end(), [](const Label& l) { return l.critical; })) {
+    return;
+  }
+  static const char* const kCritical[] = {"facial", "chorda", "nerve",     "ica",     "carotid",
+                                          "sinus",  "dura",   "labyrinth", "cochlea", "iac"};
+  bool named = false;
+  for (Label& l : labels) {
+    std::string lower = l.name;
+    std::transform(lower.begin(), lower.end(), lower.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    for (const char* word : kCritical) {
+      if (lower.find(word) != std::string::npos) l.critical = named = true;
+    }
+  }
+  if (!named) {
+    const std::vector<std::int64_t> counts = label_counts();
+    if (counts.size() < 2) return;
+    const auto commonest = static_cast<std::uint16_t>(
+        std::max_element(counts.begin() + 1, counts.end()) - counts.begin());
+    for (Label& l : labels) l.critical = l.id != commonest;
+  }
+  table_ = LabelTable(labels);
 }
 
 void VolumeData::set_intensity_type(IntensityType type) {

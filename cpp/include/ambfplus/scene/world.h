@@ -56,6 +56,8 @@ class AMBFPLUS_API World {
 
   /// The object with exactly this name, or nullptr.
   Object* find(const std::string& name) const;
+  /// The object with this id, or nullptr (ids grow with creation, so this is a search).
+  Object* object_with_id(int id) const;
   /// Objects a name refers to, the way AMBF finds them: those whose name, qualified name
   /// ("/ambf/env/l1"), identifier ("BODY l1") or namespace + identifier equals the query; if
   /// none does, every object whose qualified name or identifier contains it. Optionally of one
@@ -123,6 +125,8 @@ class AMBFPLUS_API World {
   std::unique_lock<StateMutex> lock_state() const {
     return std::unique_lock<StateMutex>(state_mutex_);
   }
+  /// The state lock itself, for callers that cannot hold a unique_lock (the plugin C API).
+  StateMutex& state_mutex() const { return state_mutex_; }
 
   /// True while a RealTimeLoop steps this world: steps then leave polled devices and plugins of
   /// other languages to the loop's low-rate thread.

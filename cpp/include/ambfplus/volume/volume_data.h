@@ -83,6 +83,15 @@ class AMBFPLUS_API VolumeData {
   const LabelTable& label_table() const { return table_; }
   /// Replaces the table; throws ArgumentError if an id does not fit the label type.
   void set_label_table(LabelTable table);
+  /// Names the labels from another table: each label becomes the id of named's label with the
+  /// nearest colour (the voxels are relabelled), the table becomes named, and that is what
+  /// reset() restores (how the original system's labels.csv names a volume's colours).
+  void name_labels_from(const LabelTable& named);
+  /// Marks critical structures, unless some label is critical already: the labels whose names
+  /// speak of nerves, vessels, the sinus and dura, the labyrinth or the IAC (facial, chorda,
+  /// nerve, ica, carotid, sinus, dura, labyrinth, cochlea, iac), else every label but the
+  /// commonest (bone).
+  void mark_critical_structures();
 
   /// The label grid (1 or 2 bytes per voxel, by label_type()). Writes through it are not seen by
   /// renderers until mark_dirty() names the changed box.

@@ -1,52 +1,36 @@
 #pragma once
 
-// Kinds that files and older scripts write as strings are py::enum_ classes whose parameters also
-// take the names: a str is parsed by the engine's own parse function, whose error lists the
-// names it knows. Every file binding one of these types includes this header, so the caster is
-// the same everywhere.
+// Kinds that files and older scripts write as strings are py::enum_ classes; every parameter
+// taking one also takes its name (KindOrName), which goes to the engine's own parse function
+// through the option tables, so a bad name gets the engine's message listing the names it knows.
 
 #include <pybind11/pybind11.h>
+#include <pybind11/typing.h>
 
+#include <initializer_list>
 #include <string>
+#include <utility>
 
-#include "ambfplus/haptics/drill.h"
-#include "ambfplus/scene/constraint_actuator.h"
-#include "ambfplus/scene/joint.h"
-#include "ambfplus/scene/light.h"
-#include "ambfplus/scene/rigid_body.h"
-
-// The caster of an enum bound with py::enum_ that also loads a str through `parse`. The signature
-// says so for parameters ("ShapeKind | str") and names the class for return values.
-#define AMBFPLUS_ENUM_FROM_STR(Type, py_name, parse)                            \
-  namespace pybind11::detail {                                                  \
-  template <>                                                                   \
-  struct type_caster<Type> : public type_caster_base<Type> {                    \
-    static constexpr auto name =                                                \
-        io_name("ambfplus._core." py_name " | str", "ambfplus._core." py_name); \
-    bool load(handle src, bool convert) {                                       \
-      if (convert && isinstance<str>(src)) {                                    \
-        parsed_ = parse(src.cast<std::string>());                               \
-        this->value = &parsed_;                                                 \
-        return true;                                                            \
-      }                                                                         \
-      return type_caster_base<Type>::load(src, convert);                        \
-    }                                                                           \
-                                                                                \
-   private:                                                                     \
-    Type parsed_{};                                                             \
-  };                                                                            \
-  }
-
-AMBFPLUS_ENUM_FROM_STR(ambfplus::Shape::Kind, "ShapeKind", ambfplus::parse_shape_kind)
-AMBFPLUS_ENUM_FROM_STR(ambfplus::Axis, "Axis", ambfplus::parse_axis)
-AMBFPLUS_ENUM_FROM_STR(ambfplus::MeshCollision, "MeshCollision", ambfplus::parse_mesh_collision)
-AMBFPLUS_ENUM_FROM_STR(ambfplus::JointType, "JointType", ambfplus::parse_joint_type)
-AMBFPLUS_ENUM_FROM_STR(ambfplus::ControlOutput, "ControlOutput", ambfplus::parse_control_output)
-AMBFPLUS_ENUM_FROM_STR(ambfplus::ActuatorHold, "ActuatorHold", ambfplus::parse_actuator_hold)
-AMBFPLUS_ENUM_FROM_STR(ambfplus::LightSpec::Type, "LightType", ambfplus::parse_light_type)
-AMBFPLUS_ENUM_FROM_STR(ambfplus::RemovalMode, "RemovalMode", ambfplus::parse_removal_mode)
+#include "ambfplus/errors.h"
 
 namespace ambfplus::bindings {
+
+/// A parameter taking an enum member or its name; stubs say "Kind | str".
+template <typename Enum>
+using KindOrName = pybind11::typing::Union<Enum, pybind11::str>;
+/// The same, or None.
+template <typename Enum>
+using OptionalKindOrName = pybind11::typing::Optional<KindOrName<Enum>>;
+
+/// The member a parameter names: an Enum member or its name (parsed by `parse`); kind names the
+/// enum in messages.
+template <typename Enum>
+Enum to_kind(const pybind11::handle& value, Enum (*parse)(const std::string&), const char* kind) {
+  if (pybind11::isinstance<pybind11::str>(value)) return parse(value.cast<std::string>());
+  if (pybind11::isinstance<Enum>(value)) return value.cast<Enum>();
+  const std::string given = pybind11::repr(value);
+  throw ArgumentTypeError(std::string("expected a ") + kind + " or its name, got " + given);
+}
 
 /// Binds an enum whose members are named as the engine writes them (lower case, underscores for
 /// spaces), so a member's name, `Kind("name")` and the str parameters agree.

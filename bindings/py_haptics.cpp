@@ -348,7 +348,8 @@ void define_devices(py::module_& m) {
       .def(py::init([](const std::string& path, const JoystickDevice::Mapping& mapping) {
              return std::make_shared<JoystickDevice>(path, mapping);
            }),
-           py::arg("path") = "", py::arg("mapping") = JoystickDevice::Mapping())
+           py::arg("path") = "",
+           py::arg_v("mapping", JoystickDevice::Mapping(), "JoystickMapping()"))
       .def(
           "feed",
           [](JoystickDevice& d, const py::bytes& events) {
@@ -412,7 +413,10 @@ void define_drill(py::module_& m) {
       .def_property_readonly("burr_radius", &Drill::burr_radius)
       .def_property(
           "removal", [](Drill& d) { return removal_mode_name(d.spec().removal); },
-          &Drill::set_removal_mode, "physical or compatible")
+          [](Drill& d, const KindOrName<RemovalMode>& mode) {
+            d.set_removal_mode(to_kind(mode, &parse_removal_mode, "RemovalMode"));
+          },
+          "physical or compatible")
       .def_property(
           "stiffness", [](Drill& d) { return d.spec().stiffness; }, &Drill::set_stiffness)
       .def_property(

@@ -199,14 +199,14 @@ py::object get(World& w, const std::string& name, const std::optional<std::strin
 
 // ---- The add_* methods, shared by Model and World (which adds to its default model).
 
-RigidBody& add_body(Model& model, const std::string& name, std::optional<Shape::Kind> shape,
-                    std::optional<Vec3> size, std::optional<double> radius,
-                    std::optional<double> height, std::optional<Path> mesh, double scale,
-                    std::optional<Mat4> pose, double mass, std::optional<std::vector<double>> color,
-                    std::optional<double> specular, std::optional<double> shininess,
-                    const py::kwargs& physics) {
+RigidBody& add_body(Model& model, const std::string& name,
+                    const OptionalKindOrName<Shape::Kind>& shape, std::optional<Vec3> size,
+                    std::optional<double> radius, std::optional<double> height,
+                    std::optional<Path> mesh, double scale, std::optional<Mat4> pose, double mass,
+                    std::optional<std::vector<double>> color, std::optional<double> specular,
+                    std::optional<double> shininess, const py::kwargs& physics) {
   OptionMap named;
-  if (shape) named.push_back({"shape", shape_kind_name(*shape)});
+  if (!shape.is_none()) named.push_back({"shape", to_option(shape)});
   if (size) named.push_back({"size", vec(*size)});
   if (radius) named.push_back({"radius", *radius});
   if (height) named.push_back({"height", *height});
@@ -224,15 +224,12 @@ RigidBody& add_body(Model& model, const std::string& name, std::optional<Shape::
 }
 
 Joint& add_joint(Model& model, const std::string& name, RigidBody& parent, RigidBody& child,
-                 const std::variant<std::string, JointType>& type, const py::kwargs& kw) {
+                 const KindOrName<JointType>& type, const py::kwargs& kw) {
   JointSpec spec;
   spec.parent = &parent;
   spec.child = &child;
-  const std::string type_name = std::holds_alternative<std::string>(type)
-                                    ? std::get<std::string>(type)
-                                    : joint_type_name(std::get<JointType>(type));
   return model.add_joint(
-      make_spec(name, joint_options(), with_kwargs({{"type", type_name}}, kw), spec));
+      make_spec(name, joint_options(), with_kwargs({{"type", to_option(type)}}, kw), spec));
 }
 
 Camera& add_camera(Model& model, const std::string& name, int width, int height, double fov_y,
@@ -245,10 +242,11 @@ Camera& add_camera(Model& model, const std::string& name, int width, int height,
   return model.add_camera(make_spec(name, camera_options(), o));
 }
 
-Light& add_light(Model& model, const std::string& name, LightSpec::Type type, const Vec3& position,
-                 const Vec3& direction, const std::vector<double>& color, double intensity,
-                 double spot_cutoff, double spot_exponent, const Vec3& attenuation) {
-  const OptionMap o{{"type", light_type_name(type)},  {"position", vec(position)},
+Light& add_light(Model& model, const std::string& name, const KindOrName<LightSpec::Type>& type,
+                 const Vec3& position, const Vec3& direction, const std::vector<double>& color,
+                 double intensity, double spot_cutoff, double spot_exponent,
+                 const Vec3& attenuation) {
+  const OptionMap o{{"type", to_option(type)},        {"position", vec(position)},
                     {"direction", vec(direction)},    {"color", OptionValue::from_numbers(color)},
                     {"intensity", intensity},         {"spot_cutoff", spot_cutoff},
                     {"spot_exponent", spot_exponent}, {"attenuation", vec(attenuation)}};
@@ -285,10 +283,10 @@ void def_adders(Class& cls, GetModel get_model) {
   using Self = typename Class::type;
   cls.def(
          "add_body",
-         [get_model](Self& self, const std::string& name, std::optional<Shape::Kind> shape,
-                     std::optional<Vec3> size, std::optional<double> radius,
-                     std::optional<double> height, std::optional<Path> mesh, double scale,
-                     std::optional<Mat4> pose, double mass,
+         [get_model](Self& self, const std::string& name,
+                     const OptionalKindOrName<Shape::Kind>& shape, std::optional<Vec3> size,
+                     std::optional<double> radius, std::optional<double> height,
+                     std::optional<Path> mesh, double scale, std::optional<Mat4> pose, double mass,
                      std::optional<std::vector<double>> color, std::optional<double> specular,
                      std::optional<double> shininess, const py::kwargs& physics) {
            Model& model = get_model(self);
@@ -313,7 +311,7 @@ void def_adders(Class& cls, GetModel get_model) {
       .def(
           "add_joint",
           [get_model](Self& self, const std::string& name, RigidBody& parent, RigidBody& child,
-                      const std::variant<std::string, JointType>& type, const py::kwargs& kw) {
+                      const KindOrName<JointType>& type, const py::kwargs& kw) {
             Model& model = get_model(self);
             return handle(&add_joint(model, name, parent, child, type, kw), model.world());
           },
@@ -340,7 +338,7 @@ void def_adders(Class& cls, GetModel get_model) {
           "vertical field of view in radians, near and far the clipping distances in metres.")
       .def(
           "add_light",
-          [get_model](Self& self, const std::string& name, LightSpec::Type type,
+          [get_model](Self& self, const std::string& name, const KindOrName<LightSpec::Type>& type,
                       const Vec3& position, const Vec3& direction, const std::vector<double>& color,
                       double intensity, double spot_cutoff, double spot_exponent,
                       const Vec3& attenuation) {
@@ -349,7 +347,7 @@ void def_adders(Class& cls, GetModel get_model) {
                                      spot_cutoff, spot_exponent, attenuation),
                           model.world());
           },
-          py::arg("name"), py::arg("type") = LightSpec::Type::kDirectional, py::kw_only(),
+          py::arg("name"), py::arg("type") = "directional", py::kw_only(),
           py::arg("position") = Vec3(0, 0, 0), py::arg("direction") = Vec3(0, 0, -1),
           py::arg("color") = std::vector<double>{1.0, 1.0, 1.0}, py::arg("intensity") = 1.0,
           py::arg("spot_cutoff") = 0.7, py::arg("spot_exponent") = 0.7,

@@ -364,6 +364,31 @@ def test_drills_declared_in_a_model_file(tmp_path, caplog):
     assert drill.cursor_radii[0] == 0.0025, "a burr change at run time resizes the tip"
 
 
+def test_a_drill_block_and_add_drill_share_their_keys(tmp_path):
+    """A DRILL block's keys are add_drill's keywords with spaces for underscores (one table)."""
+    keys = {
+        "burr diameters": [0.002, 0.004],
+        "burr": 1,
+        "cursors": 3,
+        "cursor spacing": 0.002,
+        "shaft radii": [0.0006, 0.0007],
+        "stiffness": 450.0,
+        "max force": 4.0,
+        "removal": "compatible",
+        "voxels per step": [2, 5],
+        "friction": {"static": 0.3, "dynamic": 0.2},
+    }
+    block = "DRILL burr:\n  volume: slab\n" + "".join(f"  {k}: {v}\n" for k, v in keys.items())
+    from_file = ambfplus.World()
+    (volume,) = from_file.load_volumes(adf_with_drill(tmp_path, block.replace("'", "")))
+    (loaded,) = from_file.drills
+    kwargs = {k.replace(" ", "_"): v for k, v in keys.items()}
+    kwargs["spacing"] = kwargs.pop("cursor_spacing")  # Python's name; the file's is an alias
+    made = from_file.add_drill("d", volume, **kwargs)
+    for attribute in ("burr_diameters", "burr", "cursor_radii", "stiffness", "removal"):
+        assert getattr(made, attribute) == getattr(loaded, attribute), attribute
+
+
 @pytest.mark.parametrize(
     "block, message",
     [

@@ -170,8 +170,11 @@ const OptionTable<JointSpec>& joint_options() {
                            }},
                          O{"passive", "bool", "left out of its root body's joints, not controlled",
                            [](S& s, V v, K k) { s.passive = v.boolean(k); }},
-                         O{"ignore_inter_collision", "bool", "parent and child do not collide",
-                           [](S& s, V v, K k) { s.ignore_inter_collision = v.boolean(k); }},
+                         O{"ignore_inter_collision",
+                           "bool",
+                           "parent and child do not collide",
+                           [](S& s, V v, K k) { s.ignore_inter_collision = v.boolean(k); },
+                           {"ignore inter-collision"}},
                      });
   return table;
 }

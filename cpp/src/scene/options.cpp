@@ -58,6 +58,11 @@ void OptionValue::wrong(const std::string& key, const char* expected) const {
 }
 
 bool OptionValue::boolean(const std::string& key) const {
+  // 0 and 1 too: the C API of plugins passes numbers.
+  if (type() == Type::kInteger) {
+    const std::int64_t v = std::get<std::int64_t>(value_);
+    if (v == 0 || v == 1) return v == 1;
+  }
   if (type() != Type::kBool) wrong(key, "True or False");
   return std::get<bool>(value_);
 }
@@ -106,6 +111,7 @@ Object* OptionValue::object(const std::string& key) const {
 }
 
 std::vector<double> OptionValue::numbers(const std::string& key) const {
+  if (type() == Type::kReal || type() == Type::kInteger) return {number(key)};  // a list of one
   if (type() != Type::kList) wrong(key, "a list of numbers");
   std::vector<double> out;
   for (const OptionValue& v : list(key)) {
@@ -116,6 +122,7 @@ std::vector<double> OptionValue::numbers(const std::string& key) const {
 }
 
 std::vector<int> OptionValue::integers(const std::string& key) const {
+  if (type() == Type::kReal || type() == Type::kInteger) return {integer(key)};  // a list of one
   if (type() != Type::kList) wrong(key, "a list of integers");
   std::vector<int> out;
   for (const OptionValue& v : list(key)) out.push_back(v.integer(key));

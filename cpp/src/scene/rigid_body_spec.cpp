@@ -305,6 +305,8 @@ const OptionTable<RigidBodySpec>& rigid_body_options() {
             [](S& s, V v, K k) { s.material.specular = static_cast<float>(v.number(k)); }},
           O{"shininess", "float", "Phong exponent",
             [](S& s, V v, K k) { s.material.shininess = static_cast<float>(v.number(k)); }},
+          O{"visible", "bool", "drawn in images (False: it still collides)",
+            [](S& s, V v, K k) { s.material.visible = v.boolean(k); }},
           O{"inertia", "tuple[float, float, float]", "principal moments, kg m^2",
             [](S& s, V v, K k) { s.dynamics.inertia = v.vector3(k); }},
           O{"inertial_offset", "numpy.ndarray", "4x4 centre-of-mass frame in the body frame",

@@ -53,6 +53,7 @@ class AMBFPLUS_API OptionValue {
   bool is_map() const { return type() == Type::kMap; }
   bool is_text() const { return type() == Type::kText; }
 
+  /// True or False (or the integers 1 and 0).
   bool boolean(const std::string& key) const;
   /// A real number (an integer is one too); not checked for finiteness (validate() does that).
   double number(const std::string& key) const;
@@ -64,7 +65,7 @@ class AMBFPLUS_API OptionValue {
   /// An object, or nullptr for none.
   Object* object(const std::string& key) const;
 
-  /// A list of numbers of any length.
+  /// A list of numbers of any length (one number is a list of one).
   std::vector<double> numbers(const std::string& key) const;
   std::vector<int> integers(const std::string& key) const;
   /// (x, y, z): a list of three numbers.

@@ -130,7 +130,7 @@ struct AMBFPLUS_API RigidBodySpec {
 };
 
 /// add_body's keyword options: shape, size, radius, height, axis, mesh, scale, pose, mass, color,
-/// specular, shininess, inertia, inertial_offset, friction, rolling_friction, restitution,
+/// specular, shininess, visible, inertia, inertial_offset, friction, rolling_friction, restitution,
 /// linear_damping, angular_damping, kinematic, collision, collision_mesh, collision_type,
 /// collision_shapes, margin, groups; a shape's dimensions must fit it (a box needs size, a
 /// sphere takes no height ...).

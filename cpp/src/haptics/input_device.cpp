@@ -29,6 +29,10 @@ void InputDevice::pre_step(std::int64_t step, double time) {
   const DeviceState previous = state_;
   state_ = spec_.device->read(step, time);
   log_.push_back({step, state_});
+  if (log_.size() > kMaxLog) {
+    log_.pop_front();
+    ++log_dropped_;
+  }
   const std::uint32_t pressed = state_.buttons & ~previous.buttons;
   Drill& drill = *spec_.drill;
   clutched_ = held(spec_.clutch_button);

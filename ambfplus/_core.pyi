@@ -210,6 +210,8 @@ class VolumeData:
     """
     A segmented volume: label grid (a view, indexed [i, j, k]), label table, size, edits.
     """
+    EDIT_LOG_EDITS: typing.ClassVar[int] = 4096
+    EDIT_LOG_VOXELS: typing.ClassVar[int] = 262144
     def __init__(self, labels: numpy.ndarray, *, dimensions: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] | None = None, voxel_size: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] | None = None, label_table: typing.Any = None) -> None:
         """
         A volume from a (nx, ny, nz) uint8/uint16 label array (copied), its size in metres and its labels (a list of Label or a CSV/YAML file; named label_<id> when absent).
@@ -274,6 +276,11 @@ class VolumeData:
     def edit_log(self) -> list:
         """
         the edits so far: dicts of revision, kind, box, changed, voxels, old_labels
+        """
+    @property
+    def edit_log_dropped(self) -> int:
+        """
+        edits dropped from the log because it was full (it keeps the newest VolumeData.EDIT_LOG_EDITS edits, holding at most VolumeData.EDIT_LOG_VOXELS voxels)
         """
     @property
     def intensity(self) -> typing.Any:
@@ -1803,6 +1810,8 @@ class Drill(Object):
     """
     A burr and shaft of finger-proxy cursors that drills a volume.
     """
+    MAX_EVENTS: typing.ClassVar[int] = 65536
+    MAX_REMOVED: typing.ClassVar[int] = 262144
     on: bool
     def attach(self, body: RigidBody, offset: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"] | None = None) -> None:
         """
@@ -1861,6 +1870,11 @@ class Drill(Object):
     def events(self) -> list:
         ...
     @property
+    def events_dropped(self) -> int:
+        """
+        events dropped because nobody took them in time (the newest Drill.MAX_EVENTS are kept)
+        """
+    @property
     def force(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
         """
         force fed back (the leading cursor's), N, world frame
@@ -1888,6 +1902,11 @@ class Drill(Object):
     def removed(self) -> dict:
         """
         voxels removed and not yet taken: dict of step, voxel (N, 3), label
+        """
+    @property
+    def removed_dropped(self) -> int:
+        """
+        removed voxels dropped because nobody took them in time (the newest Drill.MAX_REMOVED are kept)
         """
     @property
     def speed(self) -> float:
@@ -2083,6 +2102,7 @@ class InputDevice(Object):
     """
     A device bound to a drill: its motion moves the drill's goal (workspace scale, clutch, the reference's axes), its buttons turn and change the burr, the drill's force goes back; every reading is logged with its step.
     """
+    MAX_LOG: typing.ClassVar[int] = 65536
     def take_log(self) -> dict:
         """
         Hands over the readings logged so far and starts a new log.
@@ -2105,6 +2125,11 @@ class InputDevice(Object):
     def log(self) -> dict:
         """
         readings since the last take_log(): step, position, orientation, buttons
+        """
+    @property
+    def log_dropped(self) -> int:
+        """
+        readings dropped because nobody took them in time (the newest InputDevice.MAX_LOG are kept)
         """
     @property
     def state(self) -> dict:

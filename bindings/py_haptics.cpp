@@ -392,7 +392,12 @@ void define_input_device(py::module_& m) {
           "readings since the last take_log(): step, position, orientation, buttons")
       .def(
           "take_log", [](InputDevice& d) { return log_arrays(d.take_log()); },
-          "Hands over the readings logged so far and starts a new log.");
+          "Hands over the readings logged so far and starts a new log.")
+      .def_property_readonly("log_dropped", &InputDevice::log_dropped,
+                             "readings dropped because nobody took them in time (the newest "
+                             "InputDevice.MAX_LOG are kept)")
+      .def_readonly_static("MAX_LOG", &InputDevice::kMaxLog,
+                           "readings kept until taken (take_log)");
 }
 
 void define_drill(py::module_& m) {
@@ -487,6 +492,16 @@ void define_drill(py::module_& m) {
       .def("take_removed", [](Drill& d) { return removed_arrays(d.take_removed()); })
       .def_property_readonly("events", [](Drill& d) { return event_list(d.events()); })
       .def("take_events", [](Drill& d) { return event_list(d.take_events()); })
+      .def_property_readonly("removed_dropped", &Drill::removed_dropped,
+                             "removed voxels dropped because nobody took them in time (the newest "
+                             "Drill.MAX_REMOVED are kept)")
+      .def_property_readonly(
+          "events_dropped", &Drill::events_dropped,
+          "events dropped because nobody took them in time (the newest Drill.MAX_EVENTS are kept)")
+      .def_readonly_static("MAX_REMOVED", &Drill::kMaxRemoved,
+                           "removed voxels kept until taken (take_removed)")
+      .def_readonly_static("MAX_EVENTS", &Drill::kMaxEvents,
+                           "events kept until taken (take_events)")
       .def_property_readonly(
           "tick_seconds",
           [](Drill& d) {

@@ -293,6 +293,14 @@ void define_volume(py::module_& m) {
             return out;
           },
           "returns the edit log and starts a new one")
+      .def_property_readonly(
+          "edit_log_dropped", &VolumeData::edit_log_dropped,
+          "edits dropped from the log because it was full (it keeps the newest "
+          "VolumeData.EDIT_LOG_EDITS edits, holding at most VolumeData.EDIT_LOG_VOXELS voxels)")
+      .def_readonly_static("EDIT_LOG_EDITS", &VolumeData::kEditLogEdits,
+                           "edits kept in the log until taken")
+      .def_readonly_static("EDIT_LOG_VOXELS", &VolumeData::kEditLogVoxels,
+                           "removed voxels the kept edits hold at most")
       .def(
           "raycast",
           [](VolumeData& v, const Vec3& origin, const Vec3& direction, double iso) {

@@ -406,3 +406,18 @@ def test_bad_drill_blocks_name_the_file_and_key(tmp_path, block, message):
     with pytest.raises(ambfplus.ConfigError, match=message) as error:
         world.load_volumes(path)
     assert error.value.filename == str(path)
+
+
+def test_the_drill_logs_are_bounded_and_say_what_they_dropped():
+    world = ambfplus.World()
+    volume = world.add_volume("v", ambfplus.phantom(16, 0))
+    drill = world.add_drill("d", volume)
+    assert ambfplus.Drill.MAX_REMOVED == 262144 and ambfplus.Drill.MAX_EVENTS == 65536
+    assert drill.removed_dropped == 0 and drill.events_dropped == 0
+    data = volume.data
+    cap = ambfplus.VolumeData.EDIT_LOG_EDITS
+    for i in range(cap + 3):
+        data.set_region((0, 0, 0), (1, 1, 1), 1 + i % 2)
+    assert len(data.edit_log) == cap and data.edit_log_dropped == 3
+    assert data.edit_log[-1]["revision"] == data.revision, "the newest edits are kept"
+    assert len(data.take_edit_log()) == cap and data.edit_log == []

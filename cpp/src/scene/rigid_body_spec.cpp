@@ -5,6 +5,7 @@
 
 #include "ambfplus/errors.h"
 #include "ambfplus/scene/rigid_body.h"
+#include "scene/material_options.h"
 #include "util/strings.h"
 
 namespace ambfplus {
@@ -279,6 +280,7 @@ const OptionTable<RigidBodySpec>& rigid_body_options() {
   using K = const std::string&;
   static const OptionTable<S> table(
       "add_body()",
+      joined<O>(
       {
           O{"shape", "ShapeKind | str", "box, sphere, cylinder, capsule, cone, plane, mesh, none",
             [](S& s, V v, K k) { s.shape.kind = parse_shape_kind(v.text(k)); }},
@@ -299,14 +301,6 @@ const OptionTable<RigidBodySpec>& rigid_body_options() {
             [](S& s, V v, K k) { s.pose = v.matrix4(k); }},
           O{"mass", "float", "kg; 0: static",
             [](S& s, V v, K k) { s.dynamics.mass = v.number(k); }},
-          O{"color", "tuple[float, ...]", "RGB or RGBA in 0..1",
-            [](S& s, V v, K k) { s.material.color = v.rgba(k); }},
-          O{"specular", "float", "Phong factor",
-            [](S& s, V v, K k) { s.material.specular = static_cast<float>(v.number(k)); }},
-          O{"shininess", "float", "Phong exponent",
-            [](S& s, V v, K k) { s.material.shininess = static_cast<float>(v.number(k)); }},
-          O{"visible", "bool", "drawn in images (False: it still collides)",
-            [](S& s, V v, K k) { s.material.visible = v.boolean(k); }},
           O{"inertia", "tuple[float, float, float]", "principal moments, kg m^2",
             [](S& s, V v, K k) { s.dynamics.inertia = v.vector3(k); }},
           O{"inertial_offset", "numpy.ndarray", "4x4 centre-of-mass frame in the body frame",
@@ -349,6 +343,7 @@ const OptionTable<RigidBodySpec>& rigid_body_options() {
               }
             }},
       },
+                material_options(&S::material)),
       check_dimensions);
   return table;
 }

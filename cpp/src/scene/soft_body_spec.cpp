@@ -5,6 +5,7 @@
 
 #include "ambfplus/errors.h"
 #include "ambfplus/scene/soft_body.h"
+#include "scene/material_options.h"
 
 namespace ambfplus {
 namespace {
@@ -151,28 +152,24 @@ const OptionTable<SoftBodySpec>& soft_body_options() {
   using SO = OptionTable<S>::Option;
   static const OptionTable<S> table(
       "add_soft_body()",
-      {
-          SO{"scale", "float", "of the mesh's vertices",
-             [](S& s, V v, K k) { s.scale = v.number(k); }},
-          SO{"pose", "numpy.ndarray", "4x4 world from the mesh frame",
-             [](S& s, V v, K k) { s.pose = v.matrix4(k); }},
-          SO{"mass", "float", "kg, shared evenly by the nodes",
-             [](S& s, V v, K k) { s.mass = v.number(k); }},
-          SO{"margin", "float", "collision margin, m",
-             [](S& s, V v, K k) { s.margin = v.number(k); }},
-          SO{"config", "dict[str, Any] | None", "AMBF's config block (kLST, ... fixed nodes)",
-             [](S& s, V v, K k) { soft_body_config_options().apply(s.config, v.map(k)); }},
-          SO{"fixed_nodes", "list[int]", "nodes pinned where they are",
-             [](S& s, V v, K k) { s.config.fixed_nodes = v.integers(k); }},
-          SO{"randomize_constraints", "bool", "shuffle the order the solver takes the links in",
-             [](S& s, V v, K k) { s.randomize_constraints = v.boolean(k); }},
-          SO{"color", "tuple[float, ...]", "RGB or RGBA in 0..1",
-             [](S& s, V v, K k) { s.material.color = v.rgba(k); }},
-          SO{"specular", "float", "Phong factor",
-             [](S& s, V v, K k) { s.material.specular = static_cast<float>(v.number(k)); }},
-          SO{"shininess", "float", "Phong exponent",
-             [](S& s, V v, K k) { s.material.shininess = static_cast<float>(v.number(k)); }},
-      });
+      joined<SO>(
+          {
+              SO{"scale", "float", "of the mesh's vertices",
+                 [](S& s, V v, K k) { s.scale = v.number(k); }},
+              SO{"pose", "numpy.ndarray", "4x4 world from the mesh frame",
+                 [](S& s, V v, K k) { s.pose = v.matrix4(k); }},
+              SO{"mass", "float", "kg, shared evenly by the nodes",
+                 [](S& s, V v, K k) { s.mass = v.number(k); }},
+              SO{"margin", "float", "collision margin, m",
+                 [](S& s, V v, K k) { s.margin = v.number(k); }},
+              SO{"config", "dict[str, Any] | None", "AMBF's config block (kLST, ... fixed nodes)",
+                 [](S& s, V v, K k) { soft_body_config_options().apply(s.config, v.map(k)); }},
+              SO{"fixed_nodes", "list[int]", "nodes pinned where they are",
+                 [](S& s, V v, K k) { s.config.fixed_nodes = v.integers(k); }},
+              SO{"randomize_constraints", "bool", "shuffle the order the solver takes the links in",
+                 [](S& s, V v, K k) { s.randomize_constraints = v.boolean(k); }},
+          },
+          material_options(&S::material)));
   return table;
 }
 

@@ -104,7 +104,7 @@ struct AMBFPLUS_API SoftBodySpec {
 };
 
 /// add_soft_body's keyword options: scale, pose, mass, margin, config (a dict of the `config`
-/// keys), fixed_nodes, randomize_constraints, color, specular, shininess.
+/// keys), fixed_nodes, randomize_constraints, color, specular, shininess, visible.
 AMBFPLUS_API const OptionTable<SoftBodySpec>& soft_body_options();
 
 namespace physics {

@@ -434,7 +434,14 @@ class World:
         ...
     def add_actuator(self, name: str, parent: RigidBody, **kwargs) -> ConstraintActuator:
         """
-        Adds a constraint actuator on parent that holds bodies on request. Keywords: location (4x4 in the parent's frame) or pose (4x4 world, now), hold ('fixed': the body keeps its pose relative to the actuator, or 'point': only the point is held), max_impulse (N s per step, point hold), tau (point hold), visible, visible_size.
+        Adds a constraint actuator on parent that holds bodies on request (hold 'fixed': the body keeps its pose relative to the actuator; 'point': only the point is held). Keywords:
+          hold (ActuatorHold | str): fixed (the body keeps its pose) or point
+          max_impulse (float): N s per step (point hold)
+          tau (float): share of the point error corrected per step (point hold)
+          location (numpy.ndarray): 4x4 frame in the parent's frame
+          pose (numpy.ndarray): 4x4 frame in the world, now
+          visible (bool)
+          visible_size (float): m
         """
     def add_body(self, name: str, shape: ShapeKind | str | None = None, *, size: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] | None = None, radius: typing.SupportsFloat | typing.SupportsIndex | None = None, height: typing.SupportsFloat | typing.SupportsIndex | None = None, mesh: os.PathLike | str | bytes | None = None, scale: typing.SupportsFloat | typing.SupportsIndex = 1.0, pose: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"] | None = None, mass: typing.SupportsFloat | typing.SupportsIndex = 1.0, color: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex] | None = None, specular: typing.SupportsFloat | typing.SupportsIndex | None = None, shininess: typing.SupportsFloat | typing.SupportsIndex | None = None, **kwargs) -> RigidBody:
         """
@@ -446,15 +453,56 @@ class World:
         """
     def add_drill(self, name: str, volume: Volume, **kwargs) -> Drill:
         """
-        Adds a drill working on `volume`. Options: burr_diameters (m), burr (index), cursors, spacing, shaft_radii, stiffness (N/m), damping, max_force, soft_start, static_friction, dynamic_friction, removal ('physical' or 'compatible'), cutting_rate (m^3/(s N)), voxels_per_step, pose (initial goal, 4x4).
+        Adds a drill working on `volume`. Keywords:
+          burr_diameters (list[float]): m
+          burr (int): index into burr_diameters
+          cursors (int): tip + shaft cursors, 1..16
+          spacing (float): m between cursors along the shaft
+          shaft_radii (list[float]): m, one per shaft cursor
+          stiffness (float): N/m
+          damping (float): N s/m
+          max_force (float): N
+          soft_start (float): s over which forces ramp up
+          static_friction (float)
+          dynamic_friction (float)
+          friction (dict[str, float]): {static, dynamic}
+          removal (RemovalMode | str): physical or compatible
+          cutting_rate (float): m^3 / (s N) at full speed
+          voxels_per_step (list[int]): per burr (compatible removal)
+          pose (numpy.ndarray): 4x4 initial goal, world from drill
         """
     def add_input_device(self, name: str, device: Device, drill: Drill, **kwargs) -> InputDevice:
         """
-        Binds a device to a drill. Options: workspace_scale (world m per device m), reference (an object, e.g. a camera, whose axes device motion follows: x right, y up, z towards the viewer), drill_button (0), clutch_button (1), burr_button (-1: none), max_force (N), force_scale.
+        Binds a device to a drill, as a surgeon holds it. Keywords:
+          workspace_scale (float): world m per device m
+          reference (Object | None): the object whose axes device motion follows
+          drill_button (int): held: the burr spins (-1: none)
+          clutch_button (int): held: the device moves alone (-1: none)
+          burr_button (int): pressed: the next burr (-1: none)
+          max_force (float): N sent at most
+          force_scale (float): force sent per newton of the drill's
         """
     def add_joint(self, name: str, parent: RigidBody, child: RigidBody, type: JointType | str = 'revolute', **kwargs) -> Joint:
         """
-        Adds a joint (revolute/hinge/continuous, prismatic/slider, fixed, spring, torsion spring, p2p, cone twist, six dof, six dof spring) between two bodies. Keywords: parent_pivot, parent_axis, child_pivot, child_axis (each body's frame), offset, child_offset, lower, upper, damping, stiffness, equilibrium, max_motor_impulse, erp, cfm, controller ({p, i, d, output}), passive, ignore_inter_collision.
+        Adds a joint between two bodies (type: revolute/hinge/continuous, prismatic/slider, fixed, spring, torsion spring, p2p, cone twist, six dof, six dof spring); pivots and axes are in each body's frame. Keywords:
+          type (JointType | str): revolute, prismatic, fixed, spring, ...
+          parent_pivot (tuple[float, float, float]): in the parent's frame, m
+          parent_axis (tuple[float, float, float]): in the parent's frame
+          child_pivot (tuple[float, float, float]): in the child's frame, m
+          child_axis (tuple[float, float, float]): in the child's frame
+          offset (float): the parent frame's turn about the axis, rad
+          child_offset (float): the child frame's turn about the axis, rad
+          lower (float | None): limit, rad or m
+          upper (float | None): limit, rad or m
+          damping (float): N m s/rad or N s/m
+          stiffness (float): springs: N m/rad or N/m
+          equilibrium (float): springs: rest position
+          max_motor_impulse (float): N m s (or N s) per step
+          erp (float)
+          cfm (float)
+          controller (dict[str, Any] | None): {p, i, d, output}
+          passive (bool): left out of its root body's joints, not controlled
+          ignore_inter_collision (bool): parent and child do not collide
         """
     def add_light(self, name: str, type: LightType | str = 'directional', *, position: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] = ..., direction: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] = ..., color: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex] = [1.0, 1.0, 1.0], intensity: typing.SupportsFloat | typing.SupportsIndex = 1.0, spot_cutoff: typing.SupportsFloat | typing.SupportsIndex = 0.7, spot_exponent: typing.SupportsFloat | typing.SupportsIndex = 0.7, attenuation: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] = ...) -> Light:
         """
@@ -466,11 +514,31 @@ class World:
         """
     def add_sensor(self, name: str, parent: RigidBody, **kwargs) -> ProximitySensor:
         """
-        Adds a proximity sensor fixed to parent, updated after every physics step. Keywords: location (4x4 in the parent's frame) or pose (4x4 world, now), range (m, 0.5), one ray by offset and direction (sensor frame, default +x from the origin), or rays ([{offset, direction}]) or parametric ({resolution, horizontal angle, vertical angle, start offset}); a ray reaches offset + direction * range. visible, visible_size.
+        Adds a proximity sensor fixed to parent, updated after every physics step; a ray reaches offset + direction * range (sensor frame, default +x from the origin). Keywords:
+          range (float): m each ray reaches (per unit of its direction)
+          offset (tuple[float, float, float]): the one ray's start, sensor frame
+          direction (tuple[float, float, float]): the one ray's direction, sensor frame
+          rays (list[Any]): [{offset, direction}] or [(offset, direction)]
+          parametric (dict[str, float]): {resolution, horizontal angle, vertical angle, start offset}
+          location (numpy.ndarray): 4x4 frame in the parent's frame
+          pose (numpy.ndarray): 4x4 frame in the world, now
+          visible (bool)
+          visible_size (float): m
         """
     def add_soft_body(self, name: str, mesh: os.PathLike | str | bytes, **kwargs) -> SoftBody:
         """
-        Adds a soft body made from a mesh file (STL, OBJ, ...): nodes at its distinct vertices, links along its triangle edges. Keywords: scale, pose (4x4 world from the mesh frame), mass (kg, shared evenly), margin (collision margin, m), config (AMBF's config block as a dict: kLST, kAST, kVST, kVCF, kDP, kDG, kLF, kPR, kVC, kDF, kMT, kCHR, kKHR, kSHR, kAHR, cluster keys, viterations, piterations, diterations, citerations, flags, 'bending constraint', clusters, 'fixed nodes'), fixed_nodes, randomize_constraints, color, specular, shininess.
+        Adds a soft body made from a mesh file (STL, OBJ, ...): nodes at its distinct vertices, links along its triangle edges. Keywords:
+          scale (float): of the mesh's vertices
+          pose (numpy.ndarray): 4x4 world from the mesh frame
+          mass (float): kg, shared evenly by the nodes
+          margin (float): collision margin, m
+          config (dict[str, Any] | None): AMBF's config block (kLST, ... fixed nodes)
+          fixed_nodes (list[int]): nodes pinned where they are
+          randomize_constraints (bool): shuffle the order the solver takes the links in
+          color (tuple[float, ...]): RGB or RGBA in 0..1
+          specular (float): Phong factor
+          shininess (float): Phong exponent
+          visible (bool): drawn in images (False: it still collides)
         """
     def add_volume(self, name: str, data: VolumeData, *, pose: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"] | None = None, iso: typing.SupportsFloat | typing.SupportsIndex = 0.5, quality: typing.SupportsFloat | typing.SupportsIndex = 0.5, optical_density: typing.SupportsFloat | typing.SupportsIndex = 1.0, specular: typing.SupportsFloat | typing.SupportsIndex | None = None, shininess: typing.SupportsFloat | typing.SupportsIndex | None = None) -> Volume:
         """
@@ -652,7 +720,14 @@ class Model:
         ...
     def add_actuator(self, name: str, parent: RigidBody, **kwargs) -> ConstraintActuator:
         """
-        Adds a constraint actuator on parent that holds bodies on request. Keywords: location (4x4 in the parent's frame) or pose (4x4 world, now), hold ('fixed': the body keeps its pose relative to the actuator, or 'point': only the point is held), max_impulse (N s per step, point hold), tau (point hold), visible, visible_size.
+        Adds a constraint actuator on parent that holds bodies on request (hold 'fixed': the body keeps its pose relative to the actuator; 'point': only the point is held). Keywords:
+          hold (ActuatorHold | str): fixed (the body keeps its pose) or point
+          max_impulse (float): N s per step (point hold)
+          tau (float): share of the point error corrected per step (point hold)
+          location (numpy.ndarray): 4x4 frame in the parent's frame
+          pose (numpy.ndarray): 4x4 frame in the world, now
+          visible (bool)
+          visible_size (float): m
         """
     def add_body(self, name: str, shape: ShapeKind | str | None = None, *, size: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] | None = None, radius: typing.SupportsFloat | typing.SupportsIndex | None = None, height: typing.SupportsFloat | typing.SupportsIndex | None = None, mesh: os.PathLike | str | bytes | None = None, scale: typing.SupportsFloat | typing.SupportsIndex = 1.0, pose: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"] | None = None, mass: typing.SupportsFloat | typing.SupportsIndex = 1.0, color: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex] | None = None, specular: typing.SupportsFloat | typing.SupportsIndex | None = None, shininess: typing.SupportsFloat | typing.SupportsIndex | None = None, **kwargs) -> RigidBody:
         """
@@ -664,15 +739,56 @@ class Model:
         """
     def add_drill(self, name: str, volume: Volume, **kwargs) -> Drill:
         """
-        Adds a drill working on `volume`. Options: burr_diameters (m), burr (index), cursors, spacing, shaft_radii, stiffness (N/m), damping, max_force, soft_start, static_friction, dynamic_friction, removal ('physical' or 'compatible'), cutting_rate (m^3/(s N)), voxels_per_step, pose (initial goal, 4x4).
+        Adds a drill working on `volume`. Keywords:
+          burr_diameters (list[float]): m
+          burr (int): index into burr_diameters
+          cursors (int): tip + shaft cursors, 1..16
+          spacing (float): m between cursors along the shaft
+          shaft_radii (list[float]): m, one per shaft cursor
+          stiffness (float): N/m
+          damping (float): N s/m
+          max_force (float): N
+          soft_start (float): s over which forces ramp up
+          static_friction (float)
+          dynamic_friction (float)
+          friction (dict[str, float]): {static, dynamic}
+          removal (RemovalMode | str): physical or compatible
+          cutting_rate (float): m^3 / (s N) at full speed
+          voxels_per_step (list[int]): per burr (compatible removal)
+          pose (numpy.ndarray): 4x4 initial goal, world from drill
         """
     def add_input_device(self, name: str, device: Device, drill: Drill, **kwargs) -> InputDevice:
         """
-        Binds a device to a drill. Options: workspace_scale (world m per device m), reference (an object, e.g. a camera, whose axes device motion follows: x right, y up, z towards the viewer), drill_button (0), clutch_button (1), burr_button (-1: none), max_force (N), force_scale.
+        Binds a device to a drill, as a surgeon holds it. Keywords:
+          workspace_scale (float): world m per device m
+          reference (Object | None): the object whose axes device motion follows
+          drill_button (int): held: the burr spins (-1: none)
+          clutch_button (int): held: the device moves alone (-1: none)
+          burr_button (int): pressed: the next burr (-1: none)
+          max_force (float): N sent at most
+          force_scale (float): force sent per newton of the drill's
         """
     def add_joint(self, name: str, parent: RigidBody, child: RigidBody, type: JointType | str = 'revolute', **kwargs) -> Joint:
         """
-        Adds a joint (revolute/hinge/continuous, prismatic/slider, fixed, spring, torsion spring, p2p, cone twist, six dof, six dof spring) between two bodies. Keywords: parent_pivot, parent_axis, child_pivot, child_axis (each body's frame), offset, child_offset, lower, upper, damping, stiffness, equilibrium, max_motor_impulse, erp, cfm, controller ({p, i, d, output}), passive, ignore_inter_collision.
+        Adds a joint between two bodies (type: revolute/hinge/continuous, prismatic/slider, fixed, spring, torsion spring, p2p, cone twist, six dof, six dof spring); pivots and axes are in each body's frame. Keywords:
+          type (JointType | str): revolute, prismatic, fixed, spring, ...
+          parent_pivot (tuple[float, float, float]): in the parent's frame, m
+          parent_axis (tuple[float, float, float]): in the parent's frame
+          child_pivot (tuple[float, float, float]): in the child's frame, m
+          child_axis (tuple[float, float, float]): in the child's frame
+          offset (float): the parent frame's turn about the axis, rad
+          child_offset (float): the child frame's turn about the axis, rad
+          lower (float | None): limit, rad or m
+          upper (float | None): limit, rad or m
+          damping (float): N m s/rad or N s/m
+          stiffness (float): springs: N m/rad or N/m
+          equilibrium (float): springs: rest position
+          max_motor_impulse (float): N m s (or N s) per step
+          erp (float)
+          cfm (float)
+          controller (dict[str, Any] | None): {p, i, d, output}
+          passive (bool): left out of its root body's joints, not controlled
+          ignore_inter_collision (bool): parent and child do not collide
         """
     def add_light(self, name: str, type: LightType | str = 'directional', *, position: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] = ..., direction: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] = ..., color: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex] = [1.0, 1.0, 1.0], intensity: typing.SupportsFloat | typing.SupportsIndex = 1.0, spot_cutoff: typing.SupportsFloat | typing.SupportsIndex = 0.7, spot_exponent: typing.SupportsFloat | typing.SupportsIndex = 0.7, attenuation: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] = ...) -> Light:
         """
@@ -680,11 +796,31 @@ class Model:
         """
     def add_sensor(self, name: str, parent: RigidBody, **kwargs) -> ProximitySensor:
         """
-        Adds a proximity sensor fixed to parent, updated after every physics step. Keywords: location (4x4 in the parent's frame) or pose (4x4 world, now), range (m, 0.5), one ray by offset and direction (sensor frame, default +x from the origin), or rays ([{offset, direction}]) or parametric ({resolution, horizontal angle, vertical angle, start offset}); a ray reaches offset + direction * range. visible, visible_size.
+        Adds a proximity sensor fixed to parent, updated after every physics step; a ray reaches offset + direction * range (sensor frame, default +x from the origin). Keywords:
+          range (float): m each ray reaches (per unit of its direction)
+          offset (tuple[float, float, float]): the one ray's start, sensor frame
+          direction (tuple[float, float, float]): the one ray's direction, sensor frame
+          rays (list[Any]): [{offset, direction}] or [(offset, direction)]
+          parametric (dict[str, float]): {resolution, horizontal angle, vertical angle, start offset}
+          location (numpy.ndarray): 4x4 frame in the parent's frame
+          pose (numpy.ndarray): 4x4 frame in the world, now
+          visible (bool)
+          visible_size (float): m
         """
     def add_soft_body(self, name: str, mesh: os.PathLike | str | bytes, **kwargs) -> SoftBody:
         """
-        Adds a soft body made from a mesh file (STL, OBJ, ...): nodes at its distinct vertices, links along its triangle edges. Keywords: scale, pose (4x4 world from the mesh frame), mass (kg, shared evenly), margin (collision margin, m), config (AMBF's config block as a dict: kLST, kAST, kVST, kVCF, kDP, kDG, kLF, kPR, kVC, kDF, kMT, kCHR, kKHR, kSHR, kAHR, cluster keys, viterations, piterations, diterations, citerations, flags, 'bending constraint', clusters, 'fixed nodes'), fixed_nodes, randomize_constraints, color, specular, shininess.
+        Adds a soft body made from a mesh file (STL, OBJ, ...): nodes at its distinct vertices, links along its triangle edges. Keywords:
+          scale (float): of the mesh's vertices
+          pose (numpy.ndarray): 4x4 world from the mesh frame
+          mass (float): kg, shared evenly by the nodes
+          margin (float): collision margin, m
+          config (dict[str, Any] | None): AMBF's config block (kLST, ... fixed nodes)
+          fixed_nodes (list[int]): nodes pinned where they are
+          randomize_constraints (bool): shuffle the order the solver takes the links in
+          color (tuple[float, ...]): RGB or RGBA in 0..1
+          specular (float): Phong factor
+          shininess (float): Phong exponent
+          visible (bool): drawn in images (False: it still collides)
         """
     def add_volume(self, name: str, data: VolumeData, *, pose: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"] | None = None, iso: typing.SupportsFloat | typing.SupportsIndex = 0.5, quality: typing.SupportsFloat | typing.SupportsIndex = 0.5, optical_density: typing.SupportsFloat | typing.SupportsIndex = 1.0, specular: typing.SupportsFloat | typing.SupportsIndex | None = None, shininess: typing.SupportsFloat | typing.SupportsIndex | None = None) -> Volume:
         """

@@ -278,6 +278,17 @@ InputDevice& add_input_device(Model& model, const std::string& name,
   return model.add_input_device(spec);
 }
 
+// A method's docstring: what it does, then its keywords from the spec's option table (one
+// source for the engine, the docs and the stubs).
+template <typename Spec>
+std::string with_keywords(const char* what, const OptionTable<Spec>& table) {
+  std::string doc = std::string(what) + " Keywords:";
+  for (const auto& o : table.options()) {
+    doc += "\n  " + o.key + " (" + o.type + ")" + (o.help.empty() ? "" : ": " + o.help);
+  }
+  return doc;
+}
+
 template <typename Class, typename GetModel>
 void def_adders(Class& cls, GetModel get_model) {
   using Self = typename Class::type;
@@ -316,11 +327,11 @@ void def_adders(Class& cls, GetModel get_model) {
             return handle(&add_joint(model, name, parent, child, type, kw), model.world());
           },
           py::arg("name"), py::arg("parent"), py::arg("child"), py::arg("type") = "revolute",
-          "Adds a joint (revolute/hinge/continuous, prismatic/slider, fixed, spring, torsion "
-          "spring, p2p, cone twist, six dof, six dof spring) between two bodies. Keywords: "
-          "parent_pivot, parent_axis, child_pivot, child_axis (each body's frame), offset, "
-          "child_offset, lower, upper, damping, stiffness, equilibrium, max_motor_impulse, erp, "
-          "cfm, controller ({p, i, d, output}), passive, ignore_inter_collision.")
+          with_keywords("Adds a joint between two bodies (type: revolute/hinge/continuous, "
+                        "prismatic/slider, fixed, spring, torsion spring, p2p, cone twist, six "
+                        "dof, six dof spring); pivots and axes are in each body's frame.",
+                        joint_options())
+              .c_str())
       .def(
           "add_camera",
           [get_model](Self& self, const std::string& name, int width, int height, double fov_y,
@@ -380,10 +391,7 @@ void def_adders(Class& cls, GetModel get_model) {
                           model.world());
           },
           py::arg("name"), py::arg("volume"),
-          "Adds a drill working on `volume`. Options: burr_diameters (m), burr (index), cursors, "
-          "spacing, shaft_radii, stiffness (N/m), damping, max_force, soft_start, "
-          "static_friction, dynamic_friction, removal ('physical' or 'compatible'), "
-          "cutting_rate (m^3/(s N)), voxels_per_step, pose (initial goal, 4x4).")
+          with_keywords("Adds a drill working on `volume`.", drill_options()).c_str())
       .def(
           "add_input_device",
           [get_model](Self& self, const std::string& name, const std::shared_ptr<Device>& device,
@@ -392,10 +400,8 @@ void def_adders(Class& cls, GetModel get_model) {
             return handle(&add_input_device(model, name, device, drill, kw), model.world());
           },
           py::arg("name"), py::arg("device"), py::arg("drill"),
-          "Binds a device to a drill. Options: workspace_scale (world m per device m), reference "
-          "(an object, e.g. a camera, whose axes device motion follows: x right, y up, z towards "
-          "the viewer), drill_button (0), clutch_button (1), burr_button (-1: none), max_force "
-          "(N), force_scale.")
+          with_keywords("Binds a device to a drill, as a surgeon holds it.", input_device_options())
+              .c_str())
       .def(
           "add_soft_body",
           [get_model](Self& self, const std::string& name, const Path& mesh, const py::kwargs& kw) {
@@ -411,13 +417,10 @@ void def_adders(Class& cls, GetModel get_model) {
             return handle(body, model.world());
           },
           py::arg("name"), py::arg("mesh"),
-          "Adds a soft body made from a mesh file (STL, OBJ, ...): nodes at its distinct "
-          "vertices, links along its triangle edges. Keywords: scale, pose (4x4 world from the "
-          "mesh frame), mass (kg, shared evenly), margin (collision margin, m), config (AMBF's "
-          "config block as a dict: kLST, kAST, kVST, kVCF, kDP, kDG, kLF, kPR, kVC, kDF, kMT, "
-          "kCHR, kKHR, kSHR, kAHR, cluster keys, viterations, piterations, diterations, "
-          "citerations, flags, 'bending constraint', clusters, 'fixed nodes'), fixed_nodes, "
-          "randomize_constraints, color, specular, shininess.")
+          with_keywords("Adds a soft body made from a mesh file (STL, OBJ, ...): nodes at its "
+                        "distinct vertices, links along its triangle edges.",
+                        soft_body_options())
+              .c_str())
       .def(
           "add_sensor",
           [get_model](Self& self, const std::string& name, RigidBody& parent,
@@ -430,12 +433,11 @@ void def_adders(Class& cls, GetModel get_model) {
                           model.world());
           },
           py::arg("name"), py::arg("parent"),
-          "Adds a proximity sensor fixed to parent, updated after every physics step. Keywords: "
-          "location (4x4 in the parent's frame) or pose (4x4 world, now), range (m, 0.5), one "
-          "ray by offset and direction (sensor frame, default +x from the origin), or rays "
-          "([{offset, direction}]) or parametric ({resolution, horizontal angle, vertical "
-          "angle, start offset}); a ray reaches offset + direction * range. visible, "
-          "visible_size.")
+          with_keywords(
+              "Adds a proximity sensor fixed to parent, updated after every physics step; a ray "
+              "reaches offset + direction * range (sensor frame, default +x from the origin).",
+              proximity_sensor_options())
+              .c_str())
       .def(
           "add_actuator",
           [get_model](Self& self, const std::string& name, RigidBody& parent,
@@ -448,10 +450,11 @@ void def_adders(Class& cls, GetModel get_model) {
                           model.world());
           },
           py::arg("name"), py::arg("parent"),
-          "Adds a constraint actuator on parent that holds bodies on request. Keywords: "
-          "location (4x4 in the parent's frame) or pose (4x4 world, now), hold ('fixed': the "
-          "body keeps its pose relative to the actuator, or 'point': only the point is held), "
-          "max_impulse (N s per step, point hold), tau (point hold), visible, visible_size.");
+          with_keywords(
+              "Adds a constraint actuator on parent that holds bodies on request (hold 'fixed': "
+              "the body keeps its pose relative to the actuator; 'point': only the point is held).",
+              constraint_actuator_options())
+              .c_str());
 }
 
 // ---- The classes' methods.

@@ -7,6 +7,7 @@
 #include "ambfplus/errors.h"
 #include "ambfplus/scene/constraint_actuator.h"
 #include "ambfplus/scene/rigid_body.h"
+#include "scene/shared_options.h"
 #include "util/strings.h"
 
 namespace ambfplus {
@@ -43,23 +44,16 @@ const OptionTable<ConstraintActuatorSpec>& constraint_actuator_options() {
   using K = const std::string&;
   static const OptionTable<S> table(
       "add_actuator()",
-      {
-          O{"location", "numpy.ndarray", "4x4 actuator frame in the parent's frame",
-            [](S& s, V v, K k) { s.location = v.matrix4(k); }},
-          O{"pose", "numpy.ndarray", "4x4 actuator frame in the world, now",
-            [](S& s, V v, K k) {
-              if (s.parent == nullptr) throw ArgumentError("an actuator's pose needs its parent");
-              s.location = (s.parent->pose().inverse() * checked_pose(v.matrix4(k))).matrix();
-            }},
-          O{"hold", "ActuatorHold | str", "fixed (the body keeps its pose) or point",
-            [](S& s, V v, K k) { s.hold = parse_actuator_hold(v.text(k)); }},
-          O{"max_impulse", "float", "N s per step (point hold)",
-            [](S& s, V v, K k) { s.max_impulse = v.number(k); }},
-          O{"tau", "float", "share of the point error corrected per step (point hold)",
-            [](S& s, V v, K k) { s.tau = v.number(k); }},
-          O{"visible", "bool", "", [](S& s, V v, K k) { s.visible = v.boolean(k); }},
-          O{"visible_size", "float", "m", [](S& s, V v, K k) { s.visible_size = v.number(k); }},
-      },
+      joined<O>(
+          {
+              O{"hold", "ActuatorHold | str", "fixed (the body keeps its pose) or point",
+                [](S& s, V v, K k) { s.hold = parse_actuator_hold(v.text(k)); }},
+              O{"max_impulse", "float", "N s per step (point hold)",
+                [](S& s, V v, K k) { s.max_impulse = v.number(k); }},
+              O{"tau", "float", "share of the point error corrected per step (point hold)",
+                [](S& s, V v, K k) { s.tau = v.number(k); }},
+          },
+          attachment_options<S>("an actuator")),
       [](S& s, const std::vector<std::string>& given) {
         const auto has = [&](const char* k) {
           return std::find(given.begin(), given.end(), k) != given.end();

@@ -7,6 +7,7 @@
 #include "ambfplus/errors.h"
 #include "ambfplus/scene/proximity_sensor.h"
 #include "ambfplus/scene/rigid_body.h"
+#include "scene/shared_options.h"
 
 namespace ambfplus {
 namespace {
@@ -108,36 +109,29 @@ void ProximitySensorSpec::validate() const {
 const OptionTable<ProximitySensorSpec>& proximity_sensor_options() {
   static const OptionTable<S> table(
       "add_sensor()",
-      {
-          O{"location", "numpy.ndarray", "4x4 sensor frame in the parent's frame",
-            [](S& s, V v, K k) { s.location = v.matrix4(k); }},
-          O{"pose", "numpy.ndarray", "4x4 sensor frame in the world, now",
-            [](S& s, V v, K k) {
-              if (s.parent == nullptr) throw ArgumentError("a sensor's pose needs its parent");
-              s.location = (s.parent->pose().inverse() * checked_pose(v.matrix4(k))).matrix();
-            }},
-          O{"range", "float", "m each ray reaches (per unit of its direction)",
-            [](S& s, V v, K k) { s.range = v.number(k); }},
-          O{"offset", "tuple[float, float, float]", "the one ray's start, sensor frame",
-            [](S& s, V v, K k) { single_ray(s).offset = v.vector3(k); }},
-          O{"direction", "tuple[float, float, float]", "the one ray's direction, sensor frame",
-            [](S& s, V v, K k) { single_ray(s).direction = v.vector3(k); }},
-          O{"rays",
-            "list[Any]",
-            "[{offset, direction}] or [(offset, direction)]",
-            [](S& s, V v, K k) {
-              for (const OptionValue& r : v.list(k)) s.rays.push_back(parse_ray(r, k));
-            },
-            {"array"}},
-          O{"parametric", "dict[str, float]",
-            "{resolution, horizontal angle, vertical angle, start offset}",
-            [](S& s, V v, K k) {
-              const auto fan = parametric_sensor_rays(v.map(k));
-              s.rays.insert(s.rays.end(), fan.begin(), fan.end());
-            }},
-          O{"visible", "bool", "", [](S& s, V v, K k) { s.visible = v.boolean(k); }},
-          O{"visible_size", "float", "m", [](S& s, V v, K k) { s.visible_size = v.number(k); }},
-      },
+      joined<O>(
+          {
+              O{"range", "float", "m each ray reaches (per unit of its direction)",
+                [](S& s, V v, K k) { s.range = v.number(k); }},
+              O{"offset", "tuple[float, float, float]", "the one ray's start, sensor frame",
+                [](S& s, V v, K k) { single_ray(s).offset = v.vector3(k); }},
+              O{"direction", "tuple[float, float, float]", "the one ray's direction, sensor frame",
+                [](S& s, V v, K k) { single_ray(s).direction = v.vector3(k); }},
+              O{"rays",
+                "list[Any]",
+                "[{offset, direction}] or [(offset, direction)]",
+                [](S& s, V v, K k) {
+                  for (const OptionValue& r : v.list(k)) s.rays.push_back(parse_ray(r, k));
+                },
+                {"array"}},
+              O{"parametric", "dict[str, float]",
+                "{resolution, horizontal angle, vertical angle, start offset}",
+                [](S& s, V v, K k) {
+                  const auto fan = parametric_sensor_rays(v.map(k));
+                  s.rays.insert(s.rays.end(), fan.begin(), fan.end());
+                }},
+          },
+          attachment_options<S>("a sensor")),
       finish);
   return table;
 }

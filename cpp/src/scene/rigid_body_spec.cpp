@@ -5,7 +5,7 @@
 
 #include "ambfplus/errors.h"
 #include "ambfplus/scene/rigid_body.h"
-#include "scene/material_options.h"
+#include "scene/shared_options.h"
 #include "util/strings.h"
 
 namespace ambfplus {

@@ -5,7 +5,7 @@
 
 #include "ambfplus/errors.h"
 #include "ambfplus/scene/soft_body.h"
-#include "scene/material_options.h"
+#include "scene/shared_options.h"
 
 namespace ambfplus {
 namespace {

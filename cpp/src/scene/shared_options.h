@@ -1,11 +1,13 @@
 #pragma once
 
-// The material keywords that bodies and soft bodies share, for their option tables.
+// Keywords that several specs share, for their option tables: a material's (bodies, soft
+// bodies) and an attachment's to a parent body (sensors, actuators).
 
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "ambfplus/errors.h"
 #include "ambfplus/scene/options.h"
 #include "ambfplus/scene/rigid_body.h"
 
@@ -26,6 +28,26 @@ std::vector<typename OptionTable<Spec>::Option> material_options(Material Spec::
         [member](Spec& s, V v, K k) { (s.*member).shininess = static_cast<float>(v.number(k)); }},
       O{"visible", "bool", "drawn in images (False: it still collides)",
         [member](Spec& s, V v, K k) { (s.*member).visible = v.boolean(k); }},
+  };
+}
+
+/// location (in the parent's frame) or pose (world, now), visible and visible_size of a Spec
+/// with those fields and a parent body; `what` names it in messages ("a sensor").
+template <typename Spec>
+std::vector<typename OptionTable<Spec>::Option> attachment_options(const std::string& what) {
+  using O = typename OptionTable<Spec>::Option;
+  using V = const OptionValue&;
+  using K = const std::string&;
+  return {
+      O{"location", "numpy.ndarray", "4x4 frame in the parent's frame",
+        [](Spec& s, V v, K k) { s.location = v.matrix4(k); }},
+      O{"pose", "numpy.ndarray", "4x4 frame in the world, now",
+        [what](Spec& s, V v, K k) {
+          if (s.parent == nullptr) throw ArgumentError(what + "'s pose needs its parent");
+          s.location = (s.parent->pose().inverse() * checked_pose(v.matrix4(k))).matrix();
+        }},
+      O{"visible", "bool", "", [](Spec& s, V v, K k) { s.visible = v.boolean(k); }},
+      O{"visible_size", "float", "m", [](Spec& s, V v, K k) { s.visible_size = v.number(k); }},
   };
 }
 

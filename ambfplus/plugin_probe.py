@@ -55,9 +55,8 @@ class ProbeResult:
             "made": "after making the plugin object",
         }[self.stage]
         tail = self.output.strip()[-2000:]
-        return (
-            f"{self.path}: refused: loading it in a probe process {how} {where}"
-            + (f"; the probe's output:\n{tail}" if tail else " (no output)")
+        return f"{self.path}: refused: loading it in a probe process {how} {where}" + (
+            f"; the probe's output:\n{tail}" if tail else " (no output)"
         )
 
 

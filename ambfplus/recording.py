@@ -770,9 +770,7 @@ def _memory_file(path: Path, **options) -> h5py.File:
     """An HDF5 file built in memory (HDF5's core driver, nothing on disk): HDF5 itself then never
     meets a failing disk, whose errors leave its open objects in a state that crashes the
     process when they are freed (at interpreter exit at the latest)."""
-    return h5py.File(
-        path, "w", driver="core", backing_store=False, block_size=4 * MiB, **options
-    )
+    return h5py.File(path, "w", driver="core", backing_store=False, block_size=4 * MiB, **options)
 
 
 def _store(file: h5py.File, path: Path) -> None:

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .recording_reader import CameraStream, Recording, RigStream, open_recording
+from .recording_reader import _DAMAGE, CameraStream, Recording, RigStream, open_recording
 from .recording_schema import RecordingError, glob_escape
 from .stereo import disparity_agreement
 
@@ -90,15 +90,19 @@ def validate(path, match_images: bool = True) -> ValidationReport:
         return ValidationReport(path, [Check("open", "fail", str(error))])
     with recording:
         checks = [_open_check(recording), _leftover_check(path)]
-        for name, stream in recording.cameras.items():
-            checks += _stream_checks(f"cameras/{name}", stream)
-        for name, rig in recording.rigs.items():
-            checks += _rig_checks(f"rigs/{name}", rig, match_images)
-        checks += _steps_checks(recording.steps)
-        checks += _removed_checks(recording)
-        checks += _log_order_checks(recording)
-        for name, stream in recording.cameras.items():
-            checks.append(_removed_visibility_check(f"cameras/{name}", stream, recording))
+        try:
+            for name, stream in recording.cameras.items():
+                checks += _stream_checks(f"cameras/{name}", stream)
+            for name, rig in recording.rigs.items():
+                checks += _rig_checks(f"rigs/{name}", rig, match_images)
+            checks += _steps_checks(recording.steps)
+            checks += _removed_checks(recording)
+            checks += _log_order_checks(recording)
+            for name, stream in recording.cameras.items():
+                checks.append(_removed_visibility_check(f"cameras/{name}", stream, recording))
+        except (RecordingError, *_DAMAGE) as error:
+            # Data that cannot be read or does not have the layout's shapes and types.
+            checks.append(Check("read", "fail", f"{type(error).__name__}: {error}"))
     return ValidationReport(path, checks)
 
 
@@ -249,14 +253,18 @@ def _views_paired_check(name: str, rig: RigStream, left, right) -> Check:
         f"{counts['right']} for {counts['pairs']} pairs ({unpaired['left']} and "
         f"{unpaired['right']} frames in no pair): a stereo pair was cut"
     )
-    return Check(title, "fail", detail, {**counts, **{f"unpaired_{k}": v for k, v in unpaired.items()}})
+    return Check(
+        title, "fail", detail, {**counts, **{f"unpaired_{k}": v for k, v in unpaired.items()}}
+    )
 
 
 def leftover_files(path: Path) -> list[Path]:
     """Unfinished files a recorder that did not close left beside ``path``: its last part's
     ``.partNNNN.tmp`` and a head being rewritten (``.tmp``). Readers ignore them."""
     escaped = glob_escape(path.name)
-    found = list(path.parent.glob(escaped + ".part*.tmp")) + list(path.parent.glob(escaped + ".tmp"))
+    found = list(path.parent.glob(escaped + ".part*.tmp")) + list(
+        path.parent.glob(escaped + ".tmp")
+    )
     return sorted(found)
 
 

@@ -67,7 +67,9 @@ def test_nrrd_bytes_after_the_gzip_stream_are_an_error(tmp_path):
 
 
 def test_nrrd_gzip_in_two_members_loads(tmp_path):
-    path = nrrd(tmp_path, HEADER + "encoding: gzip\n", gzip.compress(RAW[:200]) + gzip.compress(RAW[200:]))
+    path = nrrd(
+        tmp_path, HEADER + "encoding: gzip\n", gzip.compress(RAW[:200]) + gzip.compress(RAW[200:])
+    )
     assert np.array_equal(np.asarray(ambfplus.load_nrrd(path).labels), LABELS)
 
 
@@ -251,8 +253,10 @@ def stack(tmp_path: Path) -> Path:
     return tmp_path / "slices"
 
 
-@pytest.mark.parametrize(("option", "value"), [("count", 0), ("count", -2),
-                                               ("alpha_threshold", 300), ("alpha_threshold", -1)])  # fmt: skip
+BAD_STACK_OPTIONS = [("count", 0), ("count", -2), ("alpha_threshold", 300), ("alpha_threshold", -1)]
+
+
+@pytest.mark.parametrize(("option", "value"), BAD_STACK_OPTIONS)
 def test_slice_stack_bad_options_are_argument_errors(tmp_path, option, value):
     folder = stack(tmp_path)
     with pytest.raises(ambfplus.ArgumentError, match=option) as info:
@@ -424,7 +428,9 @@ def test_binary_ply_face_naming_a_missing_vertex_is_an_error(tmp_path):
 
 def test_ply_with_more_rows_than_declared_is_an_error(tmp_path):
     path = tmp_path / "more.ply"
-    path.write_text(PLY_HEAD.format(n=3, f=1) + "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 2 1\n")
+    path.write_text(
+        PLY_HEAD.format(n=3, f=1) + "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 2 1\n"
+    )
     expect_mesh_error(path, "more data after the rows the header declares")
 
 

@@ -201,7 +201,9 @@ def test_leftover_temporary_files_are_reported_and_repair_removes_them(tmp_path)
     assert report.ok
     repair(path)
     assert not leftover.exists()
-    check = next(c for c in validate(path, match_images=False).checks if c.name == "no unfinished files")
+    check = next(
+        c for c in validate(path, match_images=False).checks if c.name == "no unfinished files"
+    )
     assert check.status == "pass"
 
 

@@ -13,9 +13,7 @@ growth over an equally long stretch with no datagrams.
 
 from __future__ import annotations
 
-import math
 import os
-import struct
 import subprocess
 import sys
 import time
@@ -23,7 +21,6 @@ import time
 import numpy as np
 
 import ambfplus
-from ambfplus.network import pack_pose
 
 SENDER = r"""
 import math, socket, struct, sys, time
@@ -64,7 +61,9 @@ def drilling_world():
     n, voxel = 80, 0.0002
     grid = np.zeros((n, n, n), np.uint8)
     grid[:, :, : n // 2] = 1
-    data = ambfplus.VolumeData(grid, voxel_size=(voxel,) * 3, label_table=[ambfplus.Label(1, "Bone")])
+    data = ambfplus.VolumeData(
+        grid, voxel_size=(voxel,) * 3, label_table=[ambfplus.Label(1, "Bone")]
+    )
     world = ambfplus.World()
     volume = world.add_volume("bone", data)
     down = np.array([[1.0, 0, 0], [0, -1, 0], [0, 0, -1]])

@@ -43,7 +43,7 @@ def nrrd_seeds() -> None:
     big = labels.astype(">u2").tobytes(order="F")
     header = (
         "NRRD0004\ntype: ushort\ndimension: 3\nsizes: 6 5 4\nendian: big\nencoding: raw\n"
-        "spacings: 0.5 0.5 1\nspace units: \"mm\" \"mm\" \"mm\"\nbyte skip: -1\n\n"
+        'spacings: 0.5 0.5 1\nspace units: "mm" "mm" "mm"\nbyte skip: -1\n\n'
     )
     write("nrrd", "big-endian.nrrd", header.encode() + b"padding" + big)
     header = (
@@ -66,7 +66,9 @@ def slice_stack_seeds() -> None:
     rgba[1:4, 1:5] = (200, 200, 200, 255)
     other = rgba.copy()
     other[2, 2] = (250, 200, 0, 255)
-    write("slice_stack", "rgba", bytes([0]) + SEPARATOR.join([png(rgba, "RGBA"), png(other, "RGBA")]))
+    write(
+        "slice_stack", "rgba", bytes([0]) + SEPARATOR.join([png(rgba, "RGBA"), png(other, "RGBA")])
+    )
     grey = np.zeros((5, 6), dtype=np.uint8)
     grey[1:3, 1:3] = 3
     write("slice_stack", "grey", bytes([1]) + SEPARATOR.join([png(grey, "L")] * 3))
@@ -107,8 +109,8 @@ def recording_seeds() -> None:
             rec.add_removed({"step": [5], "voxel": [[1, 2, 3]], "label": [1]}, volume="ear")
             rec.add_events([{"step": 5, "kind": "contact", "label": 1}])
         parts = sorted(Path(folder).glob("session.h5.part*"))
-        write("recording", "complete",
-              SEPARATOR.join([path.read_bytes()] + [p.read_bytes() for p in parts[:2]]))  # fmt: skip
+        files = [path.read_bytes()] + [p.read_bytes() for p in parts[:2]]
+        write("recording", "complete", SEPARATOR.join(files))
 
 
 ADF_SEEDS = {

@@ -100,7 +100,7 @@ def test_a_good_plugin_passes_its_probe_and_loads(plugins):
     assert result.ok and result.returncode == 0, result.message
     world = ambfplus.World()
     world.load_plugin(str(path), probe=True)
-    assert [p.name for p in world.plugins] == ["good"]
+    assert [p.name for p in world.plugins] == ["libgood"]  # named after its file
 
 
 def test_check_plugins_command_reports_each_plugin(plugins, capsys):

@@ -45,8 +45,7 @@ void append_mesh(const std::string& path, const aiMesh& in, double scale, MeshDa
     for (float c : {p.x, p.y, p.z}) {
       if (!std::isfinite(c)) {
         throw ConfigError(path, "vertex " + std::to_string(v) + " of mesh '" +
-                                    std::string(in.mName.C_Str()) +
-                                    "' has non-finite coordinates");
+                                    std::string(in.mName.C_Str()) + "' has non-finite coordinates");
       }
       const double scaled = c * scale;
       if (!std::isfinite(static_cast<float>(scaled))) {

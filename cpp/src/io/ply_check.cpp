@@ -108,8 +108,9 @@ Header read_header(const std::string& path, const std::string& bytes) {
     }
     if (w[0] == "format") {
       if (w.size() != 3 || w[2] != "1.0") {
-        throw ConfigError(path, where + "expected 'format ascii|binary_little_endian|"
-                                        "binary_big_endian 1.0', got '" +
+        throw ConfigError(path, where +
+                                    "expected 'format ascii|binary_little_endian|"
+                                    "binary_big_endian 1.0', got '" +
                                     line + "'");
       }
       if (w[1] == "ascii") {
@@ -147,8 +148,9 @@ Header read_header(const std::string& path, const std::string& bytes) {
         p.type = scalar_type(path, line_no, w[1]);
         p.name = w[2];
       } else {
-        throw ConfigError(path, where + "expected 'property <type> <name>' or 'property list "
-                                        "<count type> <type> <name>', got '" +
+        throw ConfigError(path, where +
+                                    "expected 'property <type> <name>' or 'property list "
+                                    "<count type> <type> <name>', got '" +
                                     line + "'");
       }
       h.elements.back().properties.push_back(p);
@@ -174,8 +176,8 @@ struct IndexCheck {
     if (e.name == "tristrips" && index == -1) return;
     if (!(index >= 0 && index < static_cast<double>(vertices))) {
       throw ConfigError(path, where + "element '" + e.name + "' names vertex " +
-                                  std::to_string(static_cast<long long>(index)) + " but there are " +
-                                  std::to_string(vertices) + " vertices");
+                                  std::to_string(static_cast<long long>(index)) +
+                                  " but there are " + std::to_string(vertices) + " vertices");
     }
   }
 };
@@ -303,8 +305,7 @@ void check_binary(const std::string& path, const std::string& bytes, const Heade
         if (bytes.size() - pos < n) {
           throw ConfigError(path, "the file ends inside row " + std::to_string(row) + " of the " +
                                       std::to_string(e.count) + " rows of element '" + e.name +
-                                      "' (declared on line " + std::to_string(e.header_line) +
-                                      ")");
+                                      "' (declared on line " + std::to_string(e.header_line) + ")");
         }
       };
       for (const Property& p : e.properties) {
@@ -317,8 +318,8 @@ void check_binary(const std::string& path, const std::string& bytes, const Heade
         const double n = read_binary(bytes.data() + pos, p.count_type, big);
         pos += p.count_type.bytes;
         if (n < 0) {
-          throw ConfigError(path, where + "element '" + e.name + "', list '" + p.name +
-                                      "' has a negative count");
+          throw ConfigError(
+              path, where + "element '" + e.name + "', list '" + p.name + "' has a negative count");
         }
         if (is_index_list(e, p) && n == 0) {
           throw ConfigError(path, where + "element '" + e.name + "' has a face of no vertices");

@@ -10,9 +10,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
-#include <limits>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <regex>
 #include <set>
@@ -264,8 +264,7 @@ std::string read_file(const std::string& path, const char* what) {
 
 // Every byte of the gzip stream (one member or several, as concatenated gzip files are), but no
 // more than `limit`: a stream that inflates to more is reported as such without being kept.
-std::string gunzip(const std::string& path, const char* data, std::size_t size,
-                   std::size_t limit) {
+std::string gunzip(const std::string& path, const char* data, std::size_t size, std::size_t limit) {
   std::string out;
   z_stream z{};
   if (inflateInit2(&z, 15 + 32) != Z_OK) throw ConfigError(path, "cannot start gzip decoding");
@@ -304,13 +303,12 @@ std::string gunzip(const std::string& path, const char* data, std::size_t size,
   inflateEnd(&z);
   if (out.size() > limit) return out;
   if (rc != Z_STREAM_END) {
-    throw ConfigError(
-        path, "gzip data is corrupt or cut short after " + std::to_string(out.size()) +
-                  " decoded bytes (zlib: " +
-                  (!message.empty() ? message
-                   : rc == Z_BUF_ERROR ? std::string("unexpected end of the stream")
-                                       : "error " + std::to_string(rc)) +
-                  ")");
+    throw ConfigError(path, "gzip data is corrupt or cut short after " +
+                                std::to_string(out.size()) + " decoded bytes (zlib: " +
+                                (!message.empty()    ? message
+                                 : rc == Z_BUF_ERROR ? std::string("unexpected end of the stream")
+                                                     : "error " + std::to_string(rc)) +
+                                ")");
   }
   return out;
 }
@@ -465,13 +463,13 @@ std::string read_payload(const std::string& path, const std::string& file, const
     const std::size_t skip = static_cast<std::size_t>(byte_skip);
     decoded = gunzip(source, data, available, skip + l.bytes);
     if (decoded.size() != skip + l.bytes) {
-      throw ConfigError(source,
-                        "gzip data decodes to " +
-                            (decoded.size() > skip + l.bytes ? "more than " : std::string()) +
-                            std::to_string(decoded.size()) + " bytes but the header needs " +
-                            std::to_string(l.bytes) +
-                            (skip ? " after skipping " + std::to_string(skip) : std::string()) +
-                            " (" + sizes + ")");
+      throw ConfigError(
+          source, "gzip data decodes to " +
+                      (decoded.size() > skip + l.bytes ? "more than " : std::string()) +
+                      std::to_string(decoded.size()) + " bytes but the header needs " +
+                      std::to_string(l.bytes) +
+                      (skip ? " after skipping " + std::to_string(skip) : std::string()) + " (" +
+                      sizes + ")");
     }
     decoded.erase(0, skip);
   } else {
@@ -557,8 +555,8 @@ Geometry read_geometry(const std::string& path, const Header& h, const Layout& l
     for (int a = 0; a < 3; ++a) {
       const double s = parse_finite(path, what, w[a + l.dimension - 3]);
       if (!(s > 0)) {
-        throw ConfigError(path, what + ": spacing " + w[a + l.dimension - 3] +
-                                    " of axis " + std::to_string(a) + " must be > 0");
+        throw ConfigError(path, what + ": spacing " + w[a + l.dimension - 3] + " of axis " +
+                                    std::to_string(a) + " must be > 0");
       }
       directions(a, a) = s;
     }
@@ -635,8 +633,8 @@ std::vector<Segment> read_segments(const std::string& path, const Header& h, con
     if (!std::regex_match(k, m, key)) continue;
     const std::string what = "key '" + k + "'";
     // Segment n becomes label n + 1 when label values cannot serve as ids.
-    const int index = static_cast<int>(parse_integer(path, what + ": segment number", m[1], 0,
-                                                     65534));
+    const int index =
+        static_cast<int>(parse_integer(path, what + ": segment number", m[1], 0, 65534));
     Segment& s = by_index[index];
     s.index = index;
     const std::string field = m[2];
@@ -654,8 +652,8 @@ std::vector<Segment> read_segments(const std::string& path, const Header& h, con
     } else if (field == "LabelValue") {
       s.label_value = parse_integer(path, what, trim(v), std::numeric_limits<long long>::min(),
                                     std::numeric_limits<long long>::max());
-      if (is_integer(l.type) && (s.label_value < std::max(1.0, lowest) ||
-                                 static_cast<double>(s.label_value) > highest)) {
+      if (is_integer(l.type) &&
+          (s.label_value < std::max(1.0, lowest) || static_cast<double>(s.label_value) > highest)) {
         throw ConfigError(path, what + ": label value " + std::to_string(s.label_value) +
                                     " cannot occur in " + l.type_name + " data (expected " +
                                     std::to_string(static_cast<long long>(std::max(1.0, lowest))) +
@@ -710,8 +708,8 @@ std::shared_ptr<VolumeData> build_intensity(const std::string& path, const Layou
       for (int i = 0; i < l.shape[0]; ++i) {
         const double x = samples.at(0, i, j, k);
         if (!std::isfinite(x) || (!wide && (x < -32768 || x > 32767))) {
-          throw ConfigError(path, "voxel (" + std::to_string(i) + ", " + std::to_string(j) +
-                                      ", " + std::to_string(k) + ") holds " + std::to_string(x) +
+          throw ConfigError(path, "voxel (" + std::to_string(i) + ", " + std::to_string(j) + ", " +
+                                      std::to_string(k) + ") holds " + std::to_string(x) +
                                       ", which is not a usable intensity");
         }
         const std::size_t n = volume->linear_index(i, j, k);

@@ -83,8 +83,8 @@ std::shared_ptr<VolumeData> load_slice_stack(const SliceStackSpec& spec) {
   }
   const std::map<int, fs::path> slices = find_slices(spec);
   if (slices.size() > 8192) {
-    throw ConfigError(spec.folder, std::to_string(slices.size()) +
-                                       " slices, more than a volume may have (8192)");
+    throw ConfigError(
+        spec.folder, std::to_string(slices.size()) + " slices, more than a volume may have (8192)");
   }
   if (slices.empty() || slices.begin()->first != 0) {
     throw AssetNotFound((fs::path(spec.folder) / (spec.prefix + "0." + spec.format)).string(),

@@ -181,10 +181,9 @@ void VolumeData::set_intensity_type(IntensityType type) {
 
 Eigen::Vector3d VolumeData::voxel_center(int i, int j, int k) const {
   if (i < 0 || j < 0 || k < 0 || i >= shape_[0] || j >= shape_[1] || k >= shape_[2]) {
-    throw OutOfRange("voxel_center: voxel (" + std::to_string(i) + ", " + std::to_string(j) +
-                     ", " + std::to_string(k) + ") is outside the grid of " +
-                     std::to_string(shape_[0]) + "x" + std::to_string(shape_[1]) + "x" +
-                     std::to_string(shape_[2]));
+    throw OutOfRange("voxel_center: voxel (" + std::to_string(i) + ", " + std::to_string(j) + ", " +
+                     std::to_string(k) + ") is outside the grid of " + std::to_string(shape_[0]) +
+                     "x" + std::to_string(shape_[1]) + "x" + std::to_string(shape_[2]));
   }
   return from_voxel_units(Eigen::Vector3d(i + 0.5, j + 0.5, k + 0.5));
 }
@@ -235,8 +234,9 @@ void VolumeData::log_edit(VolumeEdit edit) {
 std::int64_t VolumeData::remove_sphere(const Eigen::Vector3d& center, double radius,
                                        bool only_removable) {
   if (!(radius >= 0.0) || !std::isfinite(radius) || !center.allFinite()) {
-    throw ArgumentError("remove_sphere needs a finite centre and a finite radius >= 0, got radius " +
-                        std::to_string(radius));
+    throw ArgumentError(
+        "remove_sphere needs a finite centre and a finite radius >= 0, got radius " +
+        std::to_string(radius));
   }
   const Eigen::Vector3d s = voxel_size();
   const Eigen::Vector3d u = to_voxel_units(center);

@@ -130,3 +130,18 @@ def reference_dataset(dataset_spec, tmp_path_factory) -> Path:
     out = tmp_path_factory.mktemp("reference") / "data"
     generate(dataset_spec, out, workers=1, progress=False)
     return out
+
+
+# Long tests run only when asked for by their mark: `pytest -m benchmark`, `pytest -m fuzz`.
+OPT_IN_MARKS = ("benchmark", "fuzz")
+
+
+def pytest_collection_modifyitems(config, items):
+    asked = config.getoption("markexpr") or ""
+    for mark in OPT_IN_MARKS:
+        if mark in asked:
+            continue
+        skip = pytest.mark.skip(reason=f"long test: run it with pytest -m {mark}")
+        for item in items:
+            if mark in item.keywords:
+                item.add_marker(skip)

@@ -68,7 +68,24 @@ std::uint32_t pack(std::uint8_t r, std::uint8_t g, std::uint8_t b) {
 }  // namespace
 
 std::shared_ptr<VolumeData> load_slice_stack(const SliceStackSpec& spec) {
+  if (spec.count == 0 || spec.count < -1) {
+    throw ArgumentError("slice stack " + spec.folder + ": count " + std::to_string(spec.count) +
+                        " leaves no slice (expected the largest slice index, >= 1, or -1 for "
+                        "every slice)");
+  }
+  if (spec.alpha_threshold < 0 || spec.alpha_threshold > 255) {
+    throw ArgumentError("slice stack " + spec.folder + ": alpha_threshold " +
+                        std::to_string(spec.alpha_threshold) + " is outside 0..255");
+  }
+  if (!spec.dimensions.allFinite() || !(spec.dimensions.minCoeff() > 0)) {
+    throw ArgumentError("slice stack " + spec.folder +
+                        ": dimensions must be three positive finite metres");
+  }
   const std::map<int, fs::path> slices = find_slices(spec);
+  if (slices.size() > 8192) {
+    throw ConfigError(
+        spec.folder, std::to_string(slices.size()) + " slices, more than a volume may have (8192)");
+  }
   if (slices.empty() || slices.begin()->first != 0) {
     throw AssetNotFound((fs::path(spec.folder) / (spec.prefix + "0." + spec.format)).string(),
                         "first slice of the stack");
@@ -94,6 +111,11 @@ std::shared_ptr<VolumeData> load_slice_stack(const SliceStackSpec& spec) {
                                                    std::to_string(image.rows) + " but slice 0 is " +
                                                    std::to_string(images[0].cols) + "x" +
                                                    std::to_string(images[0].rows));
+    }
+    if (image.cols > 8192 || image.rows > 8192) {
+      throw ConfigError(slices.at(k).string(), "slice is " + std::to_string(image.cols) + "x" +
+                                                   std::to_string(image.rows) +
+                                                   ", larger than a volume may be (8192)");
     }
     if (k > 0 && image.channels() != images[0].channels()) {
       throw ConfigError(slices.at(k).string(), "slice has " + std::to_string(image.channels()) +

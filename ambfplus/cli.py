@@ -1,6 +1,6 @@
 """The ``ambfplus`` command line: ``demo``, ``convert``, ``launch``, ``validate``, ``export``,
-``info``, ``doctor`` (and ``--cmake-dir``, the folder of the CMake package C++ plugins build
-against)."""
+``generate``, ``dataset info``, ``info``, ``doctor`` (and ``--cmake-dir``, the folder of the
+CMake package C++ plugins build against)."""
 
 from __future__ import annotations
 
@@ -225,10 +225,15 @@ def run_launch(args: argparse.Namespace) -> int:
 
 
 def run_validate(args: argparse.Namespace) -> int:
-    """Checks a recording; exit code 0 only when every check passes."""
-    from .recording import validate  # h5py is needed only here
+    """Checks a recording or a dataset folder; exit code 0 only when every check passes."""
+    if args.recording.is_dir():
+        from .dataset import validate_dataset
 
-    report = validate(args.recording)
+        report = validate_dataset(args.recording, match_images=not args.no_image_matching)
+    else:
+        from .recording import validate  # h5py is needed only here
+
+        report = validate(args.recording, match_images=not args.no_image_matching)
     print(json.dumps(report.to_dict(), indent=2) if args.json else report)
     return 0 if report.ok else 1
 
@@ -260,6 +265,36 @@ def run_export(args: argparse.Namespace) -> int:
             line.pop("topics", None)
             line.pop("messages", None)
         print(json.dumps(line))
+    return 0
+
+
+def run_generate(args: argparse.Namespace) -> int:
+    """Generates (or resumes) a dataset from a spec."""
+    from .dataset import GenerateError, generate
+
+    try:
+        report = generate(
+            args.spec, args.out, workers=args.workers, ray=args.ray, retries=args.retries,
+            timeout=args.timeout, progress=not args.quiet,
+            ray_options={"cpus": args.ray_cpus, "gpus": args.ray_gpus},
+        )  # fmt: skip
+    except (ValueError, OSError, ImportError, GenerateError) as error:  # SpecError included
+        print(f"error: {error}", file=sys.stderr)
+        return 2
+    print(
+        f"{report.folder}: {report.generated} episodes made ({report.frames} stereo pairs), "
+        f"{report.skipped} already there, {report.retries} retries, {report.seconds:.1f} s; "
+        f"check it with: ambfplus validate {report.folder}"
+    )
+    return 0
+
+
+def run_dataset(args: argparse.Namespace) -> int:
+    """``dataset info DIR``: counts by anatomy, scenario and label."""
+    from .dataset import dataset_info, format_info
+
+    info = dataset_info(args.folder)
+    print(json.dumps(info, indent=2) if args.json else format_info(info))
     return 0
 
 
@@ -353,9 +388,13 @@ def main(argv: list[str] | None = None) -> int:
         "(libx.so, x.py, a path, or a name searched in AMBFPLUS_PLUGIN_PATH)",
     )
     validate = commands.add_parser(
-        "validate", help="check a recording (ambfplus.recording); exit 1 if any check fails"
+        "validate",
+        help="check a recording (ambfplus.recording) or a dataset folder (its manifest and "
+        "every shard); exit 1 if any check fails",
     )
-    validate.add_argument("recording", type=Path, help="the recording's head file (name.h5)")
+    validate.add_argument(
+        "recording", type=Path, help="a recording's head file (name.h5) or a dataset folder"
+    )
     validate.add_argument("--json", action="store_true", help="print the report as JSON")
     exporter = commands.add_parser(
         "export",
@@ -377,6 +416,49 @@ def main(argv: list[str] | None = None) -> int:
                           help="original-h5: samples per file (the original's 500)")  # fmt: skip
     exporter.add_argument("--no-images", action="store_true",
                           help="coco: annotations only, no PNG frames")  # fmt: skip
+    validate.add_argument(
+        "--no-image-matching",
+        action="store_true",
+        help="skip block matching the stereo pairs against depth and baseline (the costliest "
+        "check)",
+    )
+    generate = commands.add_parser(
+        "generate",
+        help="generate a dataset from a YAML spec with local workers or on a Ray cluster; "
+        "running it again resumes",
+    )
+    generate.add_argument("spec", type=Path, help="the dataset spec (YAML)")
+    generate.add_argument("--out", type=Path, required=True, help="the dataset folder")
+    generate.add_argument(
+        "--workers", type=int, default=1, help="local worker processes (default 1)"
+    )
+    generate.add_argument(
+        "--ray",
+        metavar="ADDRESS",
+        help="run on a Ray cluster instead: host:port, ray://host:port, auto (this machine's "
+        'cluster) or local (a new one); needs pip install "ambfplus[ray]"',
+    )
+    generate.add_argument(
+        "--ray-cpus", type=float, default=1.0, help="CPUs each Ray task asks for (default 1)"
+    )
+    generate.add_argument(
+        "--ray-gpus",
+        type=float,
+        default=0.0,
+        help="GPUs each Ray task asks for (default 0); a task given a GPU renders on it",
+    )
+    generate.add_argument(
+        "--retries", type=int, default=3, help="attempts after the first per episode"
+    )
+    generate.add_argument("--timeout", type=float, help="seconds an episode may take")
+    generate.add_argument("--quiet", action="store_true", help="no progress bar")
+    dataset = commands.add_parser("dataset", help="dataset folders: info")
+    dataset_commands = dataset.add_subparsers(dest="dataset_command", required=True)
+    info = dataset_commands.add_parser(
+        "info", help="counts by anatomy, scenario and label of a dataset folder"
+    )
+    info.add_argument("folder", type=Path)
+    info.add_argument("--json", action="store_true", help="print JSON")
     commands.add_parser("info", help="print the version and the OpenGL device")
     doctor = commands.add_parser(
         "doctor",
@@ -387,6 +469,10 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if args.command == "validate":
         return run_validate(args)
+    if args.command == "generate":
+        return run_generate(args)
+    if args.command == "dataset":
+        return run_dataset(args)
     if args.command == "launch":
         return run_launch(args)
     if args.command == "export":

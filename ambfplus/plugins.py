@@ -30,6 +30,7 @@ from pathlib import Path
 from types import ModuleType
 from typing import Any
 
+from . import _core
 from ._core import PluginError
 
 # Entry points of this group name Python plugins (a class or a factory returning a plugin).
@@ -176,6 +177,10 @@ def _from_entry_point(name: str):
     return None
 
 
+# The engine makes Python plugins through these (it never imports this package itself).
+_core._register_plugin_support(Plugin, _from_file, _from_entry_point)
+
+
 def cmake_dir() -> str:
     """The folder holding ``ambfplusConfig.cmake``, for building C++ plugins out of tree:
     ``cmake -Dambfplus_DIR=$(python -m ambfplus --cmake-dir)``. In an installed package it is
@@ -184,8 +189,6 @@ def cmake_dir() -> str:
     folder = Path(__file__).resolve().parent / "cmake"
     if not (folder / "ambfplusConfig.cmake").is_file():
         # The package folder may hold links into a build tree: look beside the engine itself.
-        from . import _core
-
         folder = Path(_core.__file__).resolve().parent / "cmake"
     if not (folder / "ambfplusConfig.cmake").is_file():
         raise FileNotFoundError(f"no ambfplusConfig.cmake in {folder}: the package is incomplete")

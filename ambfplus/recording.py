@@ -237,7 +237,9 @@ class Recorder:
     module docstring for the layout). All HDF5 work happens on a background thread; ``add_*``
     copies its arrays and returns, or blocks while ``max_pending_bytes`` are waiting (HDF5's
     chunk cache, up to 8 MiB per image dataset, comes on top). Parts close every
-    ``flush_interval_s``; ``compression`` is "blosc-lz4" (the default), "lzf", "gzip" or None."""
+    ``flush_interval_s``; ``compression`` is "blosc-lz4" (the default), "lzf", "gzip" or None.
+    ``recording_id`` and ``created`` (ISO 8601) replace the random id and the clock's time:
+    with them, the same rows give the same bytes (a reproducible file)."""
 
     def __init__(
         self,
@@ -248,6 +250,8 @@ class Recorder:
         flush_interval_s: float = 1.0,
         compression: str | None = "blosc-lz4",
         overwrite: bool = False,
+        recording_id: str | None = None,
+        created: str | None = None,
     ) -> None:
         if not max_pending_bytes > 0:
             raise ValueError(f"max_pending_bytes must be > 0, got {max_pending_bytes}")
@@ -260,8 +264,8 @@ class Recorder:
         self.flush_interval_s = float(flush_interval_s)
         self.compression = compression
         self._head = _HeadInfo(
-            recording_id=uuid.uuid4().hex,
-            created=datetime.now(timezone.utc).isoformat(),
+            recording_id=recording_id or uuid.uuid4().hex,
+            created=created or datetime.now(timezone.utc).isoformat(),
             metadata=to_json(metadata or {}, "metadata"),
         )
         # Producer side: what each group holds, so that a mismatch fails in the caller.
@@ -890,14 +894,30 @@ def _write_virtual_datasets(f: h5py.File, parts: list[PartSummary]) -> None:
         total = sum(group.rows for _, group in pieces)
         for column, (dtype, trailing) in first.datasets.items():
             dtype = string_dtype() if np.dtype(dtype).kind == "O" else dtype
-            layout = h5py.VirtualLayout(shape=(total,) + tuple(trailing), dtype=dtype)
-            start = 0
-            for part, group in pieces:
-                shape = (group.rows,) + tuple(trailing)
-                source = h5py.VirtualSource(part.path.name, f"{name}/{column}", shape=shape)
-                layout[start : start + group.rows] = source
-                start += group.rows
-            f[name].create_virtual_dataset(column, layout)
+            sources = [(part.path.name, group.rows) for part, group in pieces]
+            _virtual_dataset(f[name], column, dtype, (total,) + tuple(trailing), sources)
+
+
+def _virtual_dataset(group: h5py.Group, name: str, dtype, shape: tuple, sources: list) -> None:
+    """A virtual dataset concatenating the same-named dataset of each (file, rows) source along
+    axis 0. Without HDF5's object timestamps (h5py's VirtualLayout keeps them), so that the same
+    parts always give the same head, byte for byte."""
+    dcpl = h5py.h5p.create(h5py.h5p.DATASET_CREATE)
+    dcpl.set_obj_track_times(False)
+    path = f"{group.name}/{name}".lstrip("/").encode()
+    start = 0
+    for file_name, rows in sources:
+        if rows == 0:
+            continue
+        block = (rows,) + tuple(shape[1:])
+        selection = h5py.h5s.create_simple(shape)
+        selection.select_hyperslab((start,) + (0,) * (len(shape) - 1), (1,) * len(shape),
+                                   block=block)  # fmt: skip
+        dcpl.set_virtual(selection, file_name.encode(), path, h5py.h5s.create_simple(block))
+        start += rows
+    space = h5py.h5s.create_simple(shape)
+    h5py.h5d.create(group.id, name.encode(), h5py.h5t.py_create(np.dtype(dtype), logical=1),
+                    space, dcpl=dcpl)  # fmt: skip
 
 
 def repair(path) -> Recording:

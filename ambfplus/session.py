@@ -78,10 +78,13 @@ def record_session(
     metadata: dict | None = None,
     progress: Callable[[str], None] | None = None,
     progress_every: float = 0.1,
+    transform: Callable | None = None,
+    recorder_options: dict | None = None,
 ) -> dict:
     """Runs the scene for `seconds` with `device` driving its drill and records it to `path`.
     camera_motion(time) -> (eye, target) aims the rig (its midpoint at eye) before each
-    capture. Returns a summary
+    capture; transform(stereo_frame) -> stereo_frame changes each pair before it is recorded
+    (sensor noise, say); `recorder_options` go to ``Recorder``. Returns a summary
     (steps, frames, voxels removed, events)."""
     world, drill, rig = scene.world, scene.drill, scene.rig
     binding = _bind(scene, device)
@@ -102,13 +105,14 @@ def record_session(
     world.start_step_log(list(scene.logged) + [binding])
     removed = events = frames = 0
     started, next_report = time.perf_counter(), 0.0
-    with Recorder(path, metadata=meta) as recorder:
+    with Recorder(path, metadata=meta, **(recorder_options or {})) as recorder:
         recorder.set_legend(world)
         while world.step_index < total:
             world.step(min(capture_every, total - world.step_index))
             if camera_motion is not None:
                 rig.aim(*camera_motion(world.time))
-            recorder.add_stereo(RIG, rig.capture(passes))
+            pair = rig.capture(passes)
+            recorder.add_stereo(RIG, pair if transform is None else transform(pair))
             frames += 1
             _, r, e = _drain(world, drill, recorder)
             removed, events = removed + len(r["step"]), events + len(e)

@@ -79,7 +79,9 @@ class StereoRig:
     """Two cameras a baseline apart along the left camera's x axis, captured together.
 
     ``StereoRig(world, "rig", baseline=0.065, width=640, height=480, fov_y=...)`` makes cameras
-    ``rig_left`` and ``rig_right``; ``working_distance`` (metres) makes it off-axis. Move it with
+    ``rig_left`` and ``rig_right``; ``working_distance`` (metres) makes it off-axis;
+    ``background`` (RGB 0..1) is what both show where nothing is hit, and
+    ``principal_point_offset`` (pixels) moves both principal points alike. Move it with
     ``look_at`` or ``pose`` (the left camera's). ``StereoRig.from_cameras(left, right)`` wraps two
     existing cameras (e.g. an ADF file's stereoL and stereoR), keeping their poses.
     """
@@ -95,24 +97,28 @@ class StereoRig:
         near: float = 0.01,
         far: float = 10.0,
         working_distance: float | None = None,
+        background=(0.0, 0.0, 0.0),
+        principal_point_offset=(0.0, 0.0),
     ) -> None:
         if not baseline > 0:
             raise ValueError(f"baseline must be > 0 m, got {baseline}")
-        left = world.add_camera(f"{name}_left", width, height, fov_y=fov_y, near=near, far=far)
-        right = world.add_camera(f"{name}_right", width, height, fov_y=fov_y, near=near, far=far)
+        options = {"fov_y": fov_y, "near": near, "far": far, "background": list(background)}
+        left = world.add_camera(f"{name}_left", width, height, **options)
+        right = world.add_camera(f"{name}_right", width, height, **options)
         offset = np.eye(4)
         offset[0, 3] = baseline
         right.attach_to(left, offset)
         self.left, self.right = left, right
         self.name = name
         self._offset = offset
-        if working_distance is not None:
-            self.set_working_distance(working_distance)
+        self.principal_point_offset = tuple(float(v) for v in principal_point_offset)
+        self.set_working_distance(working_distance)
 
     @classmethod
     def from_cameras(cls, left: Camera, right: Camera) -> StereoRig:
         rig = cls.__new__(cls)
         rig.left, rig.right, rig.name = left, right, left.name
+        rig.principal_point_offset = (0.0, 0.0)
         rig._offset = np.linalg.inv(left.pose) @ right.pose
         if abs(rig._offset[0, 3]) <= 0 or not np.allclose(
             rig._offset[:3, :3], np.eye(3), atol=1e-6
@@ -134,15 +140,18 @@ class StereoRig:
         return float(self.right.principal_point[0] - self.left.principal_point[0])
 
     def set_working_distance(self, distance: float | None) -> None:
-        """Off-axis: points at this depth get zero disparity (None: parallel again)."""
+        """Off-axis: points at this depth get zero disparity (None: parallel again). Both
+        principal points also move by ``principal_point_offset`` (pixels; the same for both
+        views, so the pair stays rectified)."""
         w, h = self.left.width, self.left.height
+        dx, dy = self.principal_point_offset
         shift = 0.0
         if distance is not None:
             if not distance > 0:
                 raise ValueError(f"working distance must be > 0 m, got {distance}")
             shift = self.left.intrinsics[0, 0] * self.baseline / distance / 2
-        self.left.principal_point = (w / 2 - shift, h / 2)
-        self.right.principal_point = (w / 2 + shift, h / 2)
+        self.left.principal_point = (w / 2 - shift + dx, h / 2 + dy)
+        self.right.principal_point = (w / 2 + shift + dx, h / 2 + dy)
 
     @property
     def pose(self) -> np.ndarray:

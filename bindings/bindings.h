@@ -52,6 +52,9 @@ std::shared_ptr<T> handle(T* p, World& world) {
   return std::shared_ptr<T>(world.simulator().shared_from_this(), p);
 }
 
+/// ambfplus.PluginError, the Python class (set when the module is made).
+PyObject* plugin_error_type();
+
 /// An object as its most derived Python class (None for nullptr).
 pybind11::object to_python(Object* o);
 

@@ -4,7 +4,12 @@
 //   ambfplus.AssetNotFound  (Error, FileNotFoundError) missing file; .filename, .errno, .tried
 //   ambfplus.RenderError    (Error, RuntimeError)
 //   ambfplus.PluginError    (Error, RuntimeError)
-// std::invalid_argument becomes ValueError (pybind11's default).
+//   ambfplus.ArgumentError  (Error, ValueError)        a value a caller gave cannot be used
+//   ambfplus.OutOfRange     (Error, IndexError)        an index outside what it indexes
+//   ambfplus.StateError     (Error, RuntimeError)      a call that does not fit the state
+//   ambfplus.ResourceError  (Error, OSError)           a socket, port or device file
+// Any other C++ exception that reaches Python (the standard library's, a dependency's) becomes
+// an ambfplus.Error too, with its message; pybind11's own Python exceptions pass through.
 
 #include <cerrno>
 
@@ -29,6 +34,10 @@ PyObject* g_config_error = nullptr;
 PyObject* g_asset_not_found = nullptr;
 PyObject* g_render_error = nullptr;
 PyObject* g_plugin_error = nullptr;
+PyObject* g_argument_error = nullptr;
+PyObject* g_out_of_range = nullptr;
+PyObject* g_state_error = nullptr;
+PyObject* g_resource_error = nullptr;
 
 // Raises type(message) with extra attributes set on the instance.
 pybind11::object with(PyObject* type, const std::string& message, const char* filename = nullptr,
@@ -50,6 +59,8 @@ void raise_with(PyObject* type, const std::string& message, const char* filename
 
 }  // namespace
 
+PyObject* plugin_error_type() { return g_plugin_error; }
+
 void register_errors(pybind11::module_& m) {
   g_error = make_exception(m, "Error", PyExc_Exception);
   auto pair = [](PyObject* a, PyObject* b) {
@@ -60,6 +71,10 @@ void register_errors(pybind11::module_& m) {
       make_exception(m, "AssetNotFound", pair(g_error, PyExc_FileNotFoundError).ptr());
   g_render_error = make_exception(m, "RenderError", pair(g_error, PyExc_RuntimeError).ptr());
   g_plugin_error = make_exception(m, "PluginError", pair(g_error, PyExc_RuntimeError).ptr());
+  g_argument_error = make_exception(m, "ArgumentError", pair(g_error, PyExc_ValueError).ptr());
+  g_out_of_range = make_exception(m, "OutOfRange", pair(g_error, PyExc_IndexError).ptr());
+  g_state_error = make_exception(m, "StateError", pair(g_error, PyExc_RuntimeError).ptr());
+  g_resource_error = make_exception(m, "ResourceError", pair(g_error, PyExc_OSError).ptr());
 
   pybind11::register_exception_translator([](std::exception_ptr p) {
     try {
@@ -74,7 +89,27 @@ void register_errors(pybind11::module_& m) {
       raise_with(g_render_error, e.what());
     } catch (const PluginError& e) {
       raise_with(g_plugin_error, e.what());
+    } catch (const ArgumentError& e) {
+      raise_with(g_argument_error, e.what());
+    } catch (const OutOfRange& e) {
+      raise_with(g_out_of_range, e.what());
+    } catch (const StateError& e) {
+      raise_with(g_state_error, e.what());
+    } catch (const ResourceError& e) {
+      raise_with(g_resource_error, e.what());
     } catch (const Error& e) {
+      raise_with(g_error, e.what());
+    } catch (const pybind11::builtin_exception&) {
+      throw;  // pybind11's own (value_error, stop_iteration, cast_error ...) keep their type
+    } catch (const pybind11::error_already_set&) {
+      throw;  // a Python exception on its way back
+    } catch (const std::bad_alloc&) {
+      throw;  // MemoryError
+    } catch (const std::invalid_argument& e) {
+      raise_with(g_argument_error, e.what());
+    } catch (const std::out_of_range& e) {
+      raise_with(g_out_of_range, e.what());
+    } catch (const std::exception& e) {
       raise_with(g_error, e.what());
     }
   });

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "ambfplus/errors.h"
+#include "ambfplus/plugin/plugin.h"
 #include "ambfplus/plugin/registry.h"
 #include "ambfplus/scene/simulator.h"
 #include "ambfplus/scene/world.h"
@@ -22,8 +23,25 @@ namespace {
 // What a Python plugin reaches its site through (`self._site`); it forgets the plugin when the
 // plugin is destroyed, so a Python object kept longer cannot reach a dead world.
 struct PythonSite {
-  Plugin* plugin = nullptr;
+  PluginInstance* plugin = nullptr;
 };
+
+// What the Python package gives the engine when it is imported (ambfplus.plugins): the
+// Plugin base class and the functions making plugins from files and entry-point names. The
+// extension never imports the package back.
+struct PythonSupport {
+  py::object base, from_file, from_entry_point;
+};
+PythonSupport& support() {
+  static PythonSupport* s = new PythonSupport();  // left to the interpreter's exit
+  return *s;
+}
+const PythonSupport& checked_support() {
+  if (!support().base) {
+    throw PluginError("Python plugins need the ambfplus package (import ambfplus first)");
+  }
+  return support();
+}
 
 enum Hook {
   kPhysics,
@@ -47,7 +65,7 @@ const char* const kHookNames[kHookCount] = {
 std::string describe_python_error(py::error_already_set& e) {
   try {
     const py::module_ traceback = py::module_::import("traceback");
-    const bool expected = e.matches(py::module_::import("ambfplus").attr("PluginError"));
+    const bool expected = e.matches(py::handle(plugin_error_type()));
     py::list lines = expected ? traceback.attr("format_exception_only")(e.type(), e.value())
                               : traceback.attr("format_exception")(e.type(), e.value(), e.trace());
     std::string out;
@@ -62,11 +80,11 @@ std::string describe_python_error(py::error_already_set& e) {
 // A Python object with plugin hooks, as a C++ plugin. Only the hooks its class defines (other
 // than ambfplus.Plugin's empty ones) are called, each with the GIL held for the call alone; a
 // Python exception becomes a PluginError, which the registry logs before disabling the plugin.
-class PythonPlugin final : public Plugin {
+class PythonPlugin final : public PluginInstance {
  public:
   // With the GIL held.
   explicit PythonPlugin(py::object instance) : instance_(std::move(instance)) {
-    const py::object base = py::module_::import("ambfplus.plugins").attr("Plugin");
+    const py::object base = checked_support().base;
     const py::object type = py::type::of(instance_);
     for (int h = 0; h < kHookCount; ++h) {
       const py::object own = py::getattr(type, kHookNames[h], py::none());
@@ -162,7 +180,7 @@ class PythonPlugin final : public Plugin {
 };
 
 // The plugin behind a site, or PluginError; for handles, its simulator must be alive too.
-Plugin& live(const PythonSite& s, bool for_handles = true) {
+PluginInstance& live(const PythonSite& s, bool for_handles = true) {
   if (s.plugin == nullptr) throw PluginError("this plugin is closed: its world is out of reach");
   if (for_handles && s.plugin->simulator().weak_from_this().expired()) {
     throw PluginError("plugin '" + s.plugin->name() +
@@ -173,11 +191,12 @@ Plugin& live(const PythonSite& s, bool for_handles = true) {
 }
 
 // A plugin made by Python code (the ambfplus.plugins module's loaders), or null for None.
-std::shared_ptr<Plugin> from_python(const char* loader, const std::string& argument) {
+std::shared_ptr<PluginInstance> from_python(bool entry_point, const std::string& argument) {
   if (!Py_IsInitialized()) throw PluginError("Python plugins need a running interpreter");
   py::gil_scoped_acquire gil;
   try {
-    py::object instance = py::module_::import("ambfplus.plugins").attr(loader)(argument);
+    const PythonSupport& python = checked_support();
+    py::object instance = (entry_point ? python.from_entry_point : python.from_file)(argument);
     if (instance.is_none()) return nullptr;
     return std::make_shared<PythonPlugin>(std::move(instance));
   } catch (py::error_already_set& e) {
@@ -193,7 +212,7 @@ struct PluginInfo {
   py::object attached_to;  // simulator, world, model or object
 };
 
-PluginInfo info(World& world, Plugin& p) {
+PluginInfo info(World& world, PluginInstance& p) {
   PluginInfo out;
   out.name = p.name();
   out.file = p.file();
@@ -224,7 +243,7 @@ PluginInfo info(World& world, Plugin& p) {
 py::object load(World& world, const py::object& plugin, const PluginSite& site,
                 const std::optional<std::string>& name) {
   const py::object os = py::module_::import("os");
-  Plugin* loaded = nullptr;
+  PluginInstance* loaded = nullptr;
   if (py::isinstance<py::str>(plugin) || py::isinstance(plugin, os.attr("PathLike"))) {
     PluginSpec spec;
     spec.filename = os.attr("fspath")(plugin).cast<std::string>();
@@ -263,9 +282,16 @@ PluginSite site_of(World& world, const py::object& scope_object) {
 }  // namespace
 
 void register_plugin(py::module_& m) {
-  register_plugin_language(
-      {"python", ".py", [](const std::string& file) { return from_python("_from_file", file); },
-       [](const std::string& name) { return from_python("_from_entry_point", name); }});
+  register_plugin_language({"python", ".py",
+                            [](const std::string& file) { return from_python(false, file); },
+                            [](const std::string& name) { return from_python(true, name); }});
+  m.def(
+      "_register_plugin_support",
+      [](py::object base, py::object from_file, py::object from_entry_point) {
+        support() = {std::move(base), std::move(from_file), std::move(from_entry_point)};
+      },
+      "Called once by ambfplus.plugins: the Plugin base class and the functions making Python "
+      "plugins from a file and from an entry-point name.");
 
   py::class_<PythonSite>(m, "PluginSite",
                          "Where a Python plugin is attached (its `_site`); handles are made on "
@@ -282,13 +308,13 @@ void register_plugin(py::module_& m) {
           "simulator", [](const PythonSite& s) { return live(s).simulator().shared_from_this(); })
       .def_property_readonly("world",
                              [](const PythonSite& s) {
-                               Plugin& p = live(s);
+                               PluginInstance& p = live(s);
                                return handle(&p.world(), p.world());
                              })
       .def_property_readonly(
           "model",
           [](const PythonSite& s) -> py::object {
-            Plugin& p = live(s);
+            PluginInstance& p = live(s);
             if (p.model() == nullptr) return py::none();
             return py::cast(handle(p.model(), p.world()));
           },
@@ -332,7 +358,7 @@ void register_plugin(py::module_& m) {
           "plugins",
           [](World& w) {
             py::list out;
-            for (Plugin* p : w.plugins().plugins()) out.append(info(w, *p));
+            for (PluginInstance* p : w.plugins().plugins()) out.append(info(w, *p));
             return out;
           },
           "The attached plugins in call order: simulator, world, model, then object scope, "
@@ -393,7 +419,7 @@ void register_plugin(py::module_& m) {
       py::arg("plugin"), py::arg("name") = py::none(),
       (std::string(load_doc) + " The plugin is attached to the simulator.").c_str());
 
-  m.attr("PLUGIN_ABI_VERSION") = kPluginAbiVersion;
+  m.attr("PLUGIN_ABI_VERSION") = AMBFPLUS_PLUGIN_ABI_VERSION;
   m.def("plugin_search_path", &plugin_search_path,
         "The folders searched for a plugin after its declaration's own path: "
         "AMBFPLUS_PLUGIN_PATH, then the package's plugin folder.");

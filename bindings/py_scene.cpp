@@ -268,7 +268,8 @@ void def_adders(Class& cls, GetModel get_model) {
           "add_volume",
           [get_model](typename Class::type& self, const std::string& name,
                       std::shared_ptr<VolumeData> data, std::optional<Mat4> pose, double iso,
-                      double quality, double optical_density) {
+                      double quality, double optical_density, std::optional<float> specular,
+                      std::optional<float> shininess) {
             Model& model = get_model(self);
             VolumeSpec spec;
             spec.name = name;
@@ -277,12 +278,16 @@ void def_adders(Class& cls, GetModel get_model) {
             spec.iso = iso;
             spec.quality = quality;
             spec.optical_density = optical_density;
+            if (specular) spec.specular = *specular;
+            if (shininess) spec.shininess = *shininess;
             return handle(&model.add_volume(spec), model.world());
           },
           py::arg("name"), py::arg("data"), py::kw_only(), py::arg("pose") = py::none(),
           py::arg("iso") = 0.5, py::arg("quality") = 0.5, py::arg("optical_density") = 1.0,
+          py::arg("specular") = py::none(), py::arg("shininess") = py::none(),
           "Places volume data in the world; pose is world from the volume frame (centred on the "
-          "grid). Several volumes may share one VolumeData.")
+          "grid). Several volumes may share one VolumeData. specular (0..1) and shininess (Phong "
+          "exponent) set the surface's material (defaults 0.15 and 24).")
       .def(
           "add_drill",
           [get_model](typename Class::type& self, const std::string& name, Volume& volume,
@@ -624,6 +629,8 @@ void register_scene(py::module_& m) {
       .def_property("iso", &Volume::iso, &Volume::set_iso, "iso level of the smoothed occupancy")
       .def_property_readonly("quality", &Volume::quality)
       .def_property_readonly("optical_density", &Volume::optical_density)
+      .def_property_readonly("specular", &Volume::specular, "Phong specular factor, 0..1")
+      .def_property_readonly("shininess", &Volume::shininess, "Phong exponent")
       .def_property("empty_space_skipping", &Volume::empty_space_skipping,
                     &Volume::set_empty_space_skipping,
                     "rays skip empty bricks (off: every half voxel, the naive baseline)")

@@ -73,3 +73,60 @@ def display():
     yield name
     server.terminate()
     server.wait(timeout=10)
+
+
+# A small dataset spec that uses every kind of draw (12 episodes of 160x120 stereo pairs), and
+# its dataset made once per session by one local worker: the reference the dataset tests
+# compare other executors, worker counts and interrupted runs against.
+DATASET_SPEC = """\
+version: 1
+name: ci-tiny
+episodes: 12
+seed: 7
+capture: {every: 250, frames: 3, passes: [rgb, depth, label, instance, voxel]}
+anatomies:
+  - phantom: {resolution: 40, seed: {choice: [0, 1]}}
+    weight: 2
+  - phantom: {resolution: 48, seed: 3}
+    name: phantom48
+scenarios:
+  - kind: camera
+  - kind: drilling
+    frames: {uniform: [5, 6]}
+  - kind: mixed
+    frames: 5
+rigs:
+  - resolution: [160, 120]
+    baseline: {uniform: [0.05, 0.08]}
+    working_distance: {uniform: [0.22, 0.28]}
+  - resolution: [160, 120]
+    working_distance: null
+    weight: 0.5
+appearance:
+  lights: {count: {uniform: [1, 3]}, types: [directional, point, spot],
+           intensity: {uniform: [0.3, 1.0]}, color: {uniform: [0.8, 1.0]}}
+  labels: {color_jitter: 25}
+  material: {specular: {uniform: [0.05, 0.4]}, shininess: {uniform: [8, 48]}}
+  drill: {color_jitter: 0.05, specular: {uniform: [0.3, 0.8]}}
+  background: {uniform: [0.0, 0.25]}
+  intrinsics: {fov_y_jitter: 0.03, principal_point_jitter: 2.0}
+  noise: {rgb_sigma: {uniform: [0.5, 2.0]}}
+"""
+
+
+@pytest.fixture(scope="session")
+def dataset_spec(tmp_path_factory) -> Path:
+    """The small dataset spec, written to a file."""
+    path = tmp_path_factory.mktemp("spec") / "spec.yaml"
+    path.write_text(DATASET_SPEC)
+    return path
+
+
+@pytest.fixture(scope="session")
+def reference_dataset(dataset_spec, tmp_path_factory) -> Path:
+    """The small spec's dataset, made by one local worker."""
+    from ambfplus.dataset import generate
+
+    out = tmp_path_factory.mktemp("reference") / "data"
+    generate(dataset_spec, out, workers=1, progress=False)
+    return out

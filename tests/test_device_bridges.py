@@ -115,7 +115,7 @@ def test_network_device_arguments_are_checked():
     with pytest.raises(ValueError, match="IPv4"):
         ambfplus.NetworkDevice(address="loopback")
     taken = ambfplus.NetworkDevice()
-    with pytest.raises(RuntimeError, match=f"127.0.0.1:{taken.port}.*bind"):
+    with pytest.raises(ambfplus.ResourceError, match=f"127.0.0.1:{taken.port}.*bind"):
         ambfplus.NetworkDevice(port=taken.port)
 
 

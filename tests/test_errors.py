@@ -13,13 +13,50 @@ def test_error_hierarchy():
     assert issubclass(ambfplus.AssetNotFound, FileNotFoundError)
     assert issubclass(ambfplus.RenderError, RuntimeError)
     assert issubclass(ambfplus.PluginError, RuntimeError)
+    assert issubclass(ambfplus.ArgumentError, ValueError)
+    assert issubclass(ambfplus.OutOfRange, IndexError)
+    assert issubclass(ambfplus.StateError, RuntimeError)
+    assert issubclass(ambfplus.ResourceError, OSError)
     for cls in (
         ambfplus.ConfigError,
         ambfplus.AssetNotFound,
         ambfplus.RenderError,
         ambfplus.PluginError,
+        ambfplus.ArgumentError,
+        ambfplus.OutOfRange,
+        ambfplus.StateError,
+        ambfplus.ResourceError,
     ):
         assert issubclass(cls, ambfplus.Error)
+
+
+def test_engine_errors_are_typed_whatever_throws_them(tmp_path):
+    world = ambfplus.World()
+    with pytest.raises(ambfplus.ArgumentError, match="radius"):
+        world.add_body("ball", "sphere", radius=-1.0)
+    cube = tmp_path / "cube.obj"
+    cube.write_text(
+        "v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nv 0 0 0.1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"
+    )
+    soft = world.add_soft_body("soft", str(cube))
+    with pytest.raises(IndexError, match="nodes 0"):
+        soft.fix_nodes([1000])
+    loop = ambfplus.RealTimeLoop(world)
+    loop.start()
+    try:
+        with pytest.raises(ambfplus.StateError, match="already running"):
+            loop.start()
+    finally:
+        loop.stop()
+    # The standard library's own exceptions, thrown deep in a reader, arrive typed too.
+    header = (
+        "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n"
+        "Segment2147483648_LabelValue:=1\n\n"
+    )
+    path = tmp_path / "big.seg.nrrd"
+    path.write_bytes(header.encode() + bytes(8))
+    with pytest.raises(ambfplus.Error):
+        ambfplus.load_nrrd(path)
 
 
 def test_missing_mesh_is_asset_not_found_naming_the_path(tmp_path):

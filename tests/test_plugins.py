@@ -17,47 +17,80 @@ import sys
 import textwrap
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import ambfplus
 from ambfplus.cli import main
 
-# Appends every hook it sees to the file AMBFPLUS_TEST_PLUGIN_LOG names.
+# Appends every hook it sees to the file AMBFPLUS_TEST_PLUGIN_LOG names; an object plugin also
+# writes its object's pose after every step (through Eigen, in the plugin's own code, so a
+# plugin built with other vectorisation flags than the engine shows whether it sees the same).
 LOG_PLUGIN_CPP = r"""
 #include <cstdio>
 #include <cstdlib>
 #include <string>
 
+#include <Eigen/Geometry>
+
 #include "ambfplus/plugin/plugin.h"
-#include "ambfplus/scene/world.h"
 
 namespace {
 
-class LogPlugin : public ambfplus::Plugin {
+using ambfplus::plugin::Scope;
+
+const char* const kKinds[] = {"body", "joint", "camera", "light", "volume", "drill",
+                              "soft body", "sensor", "actuator", "input device"};
+const char* const kScopes[] = {"simulator", "world", "model", "object"};
+
+class LogPlugin : public ambfplus::plugin::Plugin {
  public:
   int init() override {
     std::string target = "sim";
-    if (object() != nullptr) {
-      target = object()->name() + " " + ambfplus::object_kind_name(object()->kind());
-    } else if (model() != nullptr) {
-      target = model()->name();
-    } else if (scope() == ambfplus::PluginScope::kWorld) {
+    if (object()) {
+      target = object().name() + " " + kKinds[object().kind()];
+    } else if (scope() == Scope::kModel) {
+      target = model();
+    } else if (scope() == Scope::kWorld) {
       target = world().name();
     }
-    write(std::string("init ") + ambfplus::plugin_scope_name(scope()) + " " + target);
+    write(std::string("init ") + kScopes[static_cast<int>(scope())] + " " + target);
     return 1;
   }
   void physics_update(double dt) override {
     write("physics " + std::to_string(world().step_index()) + (dt == 0.001 ? "" : " bad dt"));
+    if (object() && std::getenv("AMBFPLUS_TEST_PLUGIN_POSES") != nullptr) write_pose();
   }
   void graphics_update() override { write("graphics " + std::to_string(world().step_index())); }
   void keyboard(int key, int, int, int) override { write("key " + std::to_string(key)); }
   void reset() override { write("reset"); }
   void close() override { write("close"); }
-  void on_object_added(ambfplus::Object& o) override { write("added " + o.name()); }
-  void on_object_removed(ambfplus::Object& o) override { write("removed " + o.name()); }
+  void on_object_added(const ambfplus::plugin::Object& o) override { write("added " + o.name()); }
+  void on_object_removed(const ambfplus::plugin::Object& o) override {
+    write("removed " + o.name());
+  }
 
  private:
+  void write_pose() const {
+    const ambfplus::plugin::Pose p = object().pose();
+    Eigen::Isometry3d pose;
+    pose.matrix() = Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(p.data());
+    // A point of the body in the world: arithmetic in the plugin's own code and flags.
+    const Eigen::Vector3d point = pose * Eigen::Vector3d(0.01, 0.02, 0.03);
+    std::string line = "pose " + std::to_string(world().step_index());
+    char number[32];
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 4; ++c) {
+        std::snprintf(number, sizeof number, " %.17g", pose.matrix()(r, c));
+        line += number;
+      }
+    }
+    for (int i = 0; i < 3; ++i) {
+      std::snprintf(number, sizeof number, " %.17g", point[i]);
+      line += number;
+    }
+    write(line);
+  }
   void write(const std::string& line) const {
     const char* path = std::getenv("AMBFPLUS_TEST_PLUGIN_LOG");
     if (path == nullptr) return;
@@ -77,14 +110,9 @@ AMBFPLUS_PLUGIN(LogPlugin)
 WRONG_ABI_CPP = r"""
 #include "ambfplus/plugin/plugin.h"
 
-class Old : public ambfplus::Plugin {};
-
 extern "C" __attribute__((visibility("default"))) const AmbfplusPluginEntry*
 ambfplus_plugin_entry() {
-  static const AmbfplusPluginEntry entry = {
-      AMBFPLUS_PLUGIN_ABI_VERSION + 998, "Old",
-      []() -> ambfplus::Plugin* { return new Old(); },
-      [](ambfplus::Plugin* p) { delete p; }};
+  static const AmbfplusPluginEntry entry = {AMBFPLUS_PLUGIN_ABI_VERSION + 998, "Old"};
   return &entry;
 }
 """
@@ -93,11 +121,16 @@ ambfplus_plugin_entry() {
 NO_ENTRY_CPP = r"""
 #include "ambfplus/plugin/plugin.h"
 
-class Forgotten : public ambfplus::Plugin {};
+class Forgotten : public ambfplus::plugin::Plugin {};
 
-extern "C" __attribute__((visibility("default"))) ambfplus::Plugin* make_forgotten() {
+extern "C" __attribute__((visibility("default"))) void* make_forgotten() {
   return new Forgotten();
 }
+"""
+
+# The entry point's name on data, not a function: calling it would crash.
+DATA_ENTRY_CPP = r"""
+extern "C" __attribute__((visibility("default"))) const int ambfplus_plugin_entry = 42;
 """
 
 PLUGINS_CMAKE = """
@@ -108,6 +141,15 @@ ambfplus_add_plugin(logplugin log_plugin.cpp)
 ambfplus_add_plugin(wrongabi wrong_abi.cpp)
 add_library(noentry MODULE no_entry.cpp)
 target_link_libraries(noentry PRIVATE ambfplus::ambfplus)
+add_library(dataentry MODULE data_entry.cpp)
+# The same plugin built as other projects might build it: unoptimised without AVX, and
+# optimised for AVX2 (where the CPU has it), against the engine built with the package's flags.
+ambfplus_add_plugin(logplugin_noavx log_plugin.cpp)
+target_compile_options(logplugin_noavx PRIVATE -O0 -mno-avx)
+if(AMBFPLUS_TEST_AVX2)
+  ambfplus_add_plugin(logplugin_avx2 log_plugin.cpp)
+  target_compile_options(logplugin_avx2 PRIVATE -O3 -mavx2 -mfma)
+endif()
 """
 
 # The same log from Python.
@@ -163,6 +205,13 @@ def run(command: list[str], cwd: Path | None = None) -> subprocess.CompletedProc
     return result
 
 
+def cpu_has_avx2() -> bool:
+    try:
+        return " avx2 " in Path("/proc/cpuinfo").read_text().replace("\n", " ")
+    except OSError:
+        return False
+
+
 @pytest.fixture(scope="session")
 def cpp_plugins(tmp_path_factory) -> Path:
     """liblogplugin.so, libwrongabi.so and libnoentry.so, built against the package's config."""
@@ -173,6 +222,7 @@ def cpp_plugins(tmp_path_factory) -> Path:
     (src / "log_plugin.cpp").write_text(LOG_PLUGIN_CPP)
     (src / "wrong_abi.cpp").write_text(WRONG_ABI_CPP)
     (src / "no_entry.cpp").write_text(NO_ENTRY_CPP)
+    (src / "data_entry.cpp").write_text(DATA_ENTRY_CPP)
     build = src / "build"
     run(
         [
@@ -183,6 +233,7 @@ def cpp_plugins(tmp_path_factory) -> Path:
             str(build),
             f"-Dambfplus_DIR={ambfplus.cmake_dir()}",
             "-DCMAKE_BUILD_TYPE=Release",
+            f"-DAMBFPLUS_TEST_AVX2={'ON' if cpu_has_avx2() else 'OFF'}",
         ]
     )
     run([cmake, "--build", str(build), "-j2"])
@@ -213,8 +264,9 @@ def plugins_yaml(cpp_name: str, cpp_file: str, cpp_dir: Path, py_name: str, inde
     )
 
 
-def scene(folder: Path, cpp_dir: Path) -> Path:
-    """A launch file whose four levels each declare the C++ and the Python log plugin."""
+def scene(folder: Path, cpp_dir: Path, library: str = "logplugin") -> Path:
+    """A launch file whose four levels each declare the C++ (lib<library>.so) and the Python
+    log plugin."""
     (folder / "logplugin.py").write_text(LOG_PLUGIN_PY)
     write(
         folder,
@@ -233,7 +285,7 @@ def scene(folder: Path, cpp_dir: Path) -> Path:
     ).write_text(
         (folder / "world.yaml")
         .read_text()
-        .replace("WORLD", plugins_yaml("world_cpp", "liblogplugin.so", cpp_dir, "world_py", ""))
+        .replace("WORLD", plugins_yaml("world_cpp", f"lib{library}.so", cpp_dir, "world_py", ""))
     )
     # The model's C++ plugin is named without its extension, as AMBF's files may name it.
     write(
@@ -255,8 +307,8 @@ def scene(folder: Path, cpp_dir: Path) -> Path:
     ).write_text(
         (folder / "model.yaml")
         .read_text()
-        .replace("MODEL", plugins_yaml("model_cpp", "logplugin", cpp_dir, "model_py", ""))
-        .replace("OBJECT", plugins_yaml("obj_cpp", "liblogplugin.so", cpp_dir, "obj_py", "  "))
+        .replace("MODEL", plugins_yaml("model_cpp", library, cpp_dir, "model_py", ""))
+        .replace("OBJECT", plugins_yaml("obj_cpp", f"lib{library}.so", cpp_dir, "obj_py", "  "))
     )
     launch = write(
         folder,
@@ -272,7 +324,7 @@ def scene(folder: Path, cpp_dir: Path) -> Path:
     )
     launch.write_text(
         launch.read_text().replace(
-            "SIMULATOR", plugins_yaml("sim_cpp", "liblogplugin.so", cpp_dir, "sim_py", "")
+            "SIMULATOR", plugins_yaml("sim_cpp", f"lib{library}.so", cpp_dir, "sim_py", "")
         )
     )
     return launch
@@ -287,8 +339,23 @@ def each(event: str) -> list[str]:
     return [f"{lang}:{scope}_{lang} {event}" for scope in CALL_ORDER for lang in ("cpp", "py")]
 
 
-def test_plugins_at_four_scopes_run_their_hooks_in_order(cpp_plugins, plugin_log, tmp_path):
-    launch = scene(tmp_path, cpp_plugins)
+# The log plugin as the package builds plugins, and built with other flags than the engine.
+VARIANTS = ["logplugin", "logplugin_noavx", "logplugin_avx2"]
+
+
+def variant(cpp_plugins: Path, library: str) -> Path:
+    path = cpp_plugins / f"lib{library}.so"
+    if library.endswith("avx2") and not path.exists():
+        pytest.skip("this CPU has no AVX2, so the AVX2 build of the plugin cannot run")
+    return path
+
+
+@pytest.mark.parametrize("library", VARIANTS)
+def test_plugins_at_four_scopes_run_their_hooks_in_order(
+    cpp_plugins, plugin_log, tmp_path, library
+):
+    variant(cpp_plugins, library)
+    launch = scene(tmp_path, cpp_plugins, library)
 
     def session():
         sim = ambfplus.Simulator.from_launch(launch, models=[0], strict=True)
@@ -300,8 +367,8 @@ def test_plugins_at_four_scopes_run_their_hooks_in_order(cpp_plugins, plugin_log
         ]
         assert plugins[5].attached_to.name == "model" and plugins[7].attached_to.name == "box"
         assert plugins[1].instance.name == "sim_py"
-        # The model's, declared as `logplugin`, is found as liblogplugin.so.
-        assert plugins[0].file == plugins[4].file == str(cpp_plugins / "liblogplugin.so")
+        # The model's, declared without its extension, is found as lib<name>.so.
+        assert plugins[0].file == plugins[4].file == str(cpp_plugins / f"lib{library}.so")
         del plugins
         sim.step(2)
         camera = sim.get("camera1")
@@ -502,6 +569,48 @@ def test_missing_entry_point_is_named(cpp_plugins):
     assert str(library) in str(error.value)
     assert "no entry point ambfplus_plugin_entry" in str(error.value)
     assert "AMBFPLUS_PLUGIN" in str(error.value)
+
+
+def test_an_entry_point_that_is_data_is_refused_not_called(cpp_plugins):
+    world = ambfplus.World()
+    library = cpp_plugins / "libdataentry.so"
+    with pytest.raises(ambfplus.PluginError, match="ambfplus_plugin_entry is not a function"):
+        world.load_plugin(library)
+
+
+def test_plugins_built_with_other_flags_read_the_same_poses(cpp_plugins, plugin_log, monkeypatch):
+    """The ABI carries poses as double[16]: plugins built unoptimised without AVX and optimised
+    with AVX2 read exactly the poses Python reads of a tumbling body, every step."""
+    monkeypatch.setenv("AMBFPLUS_TEST_PLUGIN_POSES", "1")
+    seen = {}
+    for library in VARIANTS:
+        if library.endswith("avx2") and not (cpp_plugins / f"lib{library}.so").exists():
+            continue
+        plugin_log.unlink(missing_ok=True)
+        world = ambfplus.World()
+        body = world.add_body("tumbler", "box", size=(0.1, 0.05, 0.02), mass=1.0)
+        body.angular_velocity = (1.0, 2.0, 3.0)
+        body.linear_velocity = (0.1, 0.0, 0.5)
+        world.load_plugin(cpp_plugins / f"lib{library}.so", body, name="obj_cpp")
+        python = []
+        for _ in range(30):
+            world.step(1)
+            python.append((world.step_index, body.pose))
+        logged = [line.split() for line in lines(plugin_log) if " pose " in line]
+        assert len(logged) == 30, library
+        for (step, pose), line in zip(python, logged):
+            assert int(line[2]) == step
+            values = np.array([float(v) for v in line[3:]])
+            assert np.array_equal(values[:12], pose[:3].ravel()), (library, step)
+            # The plugin's own arithmetic: its flags may round (FMA) differently.
+            point = pose[:3, :3] @ (0.01, 0.02, 0.03) + pose[:3, 3]
+            assert np.allclose(values[12:], point, rtol=0, atol=1e-15), (library, step)
+        seen[library] = np.array([[float(v) for v in line[3:15]] for line in logged])
+        world.close_plugins()
+    assert len(seen) >= 2
+    first = next(iter(seen.values()))
+    for positions in seen.values():
+        assert np.array_equal(positions, first)
 
 
 def test_missing_plugin_lists_every_path_tried_and_leaves_no_model(

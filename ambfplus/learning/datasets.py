@@ -21,9 +21,9 @@ from torch.utils.data import DataLoader, Dataset, IterableDataset, get_worker_in
 
 from .. import RenderError, ScriptedDevice
 from ..recording import Recorder, open_recording
+from ..scenarios import CameraPath, DrillScript
 from ..scenes import Scene, drilling_phantom
 from .samples import OPTIONAL_PASSES, REQUIRED_PASSES, stereo_sample
-from .scenarios import CameraPath, DrillScript
 
 SCENARIOS = ("camera", "drilling", "mixed")
 DEFAULT_PASSES = REQUIRED_PASSES + OPTIONAL_PASSES
@@ -178,8 +178,7 @@ class SimulatorStereoDataset(IterableDataset):
             scene.drill.volume.reset()
         if kind == "drilling":
             seconds = self.episode_frames * self.capture_every * world.time_step
-            while script.busy_until < world.time + seconds:
-                script.plunge(max(world.time, script.busy_until))
+            script.plunge_until(world.time + seconds, now=world.time)
         return CameraPath.random(rng, moving=kind == "camera")
 
     def _recorder(self, worker: int, scene: Scene) -> Recorder | None:
@@ -202,9 +201,26 @@ class SimulatorStereoDataset(IterableDataset):
         }  # fmt: skip
 
 
+def _recordings(path: Path) -> list[Path]:
+    """A recording's head, or the shards of a dataset folder (``ambfplus generate``) in
+    episode order, as its manifest lists them."""
+    if not path.is_dir():
+        return [path]
+    from ..dataset import is_dataset, read_manifest
+
+    if not is_dataset(path):
+        raise ValueError(f"{path}: a folder, but not a dataset folder (no environment.json)")
+    records, _ = read_manifest(path)
+    shards = sorted({r["episode"]: r["file"] for r in records}.items())
+    if not shards:
+        raise ValueError(f"{path}: the dataset's manifest lists no shard yet")
+    return [path / file for _, file in shards]
+
+
 class RecordingStereoDataset(Dataset):
     """Stereo samples read from the pairs of one or more recordings (``ambfplus.recording``),
     in order: index i runs through the first recording's pairs of rig `rig`, then the next's.
+    A dataset folder (``ambfplus generate``) stands for its shards, in episode order.
 
     Files are opened lazily, in the process that reads them (each DataLoader worker opens its
     own), and never held open by the parent: lengths are read once at construction and the
@@ -218,7 +234,7 @@ class RecordingStereoDataset(Dataset):
     ) -> None:
         if isinstance(paths, (str, os.PathLike)):
             paths = [paths]
-        self.paths = [Path(p) for p in paths]
+        self.paths = [shard for p in paths for shard in _recordings(Path(p))]
         if not self.paths:
             raise ValueError("RecordingStereoDataset needs at least one recording")
         self.rig = rig

@@ -18,9 +18,9 @@ import numpy as np
 
 from .. import NullDevice, ScriptedDevice
 from ..recording import open_recording
+from ..scenarios import DrillScript
 from ..scenes import drilling_phantom, orbit_view
 from ..session import record_session
-from .scenarios import DrillScript
 
 PASSES = ("rgb", "depth", "label", "instance", "segmentation")
 MOVING_CAMERA, MOVING_DRILL = "moving camera", "moving drill"
@@ -64,8 +64,7 @@ def record_sequence(
         script = DrillScript(
             drill.volume, drill.goal[:3, 3], drill.burr_radius, np.random.default_rng(seed)
         )
-        while script.busy_until < seconds:
-            script.plunge(script.busy_until)
+        script.plunge_until(seconds)
         device, motion = ScriptedDevice(), None
         device.set_callback(script, every=10)
     return record_session(

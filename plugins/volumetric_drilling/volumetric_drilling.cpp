@@ -27,17 +27,12 @@
 #include <utility>
 #include <vector>
 
-#include "ambfplus/haptics/drill.h"
-#include "ambfplus/log.h"
 #include "ambfplus/plugin/plugin.h"
-#include "ambfplus/scene/model.h"
-#include "ambfplus/scene/simulator.h"
-#include "ambfplus/scene/world.h"
 
 namespace {
 
-using ambfplus::Drill;
-using ambfplus::RigidBody;
+using ambfplus::plugin::Object;
+using ambfplus::plugin::Pose;
 
 // The value after `flag` in args, or fallback.
 std::string option(const std::vector<std::string>& args, const std::string& flag,
@@ -64,44 +59,56 @@ double number(const std::vector<std::string>& args, const std::string& flag, dou
                               "'");
 }
 
-class VolumetricDrilling : public ambfplus::Plugin {
+void log(int level, const std::string& message) {
+  ambfplus_log(level, ("volumetric_drilling: " + message).c_str());
+}
+
+// An option of ambfplus_world_add holding numbers (they must outlive the call).
+AmbfplusOption numbers(const char* key, const std::vector<double>& values) {
+  return AmbfplusOption{key, values.data(), static_cast<int>(values.size()), nullptr};
+}
+AmbfplusOption text(const char* key, const std::string& value) {
+  return AmbfplusOption{key, nullptr, 0, value.c_str()};
+}
+
+class VolumetricDrilling : public ambfplus::plugin::Plugin {
  public:
   int init() override {
-    ambfplus::World& w = world();
-    const std::vector<std::string>& args = simulator().arguments();
-    ambfplus::Volume* volume = find_volume(w, option(args, "--volume", ""));
-    if (volume == nullptr) {
-      ambfplus::log(ambfplus::LogLevel::kWarning,
-                    "volumetric_drilling: the world has no volume to drill; not kept");
+    const ambfplus::plugin::World w = world();
+    const std::vector<std::string> args = w.arguments();
+    const Object volume = find_volume(option(args, "--volume", ""));
+    if (!volume) {
+      log(AMBFPLUS_WARNING, "the world has no volume to drill; not kept");
       return 0;
     }
     const std::string labels = option(args, "--labels", "");
-    if (!labels.empty()) name_labels(*volume->data(), ambfplus::read_label_table(labels));
-    mark_critical(*volume->data());
+    if (!labels.empty()) {
+      ambfplus::plugin::detail::checked(
+          ambfplus_volume_name_labels(w.handle(), volume.id(), labels.c_str()));
+    }
+    ambfplus::plugin::detail::checked(ambfplus_volume_mark_critical(w.handle(), volume.id()));
     // The drill's body (an invisible anchor in the original's drills.yaml) and one body per
     // burr, named by its diameter ("1mm" ... "6mm"), whose mesh shows the burr in use.
-    const std::vector<ambfplus::Object*> bodies =
-        w.lookup("mastoidectomy_drill", ambfplus::ObjectKind::kRigidBody);
-    RigidBody* anchor = bodies.size() == 1 ? static_cast<RigidBody*>(bodies[0]) : nullptr;
+    const std::vector<Object> anchors = w.lookup("mastoidectomy_drill", AMBFPLUS_BODY);
+    const Object anchor = anchors.size() == 1 ? anchors[0] : Object();
     const std::regex burr_name(R"(^([0-9]+(\.[0-9]+)?)mm$)");
-    for (RigidBody* b : w.objects_of_kind<RigidBody>()) {
+    for (const Object& b : w.objects(AMBFPLUS_BODY)) {
       std::smatch m;
-      if (std::regex_match(b->name(), m, burr_name)) burrs_.emplace_back(std::stod(m[1]) * 1e-3, b);
+      const std::string name = b.name();
+      if (std::regex_match(name, m, burr_name)) burrs_.emplace_back(std::stod(m[1]) * 1e-3, b);
     }
     std::sort(burrs_.begin(), burrs_.end(),
               [](const auto& a, const auto& b) { return a.first < b.first; });
 
-    ambfplus::DrillSpec spec;
-    spec.name = option(args, "--drill-name", "drill");
-    spec.volume = volume;
+    std::vector<double> diameters{0.001, 0.002, 0.004, 0.006};
     if (!burrs_.empty()) {
-      spec.burr_diameters.clear();
-      for (const auto& b : burrs_) spec.burr_diameters.push_back(b.first);
+      diameters.clear();
+      for (const auto& b : burrs_) diameters.push_back(b.first);
     }
-    spec.burr = static_cast<int>(spec.burr_diameters.size()) - 1;  // the largest, as the original
-    spec.cursors = static_cast<int>(number(args, "--cursors", spec.cursors));
-    spec.spacing = number(args, "--spacing", spec.spacing);
-    spec.stiffness = number(args, "--stiffness", spec.stiffness);
+    const std::vector<double> burr{static_cast<double>(diameters.size()) - 1};  // the largest
+    const std::vector<double> cursors{number(args, "--cursors", 8)};
+    const std::vector<double> spacing{number(args, "--spacing", 0.0015)};
+    const std::vector<double> stiffness{number(args, "--stiffness", 700)};
     const std::string removal = option(args, "--removal", "physical");
     if (removal != "physical" && removal != "compatible") {
       throw std::invalid_argument(
@@ -109,26 +116,30 @@ class VolumetricDrilling : public ambfplus::Plugin {
           "compatible, got '" +
           removal + "'");
     }
-    spec.removal = removal == "compatible" ? ambfplus::RemovalMode::kCompatible
-                                           : ambfplus::RemovalMode::kPhysical;
-    if (anchor != nullptr) spec.pose = anchor->pose().matrix();
-    ambfplus::Model& model = anchor != nullptr ? anchor->model() : w.default_model();
-    drill_ = &model.add_drill(spec);
+    const std::string volume_name = volume.name();
+    const Pose start = anchor ? anchor.pose() : identity();
+    const std::vector<double> pose(start.begin(), start.end());
+    const std::string model = anchor ? anchor.model() : std::string();
+    drill_ =
+        w.add("drill", option(args, "--drill-name", "drill"),
+              {text("volume", volume_name), numbers("burr_diameters", diameters),
+               numbers("burr", burr), numbers("cursors", cursors), numbers("spacing", spacing),
+               numbers("stiffness", stiffness), text("removal", removal), numbers("pose", pose)},
+              model.empty() ? nullptr : model.c_str());
     // The meshes ride on the drill (they stop colliding with its cursors).
-    if (anchor != nullptr) drill_->attach(*anchor);
-    for (const auto& b : burrs_) drill_->attach(*b.second);
-    start_ = drill_->goal();
+    const Pose here = identity();
+    if (anchor) anchor.attach_to(drill_, &here);
+    for (const auto& b : burrs_) b.second.attach_to(drill_, &here);
+    start_ = drill_.get("goal");
     add_cursor_markers(model);
     show_burr();
-    ambfplus::log(ambfplus::LogLevel::kInfo, "volumetric_drilling: drill '" + drill_->name() +
-                                                 "' on volume '" + volume->name() + "' with " +
-                                                 std::to_string(burrs_.size()) + " burr meshes, " +
-                                                 removal + " removal");
+    log(AMBFPLUS_INFO, "drill '" + drill_.name() + "' on volume '" + volume_name + "' with " +
+                           std::to_string(burrs_.size()) + " burr meshes, " + removal + " removal");
     return 1;
   }
 
   void physics_update(double) override {
-    if (drill_->burr() != shown_) show_burr();
+    if (static_cast<int>(drill_.get1("burr")) != shown_) show_burr();
     if (show_cursors_) place_cursor_markers();
   }
 
@@ -138,137 +149,88 @@ class VolumetricDrilling : public ambfplus::Plugin {
       visible_ = !visible_;
       show_burr();
     } else if (mods == 0 && key == 'X') {
-      drill_->set_meshes_follow_goal(!drill_->meshes_follow_goal());
+      drill_.set1("meshes_follow_goal", drill_.get1("meshes_follow_goal") != 0 ? 0.0 : 1.0);
     } else if (mods == kControl && key == 'C') {
       show_cursors_ = !show_cursors_;
-      for (RigidBody* m : markers_) set_visible(*m, show_cursors_);
+      for (const Object& m : markers_) m.set1("visible", show_cursors_ ? 1.0 : 0.0);
       if (show_cursors_) place_cursor_markers();
     } else if (mods == kControl && key == 'R') {
-      drill_->set_goal(start_);
+      drill_.set("goal", start_);
     } else if ((mods == kControl || mods == kAlt) && key == 'T') {
-      const int burr = drill_->burr();
-      const int now = drill_->spec().voxels_per_step[burr];
-      drill_->set_voxels_per_step(burr, std::max(1, now + (mods == kControl ? 1 : -1)));
-      ambfplus::log(ambfplus::LogLevel::kInfo,
-                    "volumetric_drilling: " + std::to_string(drill_->spec().voxels_per_step[burr]) +
-                        " voxels per step with this burr (compatible removal)");
+      const int burr = static_cast<int>(drill_.get1("burr"));
+      std::vector<double> counts = drill_.get("voxels_per_step");
+      counts[burr] = std::max(1.0, counts[burr] + (mods == kControl ? 1 : -1));
+      drill_.set("voxels_per_step", counts);
+      log(AMBFPLUS_INFO, std::to_string(static_cast<int>(counts[burr])) +
+                             " voxels per step with this burr (compatible removal)");
     }
   }
 
-  void reset() override { drill_->set_goal(start_); }
+  void reset() override { drill_.set("goal", start_); }
 
  private:
   // GLFW's press action and modifier bits.
   static constexpr int kPress = 1, kControl = 0x2, kAlt = 0x4;
 
-  static void set_visible(RigidBody& body, bool visible) {
-    ambfplus::Material m = body.material();
-    m.visible = visible;
-    body.set_material(m);
+  static Pose identity() {
+    Pose p{};
+    p[0] = p[5] = p[10] = p[15] = 1.0;
+    return p;
   }
 
   // A small sphere per cursor proxy (green) and goal (red), drawn only, hidden until Ctrl+C.
-  void add_cursor_markers(ambfplus::Model& model) {
-    for (int i = 0; i < drill_->cursor_count(); ++i) {
+  void add_cursor_markers(const std::string& model) {
+    const std::vector<double> radii = drill_.get("cursor_radii");
+    const std::string sphere = "sphere";
+    const std::vector<double> zero{0.0}, one{1.0};
+    const std::vector<double> green{0.1, 0.85, 0.2, 1.0}, red{0.9, 0.15, 0.1, 1.0};
+    for (std::size_t i = 0; i < radii.size(); ++i) {
+      const std::vector<double> radius{std::max(0.0003, radii[i] * 0.35)};
       for (const bool goal : {false, true}) {
-        ambfplus::RigidBodySpec s;
-        s.name = drill_->name() + (goal ? "_goal_" : "_proxy_") + std::to_string(i);
-        s.shape.kind = ambfplus::Shape::Kind::kSphere;
-        s.shape.radius = std::max(0.0003, drill_->cursor_radius(i) * 0.35);
-        s.dynamics.mass = 0;
-        s.dynamics.kinematic = true;
-        s.collision.enabled = false;
-        s.material.color = goal ? std::array<float, 4>{0.9f, 0.15f, 0.1f, 1.0f}
-                                : std::array<float, 4>{0.1f, 0.85f, 0.2f, 1.0f};
-        s.material.visible = false;
-        markers_.push_back(&model.add_body(s));
+        markers_.push_back(
+            world().add("body", drill_.name() + (goal ? "_goal_" : "_proxy_") + std::to_string(i),
+                        {text("shape", sphere), numbers("radius", radius), numbers("mass", zero),
+                         numbers("kinematic", one), numbers("collision", zero),
+                         numbers("color", goal ? red : green), numbers("visible", zero)},
+                        model.empty() ? nullptr : model.c_str()));
       }
     }
   }
 
   void place_cursor_markers() {
-    for (int i = 0; i < drill_->cursor_count(); ++i) {
-      Eigen::Isometry3d at = Eigen::Isometry3d::Identity();
-      at.translation() = drill_->cursor_proxy(i);
-      markers_[2 * i]->set_pose(at);
-      at.translation() = drill_->cursor_goal(i);
-      markers_[2 * i + 1]->set_pose(at);
+    const std::vector<double> proxies = drill_.get("cursor_proxies");
+    const std::vector<double> goals = drill_.get("cursor_goals");
+    for (std::size_t i = 0; 2 * i + 1 < markers_.size(); ++i) {
+      Pose at = identity();
+      for (const bool goal : {false, true}) {
+        const std::vector<double>& p = goal ? goals : proxies;
+        at[3] = p[3 * i];
+        at[7] = p[3 * i + 1];
+        at[11] = p[3 * i + 2];
+        markers_[2 * i + (goal ? 1 : 0)].set_pose(at);
+      }
     }
   }
 
-  // Names the volume's labels from a table: each label takes the table's label of the nearest
-  // colour (voxels relabelled), and the new labels are what reset() restores.
-  static void name_labels(ambfplus::VolumeData& data, const ambfplus::LabelTable& named) {
-    std::vector<std::uint16_t> to(data.label_table().max_id() + 1, 0);
-    for (const ambfplus::Label& l : data.label_table().labels()) to[l.id] = named.nearest(l.color);
-    const std::int64_t n = data.voxel_count();
-    auto relabel = [&](auto* grid) {
-      for (std::int64_t v = 0; v < n; ++v) {
-        if (grid[v] != 0 && grid[v] < to.size()) grid[v] = static_cast<std::uint8_t>(to[grid[v]]);
-      }
-    };
-    if (data.label_type() == ambfplus::LabelType::kUInt8) {
-      if (named.max_id() > 255) {
-        throw std::invalid_argument(
-            "volumetric_drilling: --labels has ids above 255 for an "
-            "8-bit volume");
-      }
-      relabel(static_cast<std::uint8_t*>(data.label_data()));
-    } else {
-      auto* grid = static_cast<std::uint16_t*>(data.label_data());
-      for (std::int64_t v = 0; v < n; ++v) {
-        if (grid[v] != 0 && grid[v] < to.size()) grid[v] = to[grid[v]];
-      }
+  Object find_volume(const std::string& name) const {
+    for (const Object& v : world().objects(AMBFPLUS_VOLUME)) {
+      if (name.empty() || v.name() == name) return v;
     }
-    data.set_label_table(named);
-    data.mark_dirty({{0, 0, 0}, data.shape()});
-    data.commit();
-  }
-
-  // Critical structures: by name where the table names them, else all but the commonest label.
-  static void mark_critical(ambfplus::VolumeData& data) {
-    std::vector<ambfplus::Label> labels = data.label_table().labels();
-    if (std::any_of(labels.begin(), labels.end(), [](const auto& l) { return l.critical; })) {
-      return;
-    }
-    static const char* const kCritical[] = {"facial", "chorda", "nerve",     "ica",     "carotid",
-                                            "sinus",  "dura",   "labyrinth", "cochlea", "iac"};
-    bool named = false;
-    for (ambfplus::Label& l : labels) {
-      std::string lower = l.name;
-      std::transform(lower.begin(), lower.end(), lower.begin(), ::tolower);
-      for (const char* word : kCritical) {
-        if (lower.find(word) != std::string::npos) l.critical = named = true;
-      }
-    }
-    if (!named) {
-      const std::vector<std::int64_t> counts = data.label_counts();
-      const auto commonest = static_cast<std::uint16_t>(
-          std::max_element(counts.begin() + 1, counts.end()) - counts.begin());
-      for (ambfplus::Label& l : labels) l.critical = l.id != commonest;
-    }
-    data.set_label_table(ambfplus::LabelTable(labels));
-  }
-
-  static ambfplus::Volume* find_volume(ambfplus::World& w, const std::string& name) {
-    for (ambfplus::Volume* v : w.objects_of_kind<ambfplus::Volume>()) {
-      if (name.empty() || v->name() == name) return v;
-    }
-    return nullptr;
+    return Object();
   }
 
   // Only the burr in use is drawn (none while hidden with B).
   void show_burr() {
-    shown_ = drill_->burr();
+    shown_ = static_cast<int>(drill_.get1("burr"));
     for (std::size_t i = 0; i < burrs_.size(); ++i) {
-      set_visible(*burrs_[i].second, visible_ && static_cast<int>(i) == shown_);
+      burrs_[i].second.set1("visible", visible_ && static_cast<int>(i) == shown_ ? 1.0 : 0.0);
     }
   }
 
-  Drill* drill_ = nullptr;
-  std::vector<std::pair<double, RigidBody*>> burrs_;  // diameter (m), its mesh's body
-  std::vector<RigidBody*> markers_;                   // proxy then goal, per cursor
-  Eigen::Isometry3d start_ = Eigen::Isometry3d::Identity();
+  Object drill_;
+  std::vector<std::pair<double, Object>> burrs_;  // diameter (m), its mesh's body
+  std::vector<Object> markers_;                   // proxy then goal, per cursor
+  std::vector<double> start_;                     // the goal to go back to
   int shown_ = -1;
   bool visible_ = true;
   bool show_cursors_ = false;

@@ -2,7 +2,8 @@
 
 #include <cmath>
 
-#include "ambfplus/scene/simulator.h"
+#include "ambfplus//scene/simulator.h"
+#include "ambfplus/errors.h"
 
 namespace ambfplus {
 namespace {
@@ -58,8 +59,8 @@ TEST(Camera, LookAtPointsTheOpticalAxisAndKeepsUpUp) {
   EXPECT_TRUE(pose.linear().col(1).isApprox(Eigen::Vector3d(0, 0, -1)));
   EXPECT_NEAR(pose.linear().determinant(), 1.0, 1e-12);
   EXPECT_TRUE(pose.translation().isApprox(Eigen::Vector3d(1, 2, 3)));
-  EXPECT_THROW(cam.look_at({0, 0, 0}, {0, 0, 1}, {0, 0, 1}), std::invalid_argument);
-  EXPECT_THROW(cam.look_at({0, 0, 0}, {0, 0, 0}), std::invalid_argument);
+  EXPECT_THROW(cam.look_at({0, 0, 0}, {0, 0, 1}, {0, 0, 1}), ArgumentError);
+  EXPECT_THROW(cam.look_at({0, 0, 0}, {0, 0, 0}), ArgumentError);
 }
 
 TEST(Camera, RejectsBadSpecs) {
@@ -68,11 +69,11 @@ TEST(Camera, RejectsBadSpecs) {
   spec.name = "bad";
   spec.near = 1;
   spec.far = 0.5;
-  EXPECT_THROW(sim->world().default_model().add_camera(spec), std::invalid_argument);
+  EXPECT_THROW(sim->world().default_model().add_camera(spec), ArgumentError);
   spec.near = 0.1;
   spec.far = 10;
   spec.width = 0;
-  EXPECT_THROW(sim->world().default_model().add_camera(spec), std::invalid_argument);
+  EXPECT_THROW(sim->world().default_model().add_camera(spec), ArgumentError);
 }
 
 }  // namespace

@@ -3,7 +3,8 @@
 #include <cmath>
 #include <memory>
 
-#include "ambfplus/haptics/mesh_collider.h"
+#include "ambfplus//haptics/mesh_collider.h"
+#include "ambfplus/errors.h"
 #include "ambfplus/haptics/proxy.h"
 #include "ambfplus/scene/rigid_body.h"
 #include "scene/primitive_meshes.h"
@@ -104,12 +105,12 @@ TEST(MeshCollider, BadMeshIsRejectedWithTheReason) {
       {
         try {
           c.add_mesh(m);
-        } catch (const std::invalid_argument& e) {
+        } catch (const ArgumentError& e) {
           EXPECT_NE(std::string(e.what()).find("index 7"), std::string::npos);
           throw;
         }
       },
-      std::invalid_argument);
+      ArgumentError);
 }
 
 // The proxy against a box: no voxels at all, only the mesh.

@@ -4,7 +4,8 @@
 #include <fstream>
 #include <string>
 
-#include "ambfplus/scene/simulator.h"
+#include "ambfplus//scene/simulator.h"
+#include "ambfplus/errors.h"
 
 namespace ambfplus {
 namespace {
@@ -92,7 +93,7 @@ TEST(SoftSensors, ConfigKeysAreAmbfs) {
   EXPECT_EQ(*c.bending_constraint, 3);
   EXPECT_FALSE(set_soft_body_config(c, "fixed nodes", 1));  // a list, not a number
   EXPECT_FALSE(set_soft_body_config(c, "kLSTX", 1));
-  EXPECT_THROW(set_soft_body_config(c, "piterations", 1.5), std::invalid_argument);
+  EXPECT_THROW(set_soft_body_config(c, "piterations", 1.5), ArgumentError);
 }
 
 }  // namespace

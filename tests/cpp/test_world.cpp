@@ -5,7 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "ambfplus/scene/simulator.h"
+#include "ambfplus//scene/simulator.h"
+#include "ambfplus/errors.h"
 #include "ambfplus/scene/system.h"
 
 namespace ambfplus {
@@ -24,10 +25,10 @@ TEST(World, NamesAreUniqueAcrossModels) {
   World& world = sim->world();
   world.default_model().add_body(sphere("a"));
   Model& other = world.add_model("other");
-  EXPECT_THROW(other.add_body(sphere("a")), std::invalid_argument);
+  EXPECT_THROW(other.add_body(sphere("a")), ArgumentError);
   CameraSpec camera;
   camera.name = "a";
-  EXPECT_THROW(other.add_camera(camera), std::invalid_argument);
+  EXPECT_THROW(other.add_camera(camera), ArgumentError);
   EXPECT_EQ(world.objects().size(), 1u);
 }
 
@@ -37,7 +38,7 @@ TEST(World, IdsAreStableAndNotReusedAfterAFailedAdd) {
   const int a = world.default_model().add_body(sphere("a")).id();
   RigidBodySpec bad = sphere("bad");
   bad.shape.radius = -1;
-  EXPECT_THROW(world.default_model().add_body(bad), std::invalid_argument);
+  EXPECT_THROW(world.default_model().add_body(bad), ArgumentError);
   EXPECT_EQ(world.find("bad"), nullptr);
   const int b = world.default_model().add_body(sphere("b")).id();
   EXPECT_EQ(a, 1);
@@ -52,7 +53,7 @@ class Recorder : public System {
   const char* name() const override { return "recorder"; }
   unsigned stages() const override { return stages_; }
   void object_added(Object& o) override {
-    if (o.name() == "refused") throw std::invalid_argument("refused");
+    if (o.name() == "refused") throw ArgumentError("refused");
     log_.push_back("added " + o.name());
   }
   void object_removed(Object& o) override { log_.push_back("removed " + o.name()); }
@@ -80,7 +81,7 @@ TEST(World, StepRunsSystemsStageByStageAndObjectsAreAnnounced) {
   EXPECT_EQ(log, (std::vector<std::string>{"prepare 1", "device input 1", "sensors 1"}));
   log.clear();
   world.default_model().add_body(sphere("kept"));
-  EXPECT_THROW(world.default_model().add_body(sphere("refused")), std::invalid_argument);
+  EXPECT_THROW(world.default_model().add_body(sphere("refused")), ArgumentError);
   EXPECT_EQ(world.find("refused"), nullptr);
   EXPECT_EQ(world.objects().size(), 1u);
   EXPECT_EQ(log, (std::vector<std::string>{"added kept"}));
@@ -102,26 +103,26 @@ TEST(World, ClockCountsFixedStepsWithoutDrift) {
   for (int i = 0; i < 1000; ++i) sim->step();
   EXPECT_EQ(sim->world().step_index(), 1000);
   EXPECT_DOUBLE_EQ(sim->world().time(), 1.0);
-  EXPECT_THROW(sim->world().step(-1), std::invalid_argument);
+  EXPECT_THROW(sim->world().step(-1), ArgumentError);
 }
 
 TEST(World, RejectsBadTimeStep) {
   SimulatorOptions options;
   options.time_step = 0.0;
-  EXPECT_THROW(Simulator::create(options), std::invalid_argument);
+  EXPECT_THROW(Simulator::create(options), ArgumentError);
 }
 
 TEST(Object, CheckedPoseRejectsNonRigidMatrices) {
   Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
   EXPECT_NO_THROW(checked_pose(m));
   m(0, 0) = 2;  // scale
-  EXPECT_THROW(checked_pose(m), std::invalid_argument);
+  EXPECT_THROW(checked_pose(m), ArgumentError);
   m = Eigen::Matrix4d::Identity();
   m(0, 0) = -1;  // reflection
-  EXPECT_THROW(checked_pose(m), std::invalid_argument);
+  EXPECT_THROW(checked_pose(m), ArgumentError);
   m = Eigen::Matrix4d::Identity();
   m(3, 0) = 1;
-  EXPECT_THROW(checked_pose(m), std::invalid_argument);
+  EXPECT_THROW(checked_pose(m), ArgumentError);
 }
 
 }  // namespace

@@ -60,6 +60,35 @@ class AMBFPLUS_API RenderError : public Error {
   explicit RenderError(const std::string& message) : Error(message) {}
 };
 
+/// A value or argument a caller gave cannot be used (out of range, not finite, a name taken or
+/// unknown): names the argument and what was expected. In Python, an ambfplus.ArgumentError,
+/// which is also a ValueError.
+class AMBFPLUS_API ArgumentError : public Error {
+ public:
+  explicit ArgumentError(const std::string& message) : Error(message) {}
+};
+
+/// An index outside what it indexes (a sensor's ray, a soft body's node). In Python, an
+/// ambfplus.OutOfRange, which is also an IndexError.
+class AMBFPLUS_API OutOfRange : public Error {
+ public:
+  explicit OutOfRange(const std::string& message) : Error(message) {}
+};
+
+/// A call that does not fit the current state (a loop started twice, a session not running).
+/// In Python, an ambfplus.StateError, which is also a RuntimeError.
+class AMBFPLUS_API StateError : public Error {
+ public:
+  explicit StateError(const std::string& message) : Error(message) {}
+};
+
+/// A resource of the system cannot be had (a socket, a port, a device file). In Python, an
+/// ambfplus.ResourceError, which is also an OSError.
+class AMBFPLUS_API ResourceError : public Error {
+ public:
+  explicit ResourceError(const std::string& message) : Error(message) {}
+};
+
 /// A plugin cannot be loaded or initialised.
 class AMBFPLUS_API PluginError : public Error {
  public:

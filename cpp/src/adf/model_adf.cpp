@@ -15,7 +15,8 @@
 
 #include "adf/adf_internal.h"
 #include "ambfplus/adf/volume_adf.h"
-#include "ambfplus/plugin/plugin.h"
+#include "ambfplus/errors.h"
+#include "ambfplus/plugin/registry.h"
 #include "ambfplus/scene/constraint_actuator.h"
 #include "ambfplus/scene/proximity_sensor.h"
 #include "ambfplus/scene/soft_body.h"
@@ -341,7 +342,7 @@ BodyPlan plan_body(const Doc& doc, const std::string& model_hr, const std::strin
     if (const YAML::Node type = b["collision mesh type"]) {
       try {
         c.mesh_type = parse_mesh_collision(text(doc, type, id, "collision mesh type"));
-      } catch (const std::invalid_argument& e) {
+      } catch (const ArgumentError& e) {
         fail(doc, type, id, e.what());
       }
     }
@@ -409,7 +410,7 @@ JointPlan plan_joint(const Doc& doc, const std::string& model_ns, const std::str
   const YAML::Node type = j["type"];
   try {
     s.type = parse_joint_type(text(doc, type, id, "type"));
-  } catch (const std::invalid_argument& e) {
+  } catch (const ArgumentError& e) {
     fail(doc, type, id, e.what());
   }
   s.parent_pivot = xyz(doc, j["parent pivot"], id, "parent pivot", Eigen::Vector3d::Zero());
@@ -675,7 +676,7 @@ SoftBodySpec plan_soft_body(const Doc& doc, const std::string& model_lr,
           ctx.diag->warn(doc.path,
                          at(entry.first) + id + ": unknown config key '" + key + "' ignored");
         }
-      } catch (const std::invalid_argument& e) {
+      } catch (const ArgumentError& e) {
         fail(doc, entry.second, id, e.what());
       }
     }
@@ -762,7 +763,7 @@ std::optional<SensorPlan> plan_sensor(const Doc& doc, const std::string& model_n
                                       number_or(doc, fan, "horizontal angle", id, 0.0),
                                       number_or(doc, fan, "vertical angle", id, 0.0),
                                       number_or(doc, fan, "start offset", id, 0.0));
-    } catch (const std::invalid_argument& e) {
+    } catch (const ArgumentError& e) {
       fail(doc, fan, id, e.what());
     }
   } else if (n["mesh"]) {

@@ -1,4 +1,5 @@
 #include "ambfplus/adf/volume_adf.h"
+#include "ambfplus/errors.h"
 
 #include <filesystem>
 
@@ -149,7 +150,7 @@ std::vector<Volume*> adf::add_adf_volumes(Model& model, const std::string& path,
       Volume& volume = model.add_volume(spec);
       volume.set_identifier(b.identifier);
       out.push_back(&volume);
-    } catch (const std::invalid_argument& e) {
+    } catch (const ArgumentError& e) {
       throw ConfigError(path, b.identifier + ": " + e.what());
     }
   }
@@ -158,7 +159,7 @@ std::vector<Volume*> adf::add_adf_volumes(Model& model, const std::string& path,
     d.spec.volume = out[drilled[k]];
     try {
       model.add_drill(d.spec).set_identifier(d.identifier);
-    } catch (const std::invalid_argument& e) {
+    } catch (const ArgumentError& e) {
       throw ConfigError(path, d.identifier + ": " + e.what());
     }
   }

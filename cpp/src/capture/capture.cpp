@@ -7,6 +7,7 @@
 #include "ambfplus/capture/capture.h"
 #include "ambfplus/capture/frame.h"
 #include "ambfplus/capture/points.h"
+#include "ambfplus/errors.h"
 #include "ambfplus/render/renderer.h"
 #include "ambfplus/scene/camera.h"
 #include "ambfplus/scene/world.h"
@@ -52,8 +53,7 @@ CapturePass parse_pass(const std::string& name) {
   for (const PassInfo& p : capture_passes()) {
     if (name == p.name) return p.bit;
   }
-  throw std::invalid_argument("unknown pass '" + name + "': expected one of " +
-                              pass_names(kAllPasses));
+  throw ArgumentError("unknown pass '" + name + "': expected one of " + pass_names(kAllPasses));
 }
 
 unsigned CaptureBuffers::passes() const {
@@ -83,11 +83,11 @@ void Camera::capture(Frame& frame, const PoseRequest& poses) {
   auto check = [&](const auto& buffer, int want_c, const char* what) {
     if (!buffer.empty() &&
         (buffer.height() != height_ || buffer.width() != width_ || buffer.channels() != want_c)) {
-      throw std::invalid_argument(
-          "camera '" + name() + "': the frame's " + what + " is " +
-          std::to_string(buffer.height()) + "x" + std::to_string(buffer.width()) + "x" +
-          std::to_string(buffer.channels()) + ", the camera makes " + std::to_string(height_) +
-          "x" + std::to_string(width_) + "x" + std::to_string(want_c));
+      throw ArgumentError("camera '" + name() + "': the frame's " + what + " is " +
+                          std::to_string(buffer.height()) + "x" + std::to_string(buffer.width()) +
+                          "x" + std::to_string(buffer.channels()) + ", the camera makes " +
+                          std::to_string(height_) + "x" + std::to_string(width_) + "x" +
+                          std::to_string(want_c));
     }
   };
   check(frame.rgb, 3, "rgb");
@@ -115,7 +115,7 @@ void Camera::capture(Frame& frame, const PoseRequest& poses) {
 
 void Camera::capture(const CaptureBuffers& buffers, Frame& frame, const PoseRequest& poses) {
   if ((buffers.passes() & kAllPasses) == 0) {
-    throw std::invalid_argument("camera '" + name() + "': a capture needs at least one pass");
+    throw ArgumentError("camera '" + name() + "': a capture needs at least one pass");
   }
   // Points follow from depth: render it into scratch memory when not asked for.
   CaptureBuffers drawn = buffers;

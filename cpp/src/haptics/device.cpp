@@ -1,4 +1,5 @@
 #include "ambfplus/haptics/device.h"
+#include "ambfplus/errors.h"
 
 #include <algorithm>
 #include <cmath>
@@ -15,7 +16,7 @@ NullDevice::NullDevice() : Device({"null", 0.1, 0.1, 0.0, 0.1}) {}
 SimulatedDevice::SimulatedDevice(const Hand& hand, const Eigen::Vector3d& position)
     : Device({"simulated", 10.0, 1000.0, 5.0, 0.1}), hand_(hand), x_(position), target_(position) {
   if (!(hand.mass > 0) || !(hand.stiffness >= 0) || !(hand.damping >= 0)) {
-    throw std::invalid_argument(
+    throw ArgumentError(
         "simulated device: the hand needs mass > 0, stiffness >= 0 and "
         "damping >= 0");
   }
@@ -64,7 +65,7 @@ ScriptedDevice::ScriptedDevice() : Device({"scripted", 10.0, 1000.0, 5.0, 0.1}) 
 void ScriptedDevice::set_waypoints(std::vector<Waypoint> waypoints) {
   for (std::size_t i = 1; i < waypoints.size(); ++i) {
     if (!(waypoints[i].time >= waypoints[i - 1].time)) {
-      throw std::invalid_argument("scripted device: waypoint times must not decrease");
+      throw ArgumentError("scripted device: waypoint times must not decrease");
     }
   }
   std::lock_guard<std::mutex> lock(mutex_);
@@ -75,7 +76,7 @@ void ScriptedDevice::set_waypoints(std::vector<Waypoint> waypoints) {
 }
 
 void ScriptedDevice::set_sampler(Sampler sampler, int every) {
-  if (every < 1) throw std::invalid_argument("scripted device: every must be >= 1");
+  if (every < 1) throw ArgumentError("scripted device: every must be >= 1");
   std::lock_guard<std::mutex> lock(mutex_);
   sampler_ = std::move(sampler);
   every_ = every;
@@ -130,7 +131,7 @@ constexpr int kRelease = 0;
 KeyboardDevice::KeyboardDevice(double step, double angle)
     : Device({"keyboard", 10.0, 1000.0, 5.0, 0.1}), step_(step), angle_(angle) {
   if (!(step > 0) || !(angle > 0)) {
-    throw std::invalid_argument("keyboard device: step and angle must be > 0");
+    throw ArgumentError("keyboard device: step and angle must be > 0");
   }
 }
 
@@ -223,9 +224,9 @@ MergedDevice::MergedDevice(std::shared_ptr<Device> pose,
     : Device(pose ? pose->spec() : DeviceSpec{}),
       pose_(std::move(pose)),
       buttons_(std::move(buttons)) {
-  if (!pose_) throw std::invalid_argument("merged device: needs a device for the pose");
+  if (!pose_) throw ArgumentError("merged device: needs a device for the pose");
   for (const auto& b : buttons_) {
-    if (!b) throw std::invalid_argument("merged device: a button device is missing");
+    if (!b) throw ArgumentError("merged device: a button device is missing");
   }
 }
 
@@ -244,9 +245,9 @@ ReplayDevice::ReplayDevice(std::vector<DeviceRecord> records, DeviceSpec spec)
     : Device(std::move(spec)), records_(std::move(records)) {
   for (std::size_t i = 1; i < records_.size(); ++i) {
     if (records_[i].step <= records_[i - 1].step) {
-      throw std::invalid_argument("replay device: record " + std::to_string(i) + " has step " +
-                                  std::to_string(records_[i].step) + ", not after " +
-                                  std::to_string(records_[i - 1].step));
+      throw ArgumentError("replay device: record " + std::to_string(i) + " has step " +
+                          std::to_string(records_[i].step) + ", not after " +
+                          std::to_string(records_[i - 1].step));
     }
   }
 }

@@ -1,4 +1,5 @@
 #include "ambfplus/haptics/drill.h"
+#include "ambfplus/errors.h"
 
 #include <time.h>
 #include <algorithm>
@@ -16,8 +17,6 @@
 namespace ambfplus {
 namespace {
 
-constexpr std::size_t kTickHistory = 100000;
-
 double thread_cpu_seconds() {
   timespec t{};
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
@@ -30,31 +29,30 @@ constexpr double kPi = 3.14159265358979323846;
 Drill::Drill(Model& model, const DrillSpec& spec, int id)
     : Object(model, spec.name, id), volume_(spec.volume), spec_(spec), burr_(spec.burr) {
   const std::string who = "drill '" + spec.name + "': ";
-  if (volume_ == nullptr) throw std::invalid_argument(who + "needs a volume to drill");
+  if (volume_ == nullptr) throw ArgumentError(who + "needs a volume to drill");
   if (&volume_->world() != &model.world()) {
-    throw std::invalid_argument(who + "its volume must be in the same world");
+    throw ArgumentError(who + "its volume must be in the same world");
   }
-  if (spec_.burr_diameters.empty()) throw std::invalid_argument(who + "needs at least one burr");
+  if (spec_.burr_diameters.empty()) throw ArgumentError(who + "needs at least one burr");
   for (double d : spec_.burr_diameters) {
-    if (!(d > 0)) throw std::invalid_argument(who + "burr diameters must be > 0");
+    if (!(d > 0)) throw ArgumentError(who + "burr diameters must be > 0");
   }
   if (spec_.cursors < 1 || spec_.cursors > 16) {
-    throw std::invalid_argument(who + "cursors must be 1..16, got " +
-                                std::to_string(spec_.cursors));
+    throw ArgumentError(who + "cursors must be 1..16, got " + std::to_string(spec_.cursors));
   }
-  if (!(spec_.spacing > 0)) throw std::invalid_argument(who + "cursor spacing must be > 0");
+  if (!(spec_.spacing > 0)) throw ArgumentError(who + "cursor spacing must be > 0");
   if (spec_.shaft_radii.empty()) {
     for (int i = 1; i < spec_.cursors; ++i) spec_.shaft_radii.push_back(0.00065 + 0.0001 * (i - 1));
   }
   if (static_cast<int>(spec_.shaft_radii.size()) != spec_.cursors - 1) {
-    throw std::invalid_argument(who + "needs " + std::to_string(spec_.cursors - 1) +
-                                " shaft radii, got " + std::to_string(spec_.shaft_radii.size()));
+    throw ArgumentError(who + "needs " + std::to_string(spec_.cursors - 1) + " shaft radii, got " +
+                        std::to_string(spec_.shaft_radii.size()));
   }
   if (spec_.voxels_per_step.size() != spec_.burr_diameters.size()) {
-    throw std::invalid_argument(who + "voxels_per_step needs one count per burr");
+    throw ArgumentError(who + "voxels_per_step needs one count per burr");
   }
   if (!(spec_.max_force > 0) || spec_.damping < 0 || spec_.soft_start < 0) {
-    throw std::invalid_argument(who + "max_force must be > 0, damping and soft_start >= 0");
+    throw ArgumentError(who + "max_force must be > 0, damping and soft_start >= 0");
   }
   set_stiffness(spec_.stiffness);
   set_cutting_rate(spec_.cutting_rate);
@@ -82,19 +80,18 @@ Drill::Drill(Model& model, const DrillSpec& spec, int id)
 Drill::~Drill() = default;
 
 void Drill::set_goal(const Eigen::Isometry3d& goal) {
-  if (!goal.matrix().allFinite()) throw std::invalid_argument("drill goal must be finite");
+  if (!goal.matrix().allFinite()) throw ArgumentError("drill goal must be finite");
   goal_ = goal;
 }
 
 void Drill::set_speed(double speed) {
-  if (!(speed >= 0.0 && speed <= 1.0)) throw std::invalid_argument("drill speed must be in 0..1");
+  if (!(speed >= 0.0 && speed <= 1.0)) throw ArgumentError("drill speed must be in 0..1");
   speed_ = speed;
 }
 
 void Drill::set_burr(int index) {
   if (index < 0 || index >= static_cast<int>(spec_.burr_diameters.size())) {
-    throw std::invalid_argument("burr index must be 0.." +
-                                std::to_string(spec_.burr_diameters.size() - 1));
+    throw ArgumentError("burr index must be 0.." + std::to_string(spec_.burr_diameters.size() - 1));
   }
   burr_ = index;
   if (!cursors_.empty()) cursors_[0].set_radius(burr_radius());
@@ -102,35 +99,32 @@ void Drill::set_burr(int index) {
 
 void Drill::set_voxels_per_step(int burr, int count) {
   if (burr < 0 || burr >= static_cast<int>(spec_.voxels_per_step.size()) || count < 1) {
-    throw std::invalid_argument("voxels per step: burr must be 0.." +
-                                std::to_string(spec_.voxels_per_step.size() - 1) +
-                                " and count >= 1");
+    throw ArgumentError("voxels per step: burr must be 0.." +
+                        std::to_string(spec_.voxels_per_step.size() - 1) + " and count >= 1");
   }
   spec_.voxels_per_step[burr] = count;
 }
 
 void Drill::set_stiffness(double k) {
-  if (!(k > 0) || !std::isfinite(k)) throw std::invalid_argument("stiffness must be > 0 N/m");
+  if (!(k > 0) || !std::isfinite(k)) throw ArgumentError("stiffness must be > 0 N/m");
   spec_.stiffness = k;
 }
 
 void Drill::set_cutting_rate(double rate) {
-  if (!(rate >= 0) || !std::isfinite(rate))
-    throw std::invalid_argument("cutting rate must be >= 0");
+  if (!(rate >= 0) || !std::isfinite(rate)) throw ArgumentError("cutting rate must be >= 0");
   spec_.cutting_rate = rate;
 }
 
 void Drill::set_hardness(std::uint16_t label, double hardness) {
-  if (!(hardness > 0) || !std::isfinite(hardness))
-    throw std::invalid_argument("hardness must be > 0");
+  if (!(hardness > 0) || !std::isfinite(hardness)) throw ArgumentError("hardness must be > 0");
   hardness_[label] = hardness;
 }
 
 void Drill::set_waypoints(const std::vector<DrillWaypoint>& waypoints) {
   double last = 0;
   for (const DrillWaypoint& w : waypoints) {
-    if (!(w.time >= last)) throw std::invalid_argument("waypoint times must not decrease from 0");
-    if (!(w.speed >= 0 && w.speed <= 1)) throw std::invalid_argument("waypoint speed must be 0..1");
+    if (!(w.time >= last)) throw ArgumentError("waypoint times must not decrease from 0");
+    if (!(w.speed >= 0 && w.speed <= 1)) throw ArgumentError("waypoint speed must be 0..1");
     checked_pose(w.pose);
     last = w.time;
   }
@@ -203,10 +197,18 @@ void Drill::tick(double dt, std::int64_t step) {
   age_ += dt;
   collider_->sync();
   sync_meshes();
+  update_cursors();
+  place_drill();
+  const Eigen::Vector3d tip_force = update_forces(dt);
+  remove_tissue(dt, step, tip_force);
+  update_critical_distances();
+  record_timing(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+                thread_cpu_seconds() - cpu_start);
+}
 
-  // Cursor goals along the shaft, in the volume frame.
+void Drill::update_cursors() {
+  // Cursor goals along the shaft, in the volume frame; the one furthest from its goal leads.
   const Eigen::Isometry3d volume_from_world = volume_->pose().inverse();
-  const Eigen::Matrix3d world_from_volume = volume_->pose().linear();
   const Eigen::Vector3d tip_goal = volume_from_world * goal_.translation();
   const Eigen::Vector3d axis = volume_from_world.linear() * goal_.linear().col(0);
   double largest = -1;
@@ -218,18 +220,23 @@ void Drill::tick(double dt, std::int64_t step) {
       leading_ = i;
     }
   }
+}
 
-  // The drill sits where its leading cursor's proxy puts it.
-  const ProxyCursor& lead = cursors_[leading_];
-  const Eigen::Vector3d tip = lead.proxy() - axis * (spec_.spacing * leading_);
+void Drill::place_drill() {
+  // The drill sits where its leading cursor's proxy puts it, its meshes with it (or at the goal).
+  const Eigen::Vector3d axis = volume_->pose().inverse().linear() * goal_.linear().col(0);
+  const Eigen::Vector3d tip = cursors_[leading_].proxy() - axis * (spec_.spacing * leading_);
   Eigen::Isometry3d pose = goal_;
   pose.translation() = volume_->pose() * tip;
   set_pose(pose);
   const Eigen::Isometry3d& carrier = meshes_follow_goal_ ? goal_ : pose;
   for (auto& [body, offset] : attached_) body->set_pose(carrier * offset);
+}
 
-  // Forces: stiffness times proxy - goal, damped against the goal's motion while in contact,
-  // limited, and ramped in over the soft start.
+Eigen::Vector3d Drill::update_forces(double dt) {
+  // Stiffness times proxy - goal, damped against the goal's motion while in contact, limited,
+  // and ramped in over the soft start.
+  const Eigen::Matrix3d world_from_volume = volume_->pose().linear();
   const Eigen::Vector3d goal_velocity =
       dt > 0 ? Eigen::Vector3d((goal_.translation() - last_goal_position_) / dt)
              : Eigen::Vector3d::Zero();
@@ -254,73 +261,85 @@ void Drill::tick(double dt, std::int64_t step) {
     if (i == 0) tip_force_volume = world_from_volume.transpose() * f;
   }
   total_force_ = limited(total_force_);
+  return tip_force_volume;
+}
 
-  // Removal: only the tip, only when it leads, touches the anatomy and the drill runs.
+std::vector<std::pair<double, std::array<int, 3>>> Drill::cuttable_voxels() const {
+  const ProxyCursor& burr = cursors_[0];
+  const std::shared_ptr<VolumeData>& data = volume_->data();
+  // The burr cuts what it touches: voxels whose centres are within a little more than half a
+  // voxel of its surface (where the proxy holds it, touching the voxel spheres), those nearest
+  // where the device pushes it first.
+  const double reach = burr.radius() + 0.6 * data->voxel_size().maxCoeff();
+  // The proxy does not overlap the solid, so what it touches is surface, which the proxy's
+  // last patch holds (it reaches at least the burr radius and four voxel radii beyond where the
+  // proxy started; the proxy moved towards the goal, inside that).
+  const SurfacePatch& patch = burr.patch();
+  const bool covered = (burr.proxy() - patch.centre).norm() + reach <= patch.radius;
+  const std::vector<std::array<int, 3>> gathered =
+      covered ? std::vector<std::array<int, 3>>() : collider_->surface_within(burr.proxy(), reach);
+  const std::vector<std::array<int, 3>>& candidates = covered ? patch.voxels : gathered;
+  std::vector<std::pair<double, std::array<int, 3>>> order;
+  for (std::size_t n = 0; n < candidates.size(); ++n) {
+    const std::array<int, 3>& v = candidates[n];
+    // Distance first (the patch holds the centres), the grid only for voxels in reach.
+    const Eigen::Vector3d c = covered ? Eigen::Vector3d(patch.x[n], patch.y[n], patch.z[n])
+                                      : data->voxel_center(v[0], v[1], v[2]);
+    if ((c - burr.proxy()).squaredNorm() > reach * reach) continue;
+    if (data->label(v[0], v[1], v[2]) == 0) continue;  // removed earlier this step
+    const Label* l = data->label_table().find(data->label(v[0], v[1], v[2]));
+    if (l != nullptr && !l->removable) continue;
+    order.push_back({(c - burr.goal()).squaredNorm(), v});
+  }
+  // Nearest the goal first; ties by index, so the order is the same every run.
+  std::sort(order.begin(), order.end());
+  return order;
+}
+
+void Drill::remove_tissue(double dt, std::int64_t step, const Eigen::Vector3d& tip_force_volume) {
+  // Only the tip cuts, only when it leads, touches the anatomy and the drill runs.
   const ProxyCursor& burr = cursors_[0];
   bool on_anatomy = false;  // a mesh contact alone cuts nothing
   for (int i = 0; i < burr.contacts(); ++i) on_anatomy |= burr.contact_voxel(i)[0] >= 0;
-  const bool cutting = on_ && speed_ > 0 && leading_ == 0 && on_anatomy;
-  if (!cutting) budget_ = 0;
-  if (cutting) {
-    const std::shared_ptr<VolumeData>& data = volume_->data();
-    // The burr cuts what it touches: voxels whose centres are within a little more than half a
-    // voxel of its surface (where the proxy holds it, touching the voxel spheres), those nearest
-    // where the device pushes it first.
-    const double reach = burr.radius() + 0.6 * data->voxel_size().maxCoeff();
-    // The proxy does not overlap the solid, so what it touches is surface, which the proxy's
-    // last patch holds (it reaches at least the burr radius and four voxel radii beyond where the
-    // proxy started; the proxy moved towards the goal, inside that).
-    const SurfacePatch& patch = burr.patch();
-    const bool covered = (burr.proxy() - patch.centre).norm() + reach <= patch.radius;
-    const std::vector<std::array<int, 3>> gathered =
-        covered ? std::vector<std::array<int, 3>>()
-                : collider_->surface_within(burr.proxy(), reach);
-    const std::vector<std::array<int, 3>>& candidates = covered ? patch.voxels : gathered;
-    std::vector<std::pair<double, std::array<int, 3>>> order;
-    for (std::size_t n = 0; n < candidates.size(); ++n) {
-      const std::array<int, 3>& v = candidates[n];
-      // Distance first (the patch holds the centres), the grid only for voxels in reach.
-      const Eigen::Vector3d c = covered ? Eigen::Vector3d(patch.x[n], patch.y[n], patch.z[n])
-                                        : data->voxel_center(v[0], v[1], v[2]);
-      if ((c - burr.proxy()).squaredNorm() > reach * reach) continue;
-      if (data->label(v[0], v[1], v[2]) == 0) continue;  // removed earlier this step
-      const Label* l = data->label_table().find(data->label(v[0], v[1], v[2]));
-      if (l != nullptr && !l->removable) continue;
-      order.push_back({(c - burr.goal()).squaredNorm(), v});
+  if (!(on_ && speed_ > 0 && leading_ == 0 && on_anatomy)) {
+    budget_ = 0;
+    return;
+  }
+  const std::shared_ptr<VolumeData>& data = volume_->data();
+  const std::vector<std::pair<double, std::array<int, 3>>> order = cuttable_voxels();
+  std::vector<std::array<int, 3>> take;
+  if (spec_.removal == RemovalMode::kCompatible) {
+    const std::size_t n = std::min<std::size_t>(order.size(), spec_.voxels_per_step[burr_]);
+    for (std::size_t i = 0; i < n; ++i) take.push_back(order[i].second);
+  } else {
+    // A volume budget from the normal force, spent on whole voxels by their hardness.
+    const double normal_force = std::abs(tip_force_volume.dot(burr.mean_normal()));
+    const double voxel_volume = data->voxel_size().prod();
+    const double cap = 4.0 / 3.0 * kPi * std::pow(burr.radius(), 3);
+    budget_ = std::min(cap, budget_ + spec_.cutting_rate * speed_ * normal_force * dt);
+    for (const auto& [d2, v] : order) {
+      const double cost = voxel_volume * hardness_[data->label(v[0], v[1], v[2])];
+      if (cost > budget_) break;
+      budget_ -= cost;
+      take.push_back(v);
     }
-    // Nearest the goal first; ties by index, so the order is the same every run.
-    std::sort(order.begin(), order.end());
-    std::vector<std::array<int, 3>> take;
-    if (spec_.removal == RemovalMode::kCompatible) {
-      const std::size_t n = std::min<std::size_t>(order.size(), spec_.voxels_per_step[burr_]);
-      for (std::size_t i = 0; i < n; ++i) take.push_back(order[i].second);
-    } else {
-      const double normal_force = std::abs(tip_force_volume.dot(burr.mean_normal()));
-      const double voxel_volume = data->voxel_size().prod();
-      const double cap = 4.0 / 3.0 * kPi * std::pow(burr.radius(), 3);
-      budget_ = std::min(cap, budget_ + spec_.cutting_rate * speed_ * normal_force * dt);
-      for (const auto& [d2, v] : order) {
-        const double cost = voxel_volume * hardness_[data->label(v[0], v[1], v[2])];
-        if (cost > budget_) break;
-        budget_ -= cost;
-        take.push_back(v);
-      }
-      if (order.empty()) budget_ = 0;
-    }
-    if (!take.empty()) {
-      const std::vector<std::uint16_t> old = collider_->remove(take);
-      for (std::size_t i = 0; i < take.size(); ++i) {
-        removed_.push_back(RemovedVoxel{step, take[i], old[i]});
-        const Label* l = data->label_table().find(old[i]);
-        if (l != nullptr && l->critical) {
-          events_.push_back(DrillEvent{step, "critical", old[i], take[i]});
-          critical_->removed(take[i], old[i]);
-        }
-      }
+    if (order.empty()) budget_ = 0;
+  }
+  if (take.empty()) return;
+  const std::vector<std::uint16_t> old = collider_->remove(take);
+  for (std::size_t i = 0; i < take.size(); ++i) {
+    log_removed(RemovedVoxel{step, take[i], old[i]});
+    const Label* l = data->label_table().find(old[i]);
+    if (l != nullptr && l->critical) {
+      log_event(DrillEvent{step, "critical", old[i], take[i]});
+      critical_->removed(take[i], old[i]);
     }
   }
+}
 
-  // Distances from the burr's surface to the critical structures.
+void Drill::update_critical_distances() {
+  // From the burr's surface to each critical structure.
+  const ProxyCursor& burr = cursors_[0];
   critical_distances_.clear();
   const double half_voxel = 0.5 * std::cbrt(volume_->data()->voxel_size().prod());
   for (std::uint16_t label : critical_->labels()) {
@@ -328,10 +347,27 @@ void Drill::tick(double dt, std::int64_t step) {
     critical_distances_.emplace_back(
         label, std::isinf(d) ? d : std::max(0.0, d - burr.radius() - half_voxel));
   }
+}
 
-  tick_seconds_.push_back(
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-  tick_cpu_seconds_.push_back(thread_cpu_seconds() - cpu_start);
+void Drill::log_removed(const RemovedVoxel& voxel) {
+  removed_.push_back(voxel);
+  if (removed_.size() > kMaxRemoved) {
+    removed_.pop_front();
+    ++removed_dropped_;
+  }
+}
+
+void Drill::log_event(const DrillEvent& event) {
+  events_.push_back(event);
+  if (events_.size() > kMaxEvents) {
+    events_.pop_front();
+    ++events_dropped_;
+  }
+}
+
+void Drill::record_timing(double wall, double cpu) {
+  tick_seconds_.push_back(wall);
+  tick_cpu_seconds_.push_back(cpu);
   if (tick_seconds_.size() > kTickHistory) {
     tick_seconds_.pop_front();
     tick_cpu_seconds_.pop_front();

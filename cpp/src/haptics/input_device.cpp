@@ -1,4 +1,5 @@
 #include "ambfplus/haptics/input_device.h"
+#include "ambfplus/errors.h"
 
 #include <algorithm>
 #include <stdexcept>
@@ -11,13 +12,13 @@ namespace ambfplus {
 InputDevice::InputDevice(Model& model, const InputDeviceSpec& spec, int id)
     : Object(model, spec.name, id), spec_(spec) {
   const std::string who = "input device '" + spec.name + "': ";
-  if (!spec_.device) throw std::invalid_argument(who + "needs a device");
-  if (spec_.drill == nullptr) throw std::invalid_argument(who + "needs a drill to drive");
+  if (!spec_.device) throw ArgumentError(who + "needs a device");
+  if (spec_.drill == nullptr) throw ArgumentError(who + "needs a drill to drive");
   if (!(spec_.workspace_scale > 0)) {
-    throw std::invalid_argument(who + "workspace scale must be > 0");
+    throw ArgumentError(who + "workspace scale must be > 0");
   }
   if (!(spec_.max_force >= 0) || !(spec_.force_scale >= 0)) {
-    throw std::invalid_argument(who + "max force and force scale must be >= 0");
+    throw ArgumentError(who + "max force and force scale must be >= 0");
   }
 }
 
@@ -33,6 +34,10 @@ void InputDevice::pre_step(std::int64_t step, double time) {
   const DeviceState previous = state_;
   state_ = spec_.device->read(step, time);
   log_.push_back({step, state_});
+  if (log_.size() > kMaxLog) {
+    log_.pop_front();
+    ++log_dropped_;
+  }
   const std::uint32_t pressed = state_.buttons & ~previous.buttons;
   Drill& drill = *spec_.drill;
   clutched_ = held(spec_.clutch_button);

@@ -23,7 +23,7 @@ constexpr std::size_t kEventBytes = 8;
 JoystickDevice::JoystickDevice(const std::string& path, Mapping mapping)
     : Device({"joystick", 0.0, 0.0, 0.0, 0.1}), mapping_(mapping) {
   if (!(mapping.speed >= 0) || !(mapping.deadband >= 0 && mapping.deadband < 1)) {
-    throw std::invalid_argument("joystick device: speed must be >= 0 and deadband in [0, 1)");
+    throw ArgumentError("joystick device: speed must be >= 0 and deadband in [0, 1)");
   }
   if (path.empty()) return;
   fd_ = open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);

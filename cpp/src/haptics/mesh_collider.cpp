@@ -1,4 +1,5 @@
 #include "ambfplus/haptics/mesh_collider.h"
+#include "ambfplus/errors.h"
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -65,13 +66,13 @@ double enter_capsule(const Eigen::Vector3d& a, const Eigen::Vector3d& d, double 
 
 int MeshCollider::add_mesh(const MeshData& mesh) {
   if (mesh.position_size != 3) {
-    throw std::invalid_argument("MeshCollider: mesh positions must have 3 coordinates");
+    throw ArgumentError("MeshCollider: mesh positions must have 3 coordinates");
   }
   Part part;
   auto vertex = [&](std::uint32_t i) {
     if (i >= mesh.vertex_count()) {
-      throw std::invalid_argument("MeshCollider: triangle index " + std::to_string(i) +
-                                  " past the last vertex " + std::to_string(mesh.vertex_count()));
+      throw ArgumentError("MeshCollider: triangle index " + std::to_string(i) +
+                          " past the last vertex " + std::to_string(mesh.vertex_count()));
     }
     return Eigen::Vector3d(mesh.positions[3 * i], mesh.positions[3 * i + 1],
                            mesh.positions[3 * i + 2]);

@@ -11,6 +11,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "ambfplus/errors.h"
 #include "ambfplus/haptics/device.h"
 
 namespace ambfplus {
@@ -77,19 +78,19 @@ bool NetworkDevice::parse(const std::uint8_t* data, std::size_t size, double max
 NetworkDevice::NetworkDevice(int port, const std::string& address, double max_distance)
     : Device({"network", 10.0, 1000.0, 5.0, 0.1}), max_distance_(max_distance) {
   const std::string where = "network device on " + address + ":" + std::to_string(port);
-  if (port < 0 || port > 65535) throw std::invalid_argument(where + ": port must be 0..65535");
+  if (port < 0 || port > 65535) throw ArgumentError(where + ": port must be 0..65535");
   sockaddr_in a{};
   a.sin_family = AF_INET;
   a.sin_port = htons(static_cast<std::uint16_t>(port));
   if (inet_pton(AF_INET, address.c_str(), &a.sin_addr) != 1) {
-    throw std::invalid_argument(where + ": not an IPv4 address");
+    throw ArgumentError(where + ": not an IPv4 address");
   }
   socket_ = socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
-  if (socket_ < 0) throw std::runtime_error(where + ": socket: " + std::strerror(errno));
+  if (socket_ < 0) throw ResourceError(where + ": socket: " + std::strerror(errno));
   if (bind(socket_, reinterpret_cast<sockaddr*>(&a), sizeof(a)) != 0) {
     const std::string error = std::strerror(errno);
     close(socket_);
-    throw std::runtime_error(where + ": bind: " + error);
+    throw ResourceError(where + ": bind: " + error);
   }
   socklen_t size = sizeof(a);
   getsockname(socket_, reinterpret_cast<sockaddr*>(&a), &size);

@@ -2,6 +2,7 @@
 
 #include <stdexcept>
 
+#include "ambfplus/errors.h"
 #include "ambfplus/scene/constraint_actuator.h"
 #include "ambfplus/scene/rigid_body.h"
 #include "ambfplus/scene/world.h"
@@ -11,19 +12,19 @@ namespace ambfplus {
 
 void ConstraintActuator::actuate(RigidBody& body, const Eigen::Isometry3d& offset) {
   if (&body == &parent()) {
-    throw std::invalid_argument("actuator '" + name() + "' cannot hold its own parent '" +
-                                body.name() + "'");
+    throw ArgumentError("actuator '" + name() + "' cannot hold its own parent '" + body.name() +
+                        "'");
   }
   if (&body.world() != &world()) {
-    throw std::invalid_argument("actuator '" + name() + "': body '" + body.name() +
-                                "' is in another world");
+    throw ArgumentError("actuator '" + name() + "': body '" + body.name() +
+                        "' is in another world");
   }
   if (!body.is_dynamic()) {
-    throw std::invalid_argument("actuator '" + name() + "': body '" + body.name() +
-                                "' is static or kinematic; only bodies physics moves can be held");
+    throw ArgumentError("actuator '" + name() + "': body '" + body.name() +
+                        "' is static or kinematic; only bodies physics moves can be held");
   }
   if (!offset.matrix().allFinite()) {
-    throw std::invalid_argument("actuator '" + name() + "': the offset must be finite");
+    throw ArgumentError("actuator '" + name() + "': the offset must be finite");
   }
   if (body_ == &body) return;  // already held (as AMBF, a new offset does not re-grip)
   deactuate();

@@ -2,6 +2,7 @@
 
 #include <stdexcept>
 
+#include "ambfplus/errors.h"
 #include "ambfplus/scene/rigid_body.h"
 #include "ambfplus/scene/world.h"
 #include "physics/physics_world.h"
@@ -10,8 +11,7 @@ namespace ambfplus {
 namespace {
 
 void check_finite(const Eigen::Vector3d& v, const std::string& body, const char* what) {
-  if (!v.allFinite())
-    throw std::invalid_argument("body '" + body + "': " + what + " must be finite");
+  if (!v.allFinite()) throw ArgumentError("body '" + body + "': " + what + " must be finite");
 }
 
 }  // namespace
@@ -36,7 +36,7 @@ void RigidBody::set_pose(const Eigen::Isometry3d& pose) {
 void RigidBody::set_kinematic(bool kinematic) {
   if (kinematic == dynamics_.kinematic) return;
   if (!kinematic && shape_.kind == Shape::Kind::kPlane && dynamics_.mass > 0) {
-    throw std::invalid_argument("body '" + name() + "': a plane cannot be dynamic");
+    throw ArgumentError("body '" + name() + "': a plane cannot be dynamic");
   }
   dynamics_.kinematic = kinematic;
   if (physics::body_of(*this) != nullptr) {
@@ -88,7 +88,7 @@ Eigen::Isometry3d RigidBody::inertial_offset() const { return physics::body_of(*
 
 void RigidBody::set_friction(double static_friction, double rolling_friction) {
   if (!(static_friction >= 0) || !(rolling_friction >= 0)) {
-    throw std::invalid_argument("body '" + name() + "': friction must be >= 0");
+    throw ArgumentError("body '" + name() + "': friction must be >= 0");
   }
   dynamics_.static_friction = static_friction;
   dynamics_.rolling_friction = rolling_friction;
@@ -98,7 +98,7 @@ void RigidBody::set_friction(double static_friction, double rolling_friction) {
 
 void RigidBody::set_restitution(double restitution) {
   if (!(restitution >= 0 && restitution <= 1)) {
-    throw std::invalid_argument("body '" + name() + "': restitution must be in 0..1");
+    throw ArgumentError("body '" + name() + "': restitution must be in 0..1");
   }
   dynamics_.restitution = restitution;
   physics::body_of(*this)->body->setRestitution(restitution);
@@ -106,7 +106,7 @@ void RigidBody::set_restitution(double restitution) {
 
 void RigidBody::set_damping(double linear, double angular) {
   if (!(linear >= 0 && linear <= 1) || !(angular >= 0 && angular <= 1)) {
-    throw std::invalid_argument("body '" + name() + "': damping must be in 0..1");
+    throw ArgumentError("body '" + name() + "': damping must be in 0..1");
   }
   dynamics_.linear_damping = linear;
   dynamics_.angular_damping = angular;

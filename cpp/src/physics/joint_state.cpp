@@ -2,6 +2,7 @@
 
 #include <stdexcept>
 
+#include "ambfplus/errors.h"
 #include "ambfplus/scene/joint.h"
 #include "physics/physics_world.h"
 
@@ -14,8 +15,7 @@ double Joint::velocity() const { return physics::PhysicsWorld::velocity(*this); 
 void Joint::set_limits(std::optional<double> lower, std::optional<double> upper) {
   if ((lower && !std::isfinite(*lower)) || (upper && !std::isfinite(*upper)) ||
       (lower && upper && *lower > *upper)) {
-    throw std::invalid_argument("joint '" + name() +
-                                "': limits must be finite with lower <= upper");
+    throw ArgumentError("joint '" + name() + "': limits must be finite with lower <= upper");
   }
   spec_.lower = lower;
   spec_.upper = upper;

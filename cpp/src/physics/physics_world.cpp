@@ -6,6 +6,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "ambfplus/errors.h"
 #include "ambfplus/scene/constraint_actuator.h"
 #include "ambfplus/scene/joint.h"
 #include "ambfplus/scene/proximity_sensor.h"
@@ -233,7 +234,7 @@ void PhysicsWorld::detach_all() {
 }
 
 void PhysicsWorld::set_gravity(const Eigen::Vector3d& g) {
-  if (!g.allFinite()) throw std::invalid_argument("gravity must be finite");
+  if (!g.allFinite()) throw ArgumentError("gravity must be finite");
   world_->setGravity(to_bullet(g));
   world_->getWorldInfo().m_gravity = to_bullet(g);
 }
@@ -271,9 +272,9 @@ void PhysicsWorld::add(RigidBody& rb) {
                      (rb.collision().shapes.size() == 1 &&
                       rb.collision().shapes.front().first.kind == Shape::Kind::kPlane);
   if (plane && rb.is_dynamic()) {
-    throw std::invalid_argument("body '" + rb.name() +
-                                "': a plane is infinite, so it must be static (mass 0) or "
-                                "kinematic");
+    throw ArgumentError("body '" + rb.name() +
+                        "': a plane is infinite, so it must be static (mass 0) or "
+                        "kinematic");
   }
   auto b = std::make_unique<Body>();
   // The collision mesh of a mesh shape: a separate file, or the visual triangles.
@@ -310,7 +311,7 @@ void PhysicsWorld::add(RigidBody& rb) {
   if (d.mass > 0) {
     if (d.inertia) {
       if (!(d.inertia->array() >= 0).all() || !d.inertia->allFinite()) {
-        throw std::invalid_argument("body '" + rb.name() + "': inertia must be >= 0");
+        throw ArgumentError("body '" + rb.name() + "': inertia must be >= 0");
       }
       inertia = to_bullet(*d.inertia);
     } else {

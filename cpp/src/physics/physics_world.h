@@ -104,7 +104,7 @@ class PhysicsWorld : public Physics {
   /// Takes every body and constraint out of Bullet (before the scene objects go away).
   void detach_all() override;
 
-  /// Builds the body's Bullet side and adds it. Throws std::invalid_argument for geometry Bullet
+  /// Builds the body's Bullet side and adds it. Throws ArgumentError for geometry Bullet
   /// cannot simulate (a dynamic plane).
   void add(RigidBody& body);
   void add(Joint& joint);

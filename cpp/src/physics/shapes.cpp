@@ -4,6 +4,7 @@
 #include <BulletCollision/Gimpact/btGImpactShape.h>
 #include <stdexcept>
 
+#include "ambfplus/errors.h"
 #include "ambfplus/scene/rigid_body.h"
 
 namespace ambfplus {
@@ -37,7 +38,7 @@ std::unique_ptr<btCollisionShape> primitive(const Shape& s, const std::string& b
     case Shape::Kind::kMesh:
       break;
   }
-  throw std::invalid_argument("body '" + body + "': a mesh cannot be a compound's part");
+  throw ArgumentError("body '" + body + "': a mesh cannot be a compound's part");
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <unordered_set>
 
+#include "ambfplus/errors.h"
 #include "ambfplus/scene/soft_body.h"
 #include "physics/physics_world.h"
 
@@ -243,7 +244,7 @@ std::vector<double> SoftBody::node_velocities() const {
 void SoftBody::set_node_position(int node, const Eigen::Vector3d& position) {
   check_node(node);
   if (!position.allFinite()) {
-    throw std::invalid_argument("soft body '" + name() + "': node positions must be finite");
+    throw ArgumentError("soft body '" + name() + "': node positions must be finite");
   }
   btSoftBody& b = *physics::soft_of(*this)->body;
   btSoftBody::Node& n = b.m_nodes[node];

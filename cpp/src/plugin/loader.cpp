@@ -14,6 +14,7 @@
 #include "ambfplus/errors.h"
 #include "ambfplus/log.h"
 #include "ambfplus/version.h"
+#include "plugin/native_plugin.h"
 
 namespace ambfplus {
 namespace {
@@ -62,9 +63,22 @@ std::string loaded_path(void* handle, const std::string& fallback) {
   return fallback;
 }
 
-// A plugin from an open library; the library stays open while the plugin lives.
-std::shared_ptr<Plugin> from_library(void* handle, const std::string& file,
-                                     const std::string& name) {
+// Whether a symbol dlsym found is a function (a data symbol of that name would crash when
+// called).
+bool is_function(void* symbol) {
+  Dl_info info{};
+  ElfW(Sym)* entry = nullptr;
+  if (dladdr1(symbol, &info, reinterpret_cast<void**>(&entry), RTLD_DL_SYMENT) == 0 ||
+      entry == nullptr) {
+    return false;
+  }
+  const int type = ELF64_ST_TYPE(entry->st_info);
+  return type == STT_FUNC || type == STT_GNU_IFUNC;
+}
+
+// A plugin from an open library at site; the library stays open while the plugin lives.
+std::shared_ptr<PluginInstance> from_library(void* handle, const std::string& file,
+                                             const std::string& name, const PluginSite& site) {
   std::shared_ptr<void> library(handle, [](void* h) { dlclose(h); });
   const std::string what = "plugin '" + name + "' (" + file + ")";
   dlerror();
@@ -76,38 +90,23 @@ std::shared_ptr<Plugin> from_library(void* handle, const std::string& file,
                       "ambfplus/plugin/plugin.h): " +
                       dl_error());
   }
+  if (!is_function(symbol)) {
+    throw PluginError(what + ": " AMBFPLUS_PLUGIN_ENTRY_SYMBOL
+                             " is not a function (export it with AMBFPLUS_PLUGIN(YourClass))");
+  }
   const AmbfplusPluginEntry* entry = reinterpret_cast<AmbfplusPluginEntryFunction>(symbol)();
-  if (entry == nullptr) throw PluginError(what + ": its entry point returned null");
-  if (entry->abi_version != kPluginAbiVersion) {
-    throw PluginError(what + ": built for plugin ABI version " +
-                      std::to_string(entry->abi_version) + ", but this ambfplus (" + version() +
-                      ") has plugin ABI version " + std::to_string(kPluginAbiVersion) +
-                      "; rebuild the plugin against it");
-  }
-  if (entry->create == nullptr || entry->destroy == nullptr) {
-    throw PluginError(what + ": its entry point has no create or destroy function");
-  }
-  Plugin* plugin = nullptr;
-  try {
-    plugin = entry->create();
-  } catch (const std::exception& e) {
-    throw PluginError(what + ": creating " + entry->type_name + " failed: " + e.what());
-  } catch (...) {
-    throw PluginError(what + ": creating " + entry->type_name + " failed");
-  }
-  if (plugin == nullptr) throw PluginError(what + ": create() returned null");
-  // The deleter holds the library: it is closed only after the plugin is destroyed.
-  auto destroy = entry->destroy;
-  return std::shared_ptr<Plugin>(plugin, [destroy, library](Plugin* p) { destroy(p); });
+  plugin::check_entry(entry, what);
+  return std::make_shared<plugin::NativePlugin>(std::move(library), *entry, site, name, file);
 }
 
-std::shared_ptr<Plugin> open_library(const std::string& file, const std::string& name) {
+std::shared_ptr<PluginInstance> open_library(const std::string& file, const std::string& name,
+                                             const PluginSite& site) {
   dlerror();
   void* handle = dlopen(file.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (handle == nullptr) {
     throw PluginError("plugin '" + name + "': cannot load " + file + ": " + dl_error());
   }
-  return from_library(handle, file, name);
+  return from_library(handle, file, name, site);
 }
 
 }  // namespace
@@ -168,8 +167,8 @@ std::vector<std::string> plugin_search_path() {
 
 namespace plugin {
 
-std::shared_ptr<Plugin> make(const PluginSpec& spec, const std::string& name, std::string& file,
-                             bool& native) {
+std::shared_ptr<PluginInstance> make(const PluginSpec& spec, const std::string& name,
+                                     const PluginSite& site, std::string& file, bool& native) {
   if (spec.filename.empty()) throw PluginError("plugin '" + name + "': no filename given");
   // An AMBF plugin ambfplus re-implements is replaced by its own (AMBF's cannot load here).
   const auto aliases = plugin_aliases();
@@ -204,7 +203,7 @@ std::shared_ptr<Plugin> make(const PluginSpec& spec, const std::string& name, st
   native = language == nullptr;
   auto load_file = [&](const fs::path& p) {
     file = fs::absolute(p, ec).lexically_normal().string();
-    return language != nullptr ? language->from_file(file) : open_library(file, name);
+    return language != nullptr ? language->from_file(file) : open_library(file, name, site);
   };
 
   if (f.find('/') != std::string::npos) {
@@ -228,7 +227,7 @@ std::shared_ptr<Plugin> make(const PluginSpec& spec, const std::string& name, st
       if (bare) {
         for (const PluginLanguage& l : others) {
           if (!l.from_name) continue;
-          if (std::shared_ptr<Plugin> p = l.from_name(f)) {
+          if (std::shared_ptr<PluginInstance> p = l.from_name(f)) {
             file = l.name + " entry point '" + f + "'";
             native = false;
             return p;
@@ -241,7 +240,7 @@ std::shared_ptr<Plugin> make(const PluginSpec& spec, const std::string& name, st
         dlerror();
         if (void* handle = dlopen(n.c_str(), RTLD_NOW | RTLD_LOCAL)) {
           file = loaded_path(handle, n);
-          return from_library(handle, file, name);
+          return from_library(handle, file, name, site);
         }
         tried.push_back("dlopen(\"" + n + "\"): " + dl_error());
       }

@@ -12,7 +12,7 @@
 namespace ambfplus {
 
 struct PluginRegistry::Entry {
-  std::shared_ptr<Plugin> plugin;
+  std::shared_ptr<PluginInstance> plugin;
   bool enabled = true;   // false once a hook threw
   bool attached = true;  // false once closed
   bool native = true;    // C++ (not another language's adapter)
@@ -20,7 +20,7 @@ struct PluginRegistry::Entry {
 
 namespace {
 
-std::string describe(const Plugin& p) {
+std::string describe(const PluginInstance& p) {
   std::string where = plugin_scope_name(p.scope());
   if (p.object() != nullptr) {
     where += " '" + p.object()->name() + "'";
@@ -63,34 +63,40 @@ PluginSite PluginSite::of(Object& object) {
           &object};
 }
 
-Plugin::~Plugin() = default;
+PluginInstance::~PluginInstance() = default;
 
 PluginRegistry::PluginRegistry(World& world) : world_(&world) {}
 
 PluginRegistry::~PluginRegistry() = default;
 
-Plugin* PluginRegistry::load(const PluginSpec& spec, const PluginSite& site) {
+void PluginRegistry::check_site(const std::string& name, const PluginSite& site) const {
+  const bool complete = site.simulator != nullptr && site.world == world_ &&
+                        (site.scope < PluginScope::kModel || site.model != nullptr) &&
+                        (site.scope != PluginScope::kObject || site.object != nullptr);
+  if (!complete) {
+    throw ArgumentError("plugin '" + name + "': its site is not in this world or lacks its " +
+                        std::string(plugin_scope_name(site.scope)));
+  }
+}
+
+PluginInstance* PluginRegistry::load(const PluginSpec& spec, const PluginSite& site) {
   if (site.world != world_) {
-    throw std::invalid_argument("a plugin can only be attached to this world or what it holds");
+    throw ArgumentError("a plugin can only be attached to this world or what it holds");
   }
   const std::string name =
       spec.name.empty() ? std::filesystem::path(spec.filename).stem().string() : spec.name;
   std::string file;
   bool native = true;
-  std::shared_ptr<Plugin> plugin = plugin::make(spec, name, file, native);
+  check_site(name, site);
+  std::shared_ptr<PluginInstance> plugin = plugin::make(spec, name, site, file, native);
   return attach(std::move(plugin), name, file, site, native);
 }
 
-Plugin* PluginRegistry::attach(std::shared_ptr<Plugin> plugin, const std::string& name,
-                               const std::string& file, const PluginSite& site, bool native) {
-  if (!plugin) throw std::invalid_argument("no plugin to attach");
-  const bool complete = site.simulator != nullptr && site.world == world_ &&
-                        (site.scope < PluginScope::kModel || site.model != nullptr) &&
-                        (site.scope != PluginScope::kObject || site.object != nullptr);
-  if (!complete) {
-    throw std::invalid_argument("plugin '" + name + "': its site is not in this world or lacks " +
-                                "its " + plugin_scope_name(site.scope));
-  }
+PluginInstance* PluginRegistry::attach(std::shared_ptr<PluginInstance> plugin,
+                                       const std::string& name, const std::string& file,
+                                       const PluginSite& site, bool native) {
+  if (!plugin) throw ArgumentError("no plugin to attach");
+  check_site(name, site);
   plugin->site_ = site;
   plugin->name_ = name;
   plugin->file_ = file;
@@ -114,15 +120,15 @@ Plugin* PluginRegistry::attach(std::shared_ptr<Plugin> plugin, const std::string
   return entry->plugin.get();
 }
 
-std::vector<Plugin*> PluginRegistry::plugins() const {
-  std::vector<Plugin*> out;
+std::vector<PluginInstance*> PluginRegistry::plugins() const {
+  std::vector<PluginInstance*> out;
   for (const auto& scope : entries_) {
     for (const auto& e : scope) out.push_back(e->plugin.get());
   }
   return out;
 }
 
-bool PluginRegistry::enabled(const Plugin& plugin) const {
+bool PluginRegistry::enabled(const PluginInstance& plugin) const {
   for (const auto& scope : entries_) {
     for (const auto& e : scope) {
       if (e->plugin.get() == &plugin) return e->enabled;
@@ -149,7 +155,7 @@ void PluginRegistry::each(const char* hook, const Call& call, const Model* model
   for (const auto& scope : entries_) snapshot.insert(snapshot.end(), scope.begin(), scope.end());
   for (const auto& e : snapshot) {
     if (!e->enabled || !e->attached || (which && !which(*e))) continue;
-    Plugin& p = *e->plugin;
+    PluginInstance& p = *e->plugin;
     if (model_scope_of != nullptr &&
         (p.scope() == PluginScope::kObject ||
          (p.scope() == PluginScope::kModel && p.model() != model_scope_of))) {
@@ -172,52 +178,53 @@ void PluginRegistry::each(const char* hook, const Call& call, const Model* model
 
 void PluginRegistry::physics_update(double dt, bool native_only) {
   if (!native_only) {
-    each("physics_update", [dt](Plugin& p) { p.physics_update(dt); });
+    each("physics_update", [dt](PluginInstance& p) { p.physics_update(dt); });
     return;
   }
   each(
-      "physics_update", [dt](Plugin& p) { p.physics_update(dt); }, nullptr,
+      "physics_update", [dt](PluginInstance& p) { p.physics_update(dt); }, nullptr,
       [](const Entry& e) { return e.native; });
 }
 
 void PluginRegistry::foreign_physics_update(double dt) {
   each(
-      "physics_update", [dt](Plugin& p) { p.physics_update(dt); }, nullptr,
+      "physics_update", [dt](PluginInstance& p) { p.physics_update(dt); }, nullptr,
       [](const Entry& e) { return !e.native; });
 }
 
 void PluginRegistry::graphics_update() {
-  each("graphics_update", [](Plugin& p) { p.graphics_update(); });
+  each("graphics_update", [](PluginInstance& p) { p.graphics_update(); });
 }
 
 void PluginRegistry::keyboard(int key, int scancode, int action, int mods) {
-  each("keyboard", [&](Plugin& p) { p.keyboard(key, scancode, action, mods); });
+  each("keyboard", [&](PluginInstance& p) { p.keyboard(key, scancode, action, mods); });
 }
 
 void PluginRegistry::mouse_button(int button, int action, int mods) {
-  each("mouse_button", [&](Plugin& p) { p.mouse_button(button, action, mods); });
+  each("mouse_button", [&](PluginInstance& p) { p.mouse_button(button, action, mods); });
 }
 
 void PluginRegistry::mouse_move(double x, double y) {
-  each("mouse_move", [&](Plugin& p) { p.mouse_move(x, y); });
+  each("mouse_move", [&](PluginInstance& p) { p.mouse_move(x, y); });
 }
 
 void PluginRegistry::mouse_scroll(double dx, double dy) {
-  each("mouse_scroll", [&](Plugin& p) { p.mouse_scroll(dx, dy); });
+  each("mouse_scroll", [&](PluginInstance& p) { p.mouse_scroll(dx, dy); });
 }
 
 void PluginRegistry::reset() {
-  each("reset", [](Plugin& p) { p.reset(); });
+  each("reset", [](PluginInstance& p) { p.reset(); });
 }
 
 void PluginRegistry::object_added(Object& object) {
   each(
-      "on_object_added", [&](Plugin& p) { p.on_object_added(object); }, &object.model());
+      "on_object_added", [&](PluginInstance& p) { p.on_object_added(object); }, &object.model());
 }
 
 void PluginRegistry::object_removed(Object& object) {
   each(
-      "on_object_removed", [&](Plugin& p) { p.on_object_removed(object); }, &object.model());
+      "on_object_removed", [&](PluginInstance& p) { p.on_object_removed(object); },
+      &object.model());
 }
 
 void PluginRegistry::close_where(const std::function<bool(const Entry&)>& which) {

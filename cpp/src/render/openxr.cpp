@@ -144,6 +144,203 @@ struct OpenXrSession::State {
     throw RenderError(who + ": " + call + " failed: " + result_name(r));
   }
 
+  // Opens the OpenXR loader and its entry point.
+  void open_loader() {
+    for (const char* name : {"libopenxr_loader.so.1", "libopenxr_loader.so"}) {
+      loader = dlopen(name, RTLD_NOW | RTLD_LOCAL);
+      if (loader != nullptr) break;
+    }
+    if (loader == nullptr) {
+      throw RenderError(
+          "OpenXR: no loader (libopenxr_loader.so.1 cannot be opened); on Debian: apt-get install "
+          "libopenxr-loader1, and a runtime such as Monado");
+    }
+    get_proc = reinterpret_cast<PFN_xrGetInstanceProcAddr>(dlsym(loader, "xrGetInstanceProcAddr"));
+    if (get_proc == nullptr) throw RenderError("OpenXR: the loader has no xrGetInstanceProcAddr");
+  }
+
+  // Makes the instance with the extensions that hand the runtime an EGL context (the engine's is
+  // EGL, with or without a window); throws when the runtime lacks them.
+  void create_instance(const std::string& application) {
+    static const char* const wanted[] = {XR_KHR_OPENGL_ENABLE_EXTENSION_NAME,
+                                         XR_MNDX_EGL_ENABLE_EXTENSION_NAME};
+    const auto extensions = enumerate<XrExtensionProperties>(
+        "xrEnumerateInstanceExtensionProperties",
+        [&](auto... a) {
+          return function<PFN_xrEnumerateInstanceExtensionProperties>(
+              "xrEnumerateInstanceExtensionProperties")(nullptr, a...);
+        },
+        XrExtensionProperties{XR_TYPE_EXTENSION_PROPERTIES});
+    for (const char* name : wanted) {
+      bool found = false;
+      for (const XrExtensionProperties& e : extensions)
+        found |= std::strcmp(e.extensionName, name) == 0;
+      if (!found) {
+        throw RenderError(std::string("OpenXR: the runtime does not offer ") + name +
+                          " (ambfplus gives runtimes its EGL context; Monado does)");
+      }
+    }
+    XrInstanceCreateInfo create{XR_TYPE_INSTANCE_CREATE_INFO};
+    std::strncpy(create.applicationInfo.applicationName, application.c_str(),
+                 XR_MAX_APPLICATION_NAME_SIZE - 1);
+    std::strncpy(create.applicationInfo.engineName, "ambfplus", XR_MAX_ENGINE_NAME_SIZE - 1);
+    create.applicationInfo.apiVersion = XR_MAKE_VERSION(1, 0, 0);
+    create.enabledExtensionCount = 2;
+    create.enabledExtensionNames = wanted;
+    check(function<PFN_xrCreateInstance>("xrCreateInstance")(&create, &instance),
+          "xrCreateInstance");
+  }
+
+  // An OpenXR two-call enumeration: `call(capacity, &count, items)` asked for the count, then
+  // for the items (each initialised to `blank`).
+  template <typename T, typename Call>
+  std::vector<T> enumerate(const char* what, Call call, T blank = T{}) const {
+    uint32_t count = 0;
+    check(call(0u, &count, static_cast<T*>(nullptr)), what);
+    std::vector<T> items(count, blank);
+    check(call(count, &count, items.data()), what);
+    items.resize(count);
+    return items;
+  }
+
+  // Names the runtime and finds its head-mounted display.
+  void find_system() {
+    XrInstanceProperties properties{XR_TYPE_INSTANCE_PROPERTIES};
+    check(function<PFN_xrGetInstanceProperties>("xrGetInstanceProperties")(instance, &properties),
+          "xrGetInstanceProperties");
+    runtime = std::string(properties.runtimeName) + " " +
+              std::to_string(XR_VERSION_MAJOR(properties.runtimeVersion)) + "." +
+              std::to_string(XR_VERSION_MINOR(properties.runtimeVersion)) + "." +
+              std::to_string(XR_VERSION_PATCH(properties.runtimeVersion));
+    XrSystemGetInfo get{XR_TYPE_SYSTEM_GET_INFO};
+    get.formFactor = XR_FORM_FACTOR_HEAD_MOUNTED_DISPLAY;
+    check(function<PFN_xrGetSystem>("xrGetSystem")(instance, &get, &system_id),
+          "xrGetSystem (a head-mounted display)");
+    XrSystemProperties system_properties{XR_TYPE_SYSTEM_PROPERTIES};
+    check(function<PFN_xrGetSystemProperties>("xrGetSystemProperties")(instance, system_id,
+                                                                       &system_properties),
+          "xrGetSystemProperties");
+    system = system_properties.systemName;
+  }
+
+  // The display's two views (their recommended image sizes), and its first blend mode.
+  std::vector<XrViewConfigurationView> stereo_views() {
+    const XrViewConfigurationType stereo = XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO;
+    auto views_of =
+        function<PFN_xrEnumerateViewConfigurationViews>("xrEnumerateViewConfigurationViews");
+    auto configs = enumerate<XrViewConfigurationView>(
+        "xrEnumerateViewConfigurationViews (stereo)",
+        [&](auto... a) { return views_of(instance, system_id, stereo, a...); },
+        XrViewConfigurationView{XR_TYPE_VIEW_CONFIGURATION_VIEW});
+    if (configs.size() != 2) {
+      throw RenderError("OpenXR (" + runtime + "): the stereo view configuration has " +
+                        std::to_string(configs.size()) + " views, expected 2");
+    }
+    auto blends_of =
+        function<PFN_xrEnumerateEnvironmentBlendModes>("xrEnumerateEnvironmentBlendModes");
+    const auto modes = enumerate<XrEnvironmentBlendMode>(
+        "xrEnumerateEnvironmentBlendModes",
+        [&](auto... a) { return blends_of(instance, system_id, stereo, a...); });
+    if (!modes.empty()) blend = modes.front();
+    return configs;
+  }
+
+  // A session on the engine's EGL context (current in the caller's scope), after the runtime's
+  // OpenGL requirements were asked for and met, and its local reference space.
+  void create_session() {
+    XrGraphicsRequirementsOpenGLKHR requirements{XR_TYPE_GRAPHICS_REQUIREMENTS_OPENGL_KHR};
+    check(function<PFN_xrGetOpenGLGraphicsRequirementsKHR>("xrGetOpenGLGraphicsRequirementsKHR")(
+              instance, system_id, &requirements),
+          "xrGetOpenGLGraphicsRequirementsKHR");
+    render::Context& context = render::Context::get();
+    const int gl = epoxy_gl_version();  // e.g. 45
+    if (XR_MAKE_VERSION(gl / 10, gl % 10, 0) < requirements.minApiVersionSupported) {
+      throw RenderError("OpenXR (" + runtime + "): the runtime needs OpenGL " +
+                        std::to_string(XR_VERSION_MAJOR(requirements.minApiVersionSupported)) +
+                        "." +
+                        std::to_string(XR_VERSION_MINOR(requirements.minApiVersionSupported)) +
+                        ", the engine's context is " + context.info().version);
+    }
+    XrGraphicsBindingEGLMNDX binding{XR_TYPE_GRAPHICS_BINDING_EGL_MNDX};
+    binding.getProcAddress = eglGetProcAddress;
+    binding.display = context.display();
+    binding.config = context.config();
+    binding.context = context.context();
+    XrSessionCreateInfo create{XR_TYPE_SESSION_CREATE_INFO};
+    create.next = &binding;
+    create.systemId = system_id;
+    check(function<PFN_xrCreateSession>("xrCreateSession")(instance, &create, &session),
+          "xrCreateSession");
+
+    XrReferenceSpaceCreateInfo local{XR_TYPE_REFERENCE_SPACE_CREATE_INFO};
+    local.referenceSpaceType = XR_REFERENCE_SPACE_TYPE_LOCAL;
+    local.poseInReferenceSpace.orientation.w = 1;
+    check(function<PFN_xrCreateReferenceSpace>("xrCreateReferenceSpace")(session, &local, &space),
+          "xrCreateReferenceSpace (local)");
+  }
+
+  // The swapchain format: the engine's colours are sRGB-encoded bytes, so an sRGB image says
+  // so; plain RGBA8 else.
+  std::int64_t swapchain_format() {
+    auto formats_of = function<PFN_xrEnumerateSwapchainFormats>("xrEnumerateSwapchainFormats");
+    const auto formats = enumerate<std::int64_t>(
+        "xrEnumerateSwapchainFormats", [&](auto... a) { return formats_of(session, a...); });
+    for (std::int64_t wanted : {kSrgb8Alpha8, kRgba8}) {
+      for (std::int64_t f : formats) {
+        if (f == wanted) return f;
+      }
+    }
+    throw RenderError("OpenXR (" + runtime +
+                      "): the runtime offers neither GL_SRGB8_ALPHA8 nor GL_RGBA8 swapchains");
+  }
+
+  // One swapchain per view at its recommended size, its images, and the framebuffer that draws
+  // into them.
+  void create_swapchains(const std::vector<XrViewConfigurationView>& configs, std::int64_t format) {
+    auto images_of = function<PFN_xrEnumerateSwapchainImages>("xrEnumerateSwapchainImages");
+    for (const XrViewConfigurationView& config : configs) {
+      Eye eye;
+      eye.width = static_cast<int>(config.recommendedImageRectWidth);
+      eye.height = static_cast<int>(config.recommendedImageRectHeight);
+      XrSwapchainCreateInfo info{XR_TYPE_SWAPCHAIN_CREATE_INFO};
+      info.usageFlags =
+          XR_SWAPCHAIN_USAGE_COLOR_ATTACHMENT_BIT | XR_SWAPCHAIN_USAGE_TRANSFER_DST_BIT;
+      info.format = format;
+      info.sampleCount = 1;
+      info.width = config.recommendedImageRectWidth;
+      info.height = config.recommendedImageRectHeight;
+      info.faceCount = 1;
+      info.arraySize = 1;
+      info.mipCount = 1;
+      check(function<PFN_xrCreateSwapchain>("xrCreateSwapchain")(session, &info, &eye.swapchain),
+            "xrCreateSwapchain");
+      eyes.push_back(eye);  // destroyed with the session from here on
+      const auto images = enumerate<XrSwapchainImageOpenGLKHR>(
+          "xrEnumerateSwapchainImages",
+          [&](uint32_t capacity, uint32_t* count, XrSwapchainImageOpenGLKHR* items) {
+            return images_of(eyes.back().swapchain, capacity, count,
+                             reinterpret_cast<XrSwapchainImageBaseHeader*>(items));
+          },
+          XrSwapchainImageOpenGLKHR{XR_TYPE_SWAPCHAIN_IMAGE_OPENGL_KHR});
+      for (const XrSwapchainImageOpenGLKHR& image : images)
+        eyes.back().images.push_back(image.image);
+    }
+    glGenFramebuffers(1, &framebuffer);
+    render::check_gl("making the OpenXR eyes' framebuffer");
+  }
+
+  // The calls every frame makes.
+  void look_up_frame_functions() {
+    poll_event = function<PFN_xrPollEvent>("xrPollEvent");
+    wait_frame = function<PFN_xrWaitFrame>("xrWaitFrame");
+    begin_frame = function<PFN_xrBeginFrame>("xrBeginFrame");
+    locate_views = function<PFN_xrLocateViews>("xrLocateViews");
+    acquire_image = function<PFN_xrAcquireSwapchainImage>("xrAcquireSwapchainImage");
+    wait_image = function<PFN_xrWaitSwapchainImage>("xrWaitSwapchainImage");
+    release_image = function<PFN_xrReleaseSwapchainImage>("xrReleaseSwapchainImage");
+    end_frame = function<PFN_xrEndFrame>("xrEndFrame");
+  }
+
   void destroy() {
     if (instance == XR_NULL_HANDLE) return;
     {
@@ -164,176 +361,15 @@ struct OpenXrSession::State {
 
 OpenXrSession::OpenXrSession(const std::string& application) : state_(std::make_unique<State>()) {
   State& s = *state_;
-  for (const char* name : {"libopenxr_loader.so.1", "libopenxr_loader.so"}) {
-    s.loader = dlopen(name, RTLD_NOW | RTLD_LOCAL);
-    if (s.loader != nullptr) break;
-  }
-  if (s.loader == nullptr) {
-    throw RenderError(
-        "OpenXR: no loader (libopenxr_loader.so.1 cannot be opened); on Debian: apt-get install "
-        "libopenxr-loader1, and a runtime such as Monado");
-  }
-  s.get_proc =
-      reinterpret_cast<PFN_xrGetInstanceProcAddr>(dlsym(s.loader, "xrGetInstanceProcAddr"));
-  if (s.get_proc == nullptr) throw RenderError("OpenXR: the loader has no xrGetInstanceProcAddr");
-
-  // The runtime must take an EGL context (the engine's is EGL, with or without a window).
-  auto enumerate_extensions = s.function<PFN_xrEnumerateInstanceExtensionProperties>(
-      "xrEnumerateInstanceExtensionProperties");
-  uint32_t count = 0;
-  s.check(enumerate_extensions(nullptr, 0, &count, nullptr),
-          "xrEnumerateInstanceExtensionProperties");
-  std::vector<XrExtensionProperties> extensions(count, {XR_TYPE_EXTENSION_PROPERTIES});
-  s.check(enumerate_extensions(nullptr, count, &count, extensions.data()),
-          "xrEnumerateInstanceExtensionProperties");
-  const char* wanted[] = {XR_KHR_OPENGL_ENABLE_EXTENSION_NAME, XR_MNDX_EGL_ENABLE_EXTENSION_NAME};
-  for (const char* name : wanted) {
-    bool found = false;
-    for (const XrExtensionProperties& e : extensions)
-      found |= std::strcmp(e.extensionName, name) == 0;
-    if (!found) {
-      throw RenderError(std::string("OpenXR: the runtime does not offer ") + name +
-                        " (ambfplus gives runtimes its EGL context; Monado does)");
-    }
-  }
-
-  XrInstanceCreateInfo create{XR_TYPE_INSTANCE_CREATE_INFO};
-  std::strncpy(create.applicationInfo.applicationName, application.c_str(),
-               XR_MAX_APPLICATION_NAME_SIZE - 1);
-  std::strncpy(create.applicationInfo.engineName, "ambfplus", XR_MAX_ENGINE_NAME_SIZE - 1);
-  create.applicationInfo.apiVersion = XR_MAKE_VERSION(1, 0, 0);
-  create.enabledExtensionCount = 2;
-  create.enabledExtensionNames = wanted;
-  s.check(s.function<PFN_xrCreateInstance>("xrCreateInstance")(&create, &s.instance),
-          "xrCreateInstance");
+  s.open_loader();
+  s.create_instance(application);
   try {
-    XrInstanceProperties properties{XR_TYPE_INSTANCE_PROPERTIES};
-    s.check(
-        s.function<PFN_xrGetInstanceProperties>("xrGetInstanceProperties")(s.instance, &properties),
-        "xrGetInstanceProperties");
-    s.runtime = std::string(properties.runtimeName) + " " +
-                std::to_string(XR_VERSION_MAJOR(properties.runtimeVersion)) + "." +
-                std::to_string(XR_VERSION_MINOR(properties.runtimeVersion)) + "." +
-                std::to_string(XR_VERSION_PATCH(properties.runtimeVersion));
-
-    XrSystemGetInfo system{XR_TYPE_SYSTEM_GET_INFO};
-    system.formFactor = XR_FORM_FACTOR_HEAD_MOUNTED_DISPLAY;
-    s.check(s.function<PFN_xrGetSystem>("xrGetSystem")(s.instance, &system, &s.system_id),
-            "xrGetSystem (a head-mounted display)");
-    XrSystemProperties system_properties{XR_TYPE_SYSTEM_PROPERTIES};
-    s.check(s.function<PFN_xrGetSystemProperties>("xrGetSystemProperties")(s.instance, s.system_id,
-                                                                           &system_properties),
-            "xrGetSystemProperties");
-    s.system = system_properties.systemName;
-
-    auto views =
-        s.function<PFN_xrEnumerateViewConfigurationViews>("xrEnumerateViewConfigurationViews");
-    const XrViewConfigurationType stereo = XR_VIEW_CONFIGURATION_TYPE_PRIMARY_STEREO;
-    s.check(views(s.instance, s.system_id, stereo, 0, &count, nullptr),
-            "xrEnumerateViewConfigurationViews (stereo)");
-    std::vector<XrViewConfigurationView> configs(count, {XR_TYPE_VIEW_CONFIGURATION_VIEW});
-    s.check(views(s.instance, s.system_id, stereo, count, &count, configs.data()),
-            "xrEnumerateViewConfigurationViews (stereo)");
-    if (configs.size() != 2) {
-      throw RenderError("OpenXR (" + s.runtime + "): the stereo view configuration has " +
-                        std::to_string(configs.size()) + " views, expected 2");
-    }
-
-    auto blends =
-        s.function<PFN_xrEnumerateEnvironmentBlendModes>("xrEnumerateEnvironmentBlendModes");
-    s.check(blends(s.instance, s.system_id, stereo, 0, &count, nullptr),
-            "xrEnumerateEnvironmentBlendModes");
-    std::vector<XrEnvironmentBlendMode> modes(count);
-    s.check(blends(s.instance, s.system_id, stereo, count, &count, modes.data()),
-            "xrEnumerateEnvironmentBlendModes");
-    if (!modes.empty()) s.blend = modes.front();
-
-    // The runtime must be asked for its OpenGL requirements before a session is made.
-    XrGraphicsRequirementsOpenGLKHR requirements{XR_TYPE_GRAPHICS_REQUIREMENTS_OPENGL_KHR};
-    s.check(s.function<PFN_xrGetOpenGLGraphicsRequirementsKHR>(
-                "xrGetOpenGLGraphicsRequirementsKHR")(s.instance, s.system_id, &requirements),
-            "xrGetOpenGLGraphicsRequirementsKHR");
-    render::Context& context = render::Context::get();
+    s.find_system();
+    const std::vector<XrViewConfigurationView> views = s.stereo_views();
     render::Context::Scope scope;
-    const int gl = epoxy_gl_version();  // e.g. 45
-    if (XR_MAKE_VERSION(gl / 10, gl % 10, 0) < requirements.minApiVersionSupported) {
-      throw RenderError("OpenXR (" + s.runtime + "): the runtime needs OpenGL " +
-                        std::to_string(XR_VERSION_MAJOR(requirements.minApiVersionSupported)) +
-                        "." +
-                        std::to_string(XR_VERSION_MINOR(requirements.minApiVersionSupported)) +
-                        ", the engine's context is " + context.info().version);
-    }
-    XrGraphicsBindingEGLMNDX binding{XR_TYPE_GRAPHICS_BINDING_EGL_MNDX};
-    binding.getProcAddress = eglGetProcAddress;
-    binding.display = context.display();
-    binding.config = context.config();
-    binding.context = context.context();
-    XrSessionCreateInfo session{XR_TYPE_SESSION_CREATE_INFO};
-    session.next = &binding;
-    session.systemId = s.system_id;
-    s.check(s.function<PFN_xrCreateSession>("xrCreateSession")(s.instance, &session, &s.session),
-            "xrCreateSession");
-
-    XrReferenceSpaceCreateInfo space{XR_TYPE_REFERENCE_SPACE_CREATE_INFO};
-    space.referenceSpaceType = XR_REFERENCE_SPACE_TYPE_LOCAL;
-    space.poseInReferenceSpace.orientation.w = 1;
-    s.check(s.function<PFN_xrCreateReferenceSpace>("xrCreateReferenceSpace")(s.session, &space,
-                                                                             &s.space),
-            "xrCreateReferenceSpace (local)");
-
-    auto formats_of = s.function<PFN_xrEnumerateSwapchainFormats>("xrEnumerateSwapchainFormats");
-    s.check(formats_of(s.session, 0, &count, nullptr), "xrEnumerateSwapchainFormats");
-    std::vector<std::int64_t> formats(count);
-    s.check(formats_of(s.session, count, &count, formats.data()), "xrEnumerateSwapchainFormats");
-    // The engine's colours are sRGB-encoded bytes: an sRGB image says so; plain RGBA8 else.
-    std::int64_t format = 0;
-    for (std::int64_t wanted_format : {kSrgb8Alpha8, kRgba8}) {
-      for (std::int64_t f : formats) {
-        if (format == 0 && f == wanted_format) format = f;
-      }
-    }
-    if (format == 0) {
-      throw RenderError("OpenXR (" + s.runtime +
-                        "): the runtime offers neither GL_SRGB8_ALPHA8 nor GL_RGBA8 swapchains");
-    }
-    auto enumerate_images =
-        s.function<PFN_xrEnumerateSwapchainImages>("xrEnumerateSwapchainImages");
-    for (const XrViewConfigurationView& config : configs) {
-      State::Eye eye;
-      eye.width = static_cast<int>(config.recommendedImageRectWidth);
-      eye.height = static_cast<int>(config.recommendedImageRectHeight);
-      XrSwapchainCreateInfo info{XR_TYPE_SWAPCHAIN_CREATE_INFO};
-      info.usageFlags =
-          XR_SWAPCHAIN_USAGE_COLOR_ATTACHMENT_BIT | XR_SWAPCHAIN_USAGE_TRANSFER_DST_BIT;
-      info.format = format;
-      info.sampleCount = 1;
-      info.width = config.recommendedImageRectWidth;
-      info.height = config.recommendedImageRectHeight;
-      info.faceCount = 1;
-      info.arraySize = 1;
-      info.mipCount = 1;
-      s.check(
-          s.function<PFN_xrCreateSwapchain>("xrCreateSwapchain")(s.session, &info, &eye.swapchain),
-          "xrCreateSwapchain");
-      s.eyes.push_back(eye);
-      State::Eye& added = s.eyes.back();
-      s.check(enumerate_images(added.swapchain, 0, &count, nullptr), "xrEnumerateSwapchainImages");
-      std::vector<XrSwapchainImageOpenGLKHR> images(count, {XR_TYPE_SWAPCHAIN_IMAGE_OPENGL_KHR});
-      s.check(enumerate_images(added.swapchain, count, &count,
-                               reinterpret_cast<XrSwapchainImageBaseHeader*>(images.data())),
-              "xrEnumerateSwapchainImages");
-      for (const XrSwapchainImageOpenGLKHR& image : images) added.images.push_back(image.image);
-    }
-    glGenFramebuffers(1, &s.framebuffer);
-    render::check_gl("making the OpenXR eyes' framebuffer");
-    s.poll_event = s.function<PFN_xrPollEvent>("xrPollEvent");
-    s.wait_frame = s.function<PFN_xrWaitFrame>("xrWaitFrame");
-    s.begin_frame = s.function<PFN_xrBeginFrame>("xrBeginFrame");
-    s.locate_views = s.function<PFN_xrLocateViews>("xrLocateViews");
-    s.acquire_image = s.function<PFN_xrAcquireSwapchainImage>("xrAcquireSwapchainImage");
-    s.wait_image = s.function<PFN_xrWaitSwapchainImage>("xrWaitSwapchainImage");
-    s.release_image = s.function<PFN_xrReleaseSwapchainImage>("xrReleaseSwapchainImage");
-    s.end_frame = s.function<PFN_xrEndFrame>("xrEndFrame");
+    s.create_session();
+    s.create_swapchains(views, s.swapchain_format());
+    s.look_up_frame_functions();
   } catch (...) {
     s.destroy();
     throw;
@@ -466,9 +502,9 @@ std::vector<Frame> OpenXrSession::end_frame(const std::vector<const Camera*>& ca
   }
   if (cameras.size() != s.views.size()) {
     finish();
-    throw std::invalid_argument("OpenXR: end_frame needs a camera per eye (" +
-                                std::to_string(s.views.size()) + "), got " +
-                                std::to_string(cameras.size()));
+    throw ArgumentError("OpenXR: end_frame needs a camera per eye (" +
+                        std::to_string(s.views.size()) + "), got " +
+                        std::to_string(cameras.size()));
   }
   frames.resize(cameras.size());
   for (std::size_t i = 0; i < cameras.size(); ++i) {

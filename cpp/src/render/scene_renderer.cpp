@@ -133,8 +133,8 @@ void SceneRenderer::snapshot(const Camera& camera, unsigned passes, const PoseRe
     for (const std::string& name : poses.names) {
       const Object* o = world_.find(name);
       if (o == nullptr) {
-        throw std::invalid_argument("poses: no object named '" + name + "' in world '" +
-                                    world_.name() + "'");
+        throw ArgumentError("poses: no object named '" + name + "' in world '" + world_.name() +
+                            "'");
       }
       posed.push_back(o);
     }

@@ -113,8 +113,8 @@ Window::~Window() {
 std::vector<Frame> Window::present(const std::vector<const Camera*>& cameras, int width, int height,
                                    const std::uint8_t* overlay, bool rendered) {
   if (width <= 0 || height <= 0) {
-    throw std::invalid_argument("a window's size must be positive, got " + std::to_string(width) +
-                                "x" + std::to_string(height));
+    throw ArgumentError("a window's size must be positive, got " + std::to_string(width) + "x" +
+                        std::to_string(height));
   }
   std::vector<Frame> frames(cameras.size());
   std::vector<const render::RenderTarget*> targets;
@@ -127,8 +127,8 @@ std::vector<Frame> Window::present(const std::vector<const Camera*>& cameras, in
     }
     const render::RenderTarget* last = renderer.last_target(*cameras[i]);
     if (last == nullptr) {
-      throw std::invalid_argument("camera '" + cameras[i]->name() +
-                                  "' has not rendered for a display yet (rendered=True)");
+      throw ArgumentError("camera '" + cameras[i]->name() +
+                          "' has not rendered for a display yet (rendered=True)");
     }
     frames[i].camera = cameras[i]->name();
     targets.push_back(last);
@@ -198,7 +198,7 @@ void Window::set_lens(std::optional<LensDistortion> lens) {
                     finite(lens->radius) && finite(lens->aspect) && lens->radius > 0 &&
                     lens->aspect > 0;
     if (!ok) {
-      throw std::invalid_argument(
+      throw ArgumentError(
           "a lens needs finite coefficients and aberrations and a positive radius and aspect");
     }
   }

@@ -1,4 +1,5 @@
 #include "ambfplus/scene/camera.h"
+#include "ambfplus/errors.h"
 
 #include <cmath>
 #include <stdexcept>
@@ -21,16 +22,15 @@ Camera::Camera(Model& model, const CameraSpec& spec, int id)
       publish_(spec.publish) {
   const std::string who = "camera '" + spec.name + "': ";
   if (width_ <= 0 || height_ <= 0 || width_ > 16384 || height_ > 16384) {
-    throw std::invalid_argument(who + "width and height must be in 1..16384, got " +
-                                std::to_string(width_) + "x" + std::to_string(height_));
+    throw ArgumentError(who + "width and height must be in 1..16384, got " +
+                        std::to_string(width_) + "x" + std::to_string(height_));
   }
   if (!(fov_y_ > 0.0 && fov_y_ < M_PI)) {
-    throw std::invalid_argument(who + "fov_y must be in (0, pi) radians, got " +
-                                std::to_string(fov_y_));
+    throw ArgumentError(who + "fov_y must be in (0, pi) radians, got " + std::to_string(fov_y_));
   }
   if (!(near_ > 0.0 && far_ > near_ && std::isfinite(far_))) {
-    throw std::invalid_argument(who + "clipping planes need 0 < near < far, got near " +
-                                std::to_string(near_) + ", far " + std::to_string(far_));
+    throw ArgumentError(who + "clipping planes need 0 < near < far, got near " +
+                        std::to_string(near_) + ", far " + std::to_string(far_));
   }
   set_pose(checked_pose(spec.pose));
 }
@@ -39,14 +39,14 @@ void Camera::look_at(const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
                      const Eigen::Vector3d& up) {
   const Eigen::Vector3d forward = target - eye;
   if (!(forward.norm() > 0.0)) {
-    throw std::invalid_argument("camera '" + name() + "': look_at needs target != eye");
+    throw ArgumentError("camera '" + name() + "': look_at needs target != eye");
   }
   const Eigen::Vector3d z = forward.normalized();
   // OpenCV frame: x right, y down, z forward. Image up (-y) follows `up` projected on the image.
   const Eigen::Vector3d right = z.cross(up);
   if (!(right.norm() > 1e-9 * up.norm()) || !(up.norm() > 0.0)) {
-    throw std::invalid_argument("camera '" + name() +
-                                "': look_at needs an up vector not parallel to the view direction");
+    throw ArgumentError("camera '" + name() +
+                        "': look_at needs an up vector not parallel to the view direction");
   }
   const Eigen::Vector3d x = right.normalized();
   const Eigen::Vector3d y = z.cross(x);
@@ -67,7 +67,7 @@ Eigen::Matrix3d Camera::intrinsics() const {
 
 void Camera::set_principal_point(double cx, double cy) {
   if (!std::isfinite(cx) || !std::isfinite(cy)) {
-    throw std::invalid_argument("camera '" + name() + "': the principal point must be finite");
+    throw ArgumentError("camera '" + name() + "': the principal point must be finite");
   }
   cx_ = cx;
   cy_ = cy;
@@ -75,16 +75,16 @@ void Camera::set_principal_point(double cx, double cy) {
 
 void Camera::set_fov_y(double fov_y) {
   if (!(fov_y > 0.0 && fov_y < M_PI)) {
-    throw std::invalid_argument("camera '" + name() + "': fov_y must be in (0, pi) radians, got " +
-                                std::to_string(fov_y));
+    throw ArgumentError("camera '" + name() + "': fov_y must be in (0, pi) radians, got " +
+                        std::to_string(fov_y));
   }
   fov_y_ = fov_y;
 }
 
 void Camera::set_passes(unsigned passes) {
   if (passes == 0 || (passes & ~kAllPasses) != 0) {
-    throw std::invalid_argument("camera '" + name() + "': passes must be a non-empty set of " +
-                                pass_names(kAllPasses));
+    throw ArgumentError("camera '" + name() + "': passes must be a non-empty set of " +
+                        pass_names(kAllPasses));
   }
   passes_ = passes;
 }

@@ -1,6 +1,7 @@
 // ConstraintActuator's scene side: checking the spec, following the parent.
 
 #include "ambfplus/scene/constraint_actuator.h"
+#include "ambfplus/errors.h"
 
 #include <cmath>
 #include <stdexcept>
@@ -14,23 +15,23 @@ ConstraintActuator::ConstraintActuator(Model& model, const ConstraintActuatorSpe
     : Object(model, spec.name, id), spec_(spec) {
   const std::string& name = spec.name;
   if (spec_.parent == nullptr) {
-    throw std::invalid_argument("actuator '" + name + "' needs a parent body");
+    throw ArgumentError("actuator '" + name + "' needs a parent body");
   }
   if (&spec_.parent->world() != &model.world()) {
-    throw std::invalid_argument("actuator '" + name + "': its parent '" + spec_.parent->name() +
-                                "' is in another world");
+    throw ArgumentError("actuator '" + name + "': its parent '" + spec_.parent->name() +
+                        "' is in another world");
   }
   checked_pose(spec_.location);
   if (!(spec_.max_impulse > 0) || !std::isfinite(spec_.max_impulse)) {
-    throw std::invalid_argument("actuator '" + name + "': max impulse must be > 0 N s, got " +
-                                std::to_string(spec_.max_impulse));
+    throw ArgumentError("actuator '" + name + "': max impulse must be > 0 N s, got " +
+                        std::to_string(spec_.max_impulse));
   }
   if (!(spec_.tau > 0 && spec_.tau <= 1)) {
-    throw std::invalid_argument("actuator '" + name + "': tau must be in (0, 1], got " +
-                                std::to_string(spec_.tau));
+    throw ArgumentError("actuator '" + name + "': tau must be in (0, 1], got " +
+                        std::to_string(spec_.tau));
   }
   if (!(spec_.visible_size >= 0) || !std::isfinite(spec_.visible_size)) {
-    throw std::invalid_argument("actuator '" + name + "': visible size must be >= 0");
+    throw ArgumentError("actuator '" + name + "': visible size must be >= 0");
   }
   update();
 }
@@ -39,8 +40,8 @@ Eigen::Isometry3d ConstraintActuator::location() const { return checked_pose(spe
 
 void ConstraintActuator::set_pose(const Eigen::Isometry3d& pose) {
   if (is_actuated()) {
-    throw std::logic_error("actuator '" + name() +
-                           "' holds a body: deactuate it before moving the actuator");
+    throw StateError("actuator '" + name() +
+                     "' holds a body: deactuate it before moving the actuator");
   }
   spec_.location = (parent().pose().inverse() * pose).matrix();
   Object::set_pose(pose);

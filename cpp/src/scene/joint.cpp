@@ -1,4 +1,5 @@
 #include "ambfplus/scene/joint.h"
+#include "ambfplus/errors.h"
 
 #include <cmath>
 #include <stdexcept>
@@ -22,7 +23,7 @@ JointType parse_joint_type(const std::string& name) {
   if (n == "cone twist") return JointType::kConeTwist;
   if (n == "six dof") return JointType::kSixDof;
   if (n == "six dof spring") return JointType::kSixDofSpring;
-  throw std::invalid_argument(
+  throw ArgumentError(
       "unknown joint type '" + name +
       "': expected revolute, hinge, continuous, prismatic, slider, fixed, spring, linear spring, "
       "torsion spring, torsional spring, angular spring, p2p, cone twist, six dof or six dof "
@@ -57,43 +58,43 @@ Joint::Joint(Model& model, const JointSpec& spec, int id)
     : Object(model, spec.name, id), spec_(spec) {
   const std::string who = "joint '" + spec.name + "': ";
   if (spec.parent == nullptr || spec.child == nullptr) {
-    throw std::invalid_argument(who + "needs a parent and a child body");
+    throw ArgumentError(who + "needs a parent and a child body");
   }
-  if (spec.parent == spec.child) throw std::invalid_argument(who + "parent and child are the same");
+  if (spec.parent == spec.child) throw ArgumentError(who + "parent and child are the same");
   if (&spec.parent->world() != &model.world() || &spec.child->world() != &model.world()) {
-    throw std::invalid_argument(who + "its bodies must be in the joint's world");
+    throw ArgumentError(who + "its bodies must be in the joint's world");
   }
   for (const Eigen::Vector3d* v : {&spec.parent_pivot, &spec.child_pivot}) {
-    if (!v->allFinite()) throw std::invalid_argument(who + "pivots must be finite");
+    if (!v->allFinite()) throw ArgumentError(who + "pivots must be finite");
   }
   for (const Eigen::Vector3d* v : {&spec.parent_axis, &spec.child_axis}) {
     if (!v->allFinite() || v->norm() < 1e-12) {
-      throw std::invalid_argument(who + "axes must be finite and non-zero");
+      throw ArgumentError(who + "axes must be finite and non-zero");
     }
   }
   if (spec.lower && spec.upper && *spec.lower > *spec.upper) {
-    throw std::invalid_argument(who + "lower limit above upper limit");
+    throw ArgumentError(who + "lower limit above upper limit");
   }
   if (!(spec.damping >= 0) || !(spec.stiffness >= 0) || !(spec.max_motor_impulse >= 0)) {
-    throw std::invalid_argument(who + "damping, stiffness and max motor impulse must be >= 0");
+    throw ArgumentError(who + "damping, stiffness and max motor impulse must be >= 0");
   }
 }
 
 void Joint::set_position(double target) {
-  if (!std::isfinite(target)) throw std::invalid_argument("joint position must be finite");
+  if (!std::isfinite(target)) throw ArgumentError("joint position must be finite");
   if (command_ != Command::kPosition) integral_ = 0;
   command_ = Command::kPosition;
   target_ = target;
 }
 
 void Joint::set_velocity(double target) {
-  if (!std::isfinite(target)) throw std::invalid_argument("joint velocity must be finite");
+  if (!std::isfinite(target)) throw ArgumentError("joint velocity must be finite");
   command_ = Command::kVelocity;
   target_ = target;
 }
 
 void Joint::set_effort(double effort) {
-  if (!std::isfinite(effort)) throw std::invalid_argument("joint effort must be finite");
+  if (!std::isfinite(effort)) throw ArgumentError("joint effort must be finite");
   command_ = Command::kEffort;
   target_ = effort;
 }
@@ -107,14 +108,14 @@ void Joint::release() {
 void Joint::set_controller(const JointController& controller) {
   if (!std::isfinite(controller.p) || !std::isfinite(controller.i) ||
       !std::isfinite(controller.d)) {
-    throw std::invalid_argument("joint '" + name() + "': controller gains must be finite");
+    throw ArgumentError("joint '" + name() + "': controller gains must be finite");
   }
   spec_.controller = controller;
   integral_ = 0;
 }
 
 void Joint::set_damping(double damping) {
-  if (!(damping >= 0)) throw std::invalid_argument("joint damping must be >= 0");
+  if (!(damping >= 0)) throw ArgumentError("joint damping must be >= 0");
   spec_.damping = damping;
 }
 

@@ -1,4 +1,5 @@
 #include "ambfplus/scene/light.h"
+#include "ambfplus/errors.h"
 
 #include <cmath>
 #include <stdexcept>
@@ -12,8 +13,7 @@ LightSpec::Type parse_light_type(const std::string& name) {
   if (n == "directional") return LightSpec::Type::kDirectional;
   if (n == "point") return LightSpec::Type::kPoint;
   if (n == "spot") return LightSpec::Type::kSpot;
-  throw std::invalid_argument("unknown light type '" + name +
-                              "': expected directional, point or spot");
+  throw ArgumentError("unknown light type '" + name + "': expected directional, point or spot");
 }
 
 const char* light_type_name(LightSpec::Type type) {
@@ -38,8 +38,8 @@ Light::Light(Model& model, const LightSpec& spec, int id)
       attenuation_(spec.attenuation) {
   const double n = spec.direction.norm();
   if (!(n > 0.0) || !spec.direction.allFinite() || !spec.position.allFinite()) {
-    throw std::invalid_argument("light '" + spec.name +
-                                "': needs a finite position and a non-zero direction");
+    throw ArgumentError("light '" + spec.name +
+                        "': needs a finite position and a non-zero direction");
   }
   // Any rotation whose z axis is the direction will do; pick the one nearest the identity.
   const Eigen::Vector3d z = spec.direction / n;

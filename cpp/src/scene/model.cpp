@@ -1,4 +1,5 @@
 #include "ambfplus/scene/model.h"
+#include "ambfplus/errors.h"
 
 #include "ambfplus/scene/world.h"
 
@@ -48,9 +49,9 @@ Light& Model::add_light(const LightSpec& spec) {
   int same_type = 0;
   for (const Light* l : world_->objects_of_kind<Light>()) same_type += l->type() == spec.type;
   if (same_type >= kMaxLightsPerType) {
-    throw std::invalid_argument("cannot add light '" + spec.name + "': the world already has " +
-                                std::to_string(kMaxLightsPerType) + " " +
-                                light_type_name(spec.type) + " lights, the most it can draw");
+    throw ArgumentError("cannot add light '" + spec.name + "': the world already has " +
+                        std::to_string(kMaxLightsPerType) + " " + light_type_name(spec.type) +
+                        " lights, the most it can draw");
   }
   return adopt(std::unique_ptr<Light>(new Light(*this, spec, id)));
 }
@@ -67,7 +68,7 @@ Drill& Model::add_drill(const DrillSpec& spec) {
 
 InputDevice& Model::add_input_device(const InputDeviceSpec& spec) {
   if (spec.drill != nullptr && &spec.drill->world() != world_) {
-    throw std::invalid_argument("input device '" + spec.name + "': its drill is in another world");
+    throw ArgumentError("input device '" + spec.name + "': its drill is in another world");
   }
   const int id = world_->claim_name(spec.name, "input device");
   return adopt(std::unique_ptr<InputDevice>(new InputDevice(*this, spec, id)));

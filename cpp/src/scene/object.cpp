@@ -1,4 +1,5 @@
 #include "ambfplus/scene/object.h"
+#include "ambfplus/errors.h"
 
 #include <cmath>
 #include <sstream>
@@ -45,7 +46,7 @@ World& Object::world() const { return model_->world(); }
 
 void Object::attach_to(const Object* parent, const Eigen::Isometry3d& local) {
   for (const Object* p = parent; p != nullptr; p = p->attached_to_) {
-    if (p == this) throw std::invalid_argument("'" + name_ + "' cannot ride on itself");
+    if (p == this) throw ArgumentError("'" + name_ + "' cannot ride on itself");
   }
   world().attachments().track(this, parent != nullptr);
   attached_to_ = parent;
@@ -58,18 +59,18 @@ void Object::follow_parent() {
 }
 
 Eigen::Isometry3d checked_pose(const Eigen::Matrix4d& m, double tol) {
-  if (!m.allFinite()) throw std::invalid_argument("pose has non-finite entries");
+  if (!m.allFinite()) throw ArgumentError("pose has non-finite entries");
   const Eigen::RowVector4d last = m.row(3);
   if ((last - Eigen::RowVector4d(0, 0, 0, 1)).cwiseAbs().maxCoeff() > tol) {
     std::ostringstream s;
     s << "pose must have last row [0 0 0 1], got [" << last << "]";
-    throw std::invalid_argument(s.str());
+    throw ArgumentError(s.str());
   }
   const Eigen::Matrix3d r = m.topLeftCorner<3, 3>();
   const double orthonormality =
       (r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
   if (orthonormality > tol || r.determinant() < 0) {
-    throw std::invalid_argument(
+    throw ArgumentError(
         "pose must be a rigid transform: its 3x3 block must be a rotation (orthonormal, det +1)");
   }
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();

@@ -1,5 +1,7 @@
 #include "scene/primitive_meshes.h"
 
+#include "ambfplus/errors.h"
+
 #include <cmath>
 #include <stdexcept>
 
@@ -172,7 +174,7 @@ MeshData along_axis(MeshData m, int axis) {
 
 MeshData make_primitive_mesh(const Shape& shape) {
   if (shape.axis < 0 || shape.axis > 2) {
-    throw std::invalid_argument("shape axis must be 0 (x), 1 (y) or 2 (z)");
+    throw ArgumentError("shape axis must be 0 (x), 1 (y) or 2 (z)");
   }
   switch (shape.kind) {
     case Shape::Kind::kBox:
@@ -192,7 +194,7 @@ MeshData make_primitive_mesh(const Shape& shape) {
     case Shape::Kind::kMesh:
       break;
   }
-  throw std::invalid_argument("make_primitive_mesh: a mesh shape is not a primitive");
+  throw ArgumentError("make_primitive_mesh: a mesh shape is not a primitive");
 }
 
 }  // namespace ambfplus

@@ -1,6 +1,7 @@
 // ProximitySensor's scene side: checking the spec, placing the rays.
 
 #include "ambfplus/scene/proximity_sensor.h"
+#include "ambfplus/errors.h"
 
 #include <cmath>
 #include <stdexcept>
@@ -13,12 +14,12 @@ namespace ambfplus {
 std::vector<SensorRay> parametric_sensor_rays(int resolution, double horizontal_angle,
                                               double vertical_angle, double start_offset) {
   if (resolution < 2) {
-    throw std::invalid_argument("a parametric sensor needs a resolution of at least 2, got " +
-                                std::to_string(resolution));
+    throw ArgumentError("a parametric sensor needs a resolution of at least 2, got " +
+                        std::to_string(resolution));
   }
   if (!std::isfinite(horizontal_angle) || !std::isfinite(vertical_angle) ||
       !std::isfinite(start_offset)) {
-    throw std::invalid_argument("a parametric sensor's angles and start offset must be finite");
+    throw ArgumentError("a parametric sensor's angles and start offset must be finite");
   }
   std::vector<SensorRay> rays;
   rays.reserve(static_cast<std::size_t>(resolution) * resolution);
@@ -41,26 +42,26 @@ ProximitySensor::ProximitySensor(Model& model, const ProximitySensorSpec& spec, 
     : Object(model, spec.name, id), spec_(spec) {
   const std::string& name = spec.name;
   if (spec_.parent == nullptr) {
-    throw std::invalid_argument("sensor '" + name + "' needs a parent body");
+    throw ArgumentError("sensor '" + name + "' needs a parent body");
   }
   if (&spec_.parent->world() != &model.world()) {
-    throw std::invalid_argument("sensor '" + name + "': its parent '" + spec_.parent->name() +
-                                "' is in another world");
+    throw ArgumentError("sensor '" + name + "': its parent '" + spec_.parent->name() +
+                        "' is in another world");
   }
   checked_pose(spec_.location);
   set_range(spec_.range);
   if (spec_.rays.empty()) {
-    throw std::invalid_argument("sensor '" + name + "' needs at least one ray");
+    throw ArgumentError("sensor '" + name + "' needs at least one ray");
   }
   for (std::size_t i = 0; i < spec_.rays.size(); ++i) {
     const SensorRay& r = spec_.rays[i];
     if (!r.offset.allFinite() || !r.direction.allFinite() || r.direction.norm() == 0) {
-      throw std::invalid_argument("sensor '" + name + "': ray " + std::to_string(i) +
-                                  " needs a finite offset and a finite, non-zero direction");
+      throw ArgumentError("sensor '" + name + "': ray " + std::to_string(i) +
+                          " needs a finite offset and a finite, non-zero direction");
     }
   }
   if (!(spec_.visible_size >= 0) || !std::isfinite(spec_.visible_size)) {
-    throw std::invalid_argument("sensor '" + name + "': visible size must be >= 0");
+    throw ArgumentError("sensor '" + name + "': visible size must be >= 0");
   }
   hits_.resize(spec_.rays.size());
   Object::set_pose(spec_.parent->pose() * checked_pose(spec_.location));
@@ -68,8 +69,8 @@ ProximitySensor::ProximitySensor(Model& model, const ProximitySensorSpec& spec, 
 
 void ProximitySensor::set_range(double range) {
   if (!(range > 0) || !std::isfinite(range)) {
-    throw std::invalid_argument("sensor '" + name() + "': range must be > 0 m, got " +
-                                std::to_string(range));
+    throw ArgumentError("sensor '" + name() + "': range must be > 0 m, got " +
+                        std::to_string(range));
   }
   spec_.range = range;
 }
@@ -83,9 +84,9 @@ bool ProximitySensor::triggered() const {
 
 void ProximitySensor::check_ray(int ray) const {
   if (ray < 0 || ray >= static_cast<int>(ray_count())) {
-    throw std::out_of_range("sensor '" + name() + "' has rays 0.." +
-                            std::to_string(static_cast<int>(ray_count()) - 1) + ", not " +
-                            std::to_string(ray));
+    throw OutOfRange("sensor '" + name() + "' has rays 0.." +
+                     std::to_string(static_cast<int>(ray_count()) - 1) + ", not " +
+                     std::to_string(ray));
   }
 }
 

@@ -1,4 +1,5 @@
 #include "ambfplus/scene/realtime.h"
+#include "ambfplus/errors.h"
 
 #include <pthread.h>
 #include <sched.h>
@@ -85,10 +86,10 @@ double percentile(std::vector<double> v, double q) {
 RealTimeLoop::RealTimeLoop(World& world, const RealTimeOptions& options)
     : world_(world), options_(options) {
   if (!(options.rate > 0 && options.rate <= 100000)) {
-    throw std::invalid_argument("real-time loop: rate must be in (0, 100000] steps/s");
+    throw ArgumentError("real-time loop: rate must be in (0, 100000] steps/s");
   }
   if (!(options.poll_rate > 0 && options.poll_rate <= options.rate)) {
-    throw std::invalid_argument("real-time loop: poll_rate must be in (0, rate]");
+    throw ArgumentError("real-time loop: poll_rate must be in (0, rate]");
   }
 }
 
@@ -101,9 +102,9 @@ RealTimeLoop::~RealTimeLoop() {
 }
 
 void RealTimeLoop::start() {
-  if (running_) throw std::logic_error("the real-time loop is already running");
+  if (running_) throw StateError("the real-time loop is already running");
   if (!world_.enter_realtime()) {
-    throw std::logic_error("world '" + world_.name() + "' already has a running real-time loop");
+    throw StateError("world '" + world_.name() + "' already has a running real-time loop");
   }
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -111,6 +112,11 @@ void RealTimeLoop::start() {
     step_cpu_.clear();
     step_wall_.clear();
     lock_wait_.clear();
+    max_period_ = max_cpu_ = max_wall_ = max_wait_ = 0.0;
+    over_2ms_ = 0;
+    late_.clear();
+    late_wall_.clear();
+    late_cpu_.clear();
     steps_ = 0;
     error_.clear();
     scheduling_.clear();
@@ -136,7 +142,7 @@ void RealTimeLoop::stop() {
   if (!error_.empty()) {
     const std::string error = error_;
     error_.clear();
-    throw std::runtime_error("real-time loop stopped by an error in a step: " + error);
+    throw StateError("real-time loop stopped by an error in a step: " + error);
   }
 }
 
@@ -183,13 +189,31 @@ void RealTimeLoop::run_steps() {
     const double wall = now() - start;
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      if (previous >= 0) periods_.push_back(start - previous);
+      if (previous >= 0) {
+        const double period = start - previous;
+        periods_.push(period);
+        max_period_ = std::max(max_period_, period);
+        // Period n ends at step n + 1: the step before it ran late, or the wait for it did.
+        if (period > 2e-3) {
+          ++over_2ms_;
+          if (late_.size() < RealTimeStats::kLateListed) {
+            late_.push_back(steps_ - 1);
+            late_wall_.push_back(last_wall_);
+            late_cpu_.push_back(last_cpu_);
+          }
+        }
+      }
       if (steps_ == 0) first_ = start;
       last_ = start;
       ++steps_;
-      step_cpu_.push_back(used);
-      step_wall_.push_back(wall);
-      lock_wait_.push_back(waited);
+      step_cpu_.push(used);
+      step_wall_.push(wall);
+      lock_wait_.push(waited);
+      max_cpu_ = std::max(max_cpu_, used);
+      max_wall_ = std::max(max_wall_, wall);
+      max_wait_ = std::max(max_wait_, waited);
+      last_wall_ = wall;
+      last_cpu_ = used;
     }
     previous = start;
     // Far behind (a stall): start afresh from now rather than racing to catch up.
@@ -228,33 +252,41 @@ void RealTimeLoop::run_polls() {
   }
 }
 
+void RealTimeLoop::Window::push(double v) {
+  if (values.size() < RealTimeStats::kWindow) {
+    values.push_back(v);
+  } else {
+    values[next] = v;
+  }
+  next = (next + 1) % RealTimeStats::kWindow;
+}
+
+std::vector<double> RealTimeLoop::Window::in_order() const {
+  if (values.size() < RealTimeStats::kWindow) return values;
+  std::vector<double> out(values.begin() + static_cast<std::ptrdiff_t>(next), values.end());
+  out.insert(out.end(), values.begin(), values.begin() + static_cast<std::ptrdiff_t>(next));
+  return out;
+}
+
 RealTimeStats RealTimeLoop::stats() const {
   RealTimeStats s;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    s.steps = steps_;
-    s.periods = periods_;
-    s.seconds = last_ - first_;
-    s.step_p99 = percentile(step_cpu_, 0.99);
-    if (!step_cpu_.empty()) {
-      s.step_cpu_max = *std::max_element(step_cpu_.begin(), step_cpu_.end());
-      s.step_wall_max = *std::max_element(step_wall_.begin(), step_wall_.end());
-      s.lock_wait_max = *std::max_element(lock_wait_.begin(), lock_wait_.end());
-      s.lock_wait_p99 = percentile(lock_wait_, 0.99);
-    }
-    // Period i ends at step i + 1: the step before it ran late, or the wait for it did.
-    for (std::size_t i = 0; i < periods_.size(); ++i) {
-      if (periods_[i] <= 2e-3) continue;
-      s.late.push_back(static_cast<std::int64_t>(i));
-      s.late_step_wall.push_back(step_wall_[i]);
-      s.late_step_cpu.push_back(step_cpu_[i]);
-    }
-  }
-  if (s.periods.empty()) return s;
+  std::lock_guard<std::mutex> lock(mutex_);
+  s.steps = steps_;
+  s.periods = periods_.in_order();
+  s.seconds = last_ - first_;
+  s.step_p99 = percentile(step_cpu_.values, 0.99);
+  s.step_cpu_max = max_cpu_;
+  s.step_wall_max = max_wall_;
+  s.lock_wait_max = max_wait_;
+  s.lock_wait_p99 = percentile(lock_wait_.values, 0.99);
+  s.late = late_;
+  s.late_step_wall = late_wall_;
+  s.late_step_cpu = late_cpu_;
+  if (steps_ < 2) return s;
   s.mean_rate = s.seconds > 0 ? static_cast<double>(s.steps - 1) / s.seconds : 0.0;
-  s.max = *std::max_element(s.periods.begin(), s.periods.end());
-  s.p99 = percentile(s.periods, 0.99);
-  s.over_2ms = std::count_if(s.periods.begin(), s.periods.end(), [](double p) { return p > 2e-3; });
+  s.max = max_period_;
+  s.p99 = percentile(periods_.values, 0.99);
+  s.over_2ms = over_2ms_;
   return s;
 }
 

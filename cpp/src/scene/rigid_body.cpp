@@ -1,4 +1,5 @@
 #include "ambfplus/scene/rigid_body.h"
+#include "ambfplus/errors.h"
 
 #include <cmath>
 #include <stdexcept>
@@ -11,8 +12,8 @@ namespace {
 
 void require_positive(double value, const char* what, const std::string& body) {
   if (!(value > 0.0) || !std::isfinite(value)) {
-    throw std::invalid_argument("body '" + body + "': " + what + " must be > 0, got " +
-                                std::to_string(value));
+    throw ArgumentError("body '" + body + "': " + what + " must be > 0, got " +
+                        std::to_string(value));
   }
 }
 
@@ -33,9 +34,9 @@ void check_shape(const Shape& shape, const std::string& name) {
     case Shape::Kind::kCapsule:
       require_positive(shape.radius, "radius", name);
       if (!(shape.height >= 2 * shape.radius)) {
-        throw std::invalid_argument("body '" + name +
-                                    "': a capsule's height includes its caps, so it must be >= "
-                                    "2 * radius");
+        throw ArgumentError("body '" + name +
+                            "': a capsule's height includes its caps, so it must be >= "
+                            "2 * radius");
       }
       break;
     case Shape::Kind::kPlane:
@@ -43,7 +44,7 @@ void check_shape(const Shape& shape, const std::string& name) {
       break;
     case Shape::Kind::kMesh:
       if (shape.mesh.empty()) {
-        throw std::invalid_argument("body '" + name + "': a mesh shape needs a mesh file");
+        throw ArgumentError("body '" + name + "': a mesh shape needs a mesh file");
       }
       require_positive(shape.scale, "scale", name);
       break;
@@ -62,9 +63,8 @@ Shape::Kind parse_shape_kind(const std::string& name) {
   if (n == "plane") return Shape::Kind::kPlane;
   if (n == "mesh") return Shape::Kind::kMesh;
   if (n == "none") return Shape::Kind::kNone;
-  throw std::invalid_argument(
-      "unknown shape '" + name +
-      "': expected box, sphere, cylinder, capsule, cone, plane, mesh or none");
+  throw ArgumentError("unknown shape '" + name +
+                      "': expected box, sphere, cylinder, capsule, cone, plane, mesh or none");
 }
 
 const char* shape_kind_name(Shape::Kind kind) {
@@ -95,9 +95,9 @@ MeshCollision parse_mesh_collision(const std::string& name) {
   if (n == "convex_mesh") return MeshCollision::kConvexMesh;
   if (n == "convex_hull" || n == "hull") return MeshCollision::kConvexHull;
   if (n == "point_cloud") return MeshCollision::kPointCloud;
-  throw std::invalid_argument("unknown collision mesh type '" + name +
-                              "': expected CONCAVE_MESH, TRIMESH, CONVEX_MESH, CONVEX_HULL, hull "
-                              "or POINT_CLOUD");
+  throw ArgumentError("unknown collision mesh type '" + name +
+                      "': expected CONCAVE_MESH, TRIMESH, CONVEX_MESH, CONVEX_HULL, hull "
+                      "or POINT_CLOUD");
 }
 
 RigidBody::RigidBody(Model& model, const RigidBodySpec& spec, int id)
@@ -109,35 +109,34 @@ RigidBody::RigidBody(Model& model, const RigidBodySpec& spec, int id)
   const std::string& name = spec.name;
   const double mass = dynamics_.mass;
   if (!(mass >= 0.0) || !std::isfinite(mass)) {
-    throw std::invalid_argument("body '" + name + "': mass must be >= 0 kg, got " +
-                                std::to_string(mass));
+    throw ArgumentError("body '" + name + "': mass must be >= 0 kg, got " + std::to_string(mass));
   }
   const Dynamics& d = dynamics_;
   for (double v : {d.static_friction, d.rolling_friction}) {
     if (!(v >= 0) || !std::isfinite(v)) {
-      throw std::invalid_argument("body '" + name + "': friction must be >= 0");
+      throw ArgumentError("body '" + name + "': friction must be >= 0");
     }
   }
   if (!(d.restitution >= 0 && d.restitution <= 1)) {
-    throw std::invalid_argument("body '" + name + "': restitution must be in 0..1");
+    throw ArgumentError("body '" + name + "': restitution must be in 0..1");
   }
   if (!(d.linear_damping >= 0 && d.linear_damping <= 1) ||
       !(d.angular_damping >= 0 && d.angular_damping <= 1)) {
-    throw std::invalid_argument("body '" + name + "': damping must be in 0..1");
+    throw ArgumentError("body '" + name + "': damping must be in 0..1");
   }
   if (shape_.kind == Shape::Kind::kNone && collision_.shapes.empty()) collision_.enabled = false;
   if (!(collision_.margin >= 0) || !std::isfinite(collision_.margin)) {
-    throw std::invalid_argument("body '" + name + "': collision margin must be >= 0");
+    throw ArgumentError("body '" + name + "': collision margin must be >= 0");
   }
   if (shape_.axis < 0 || shape_.axis > 2) {
-    throw std::invalid_argument("body '" + name + "': axis must be 0 (x), 1 (y) or 2 (z)");
+    throw ArgumentError("body '" + name + "': axis must be 0 (x), 1 (y) or 2 (z)");
   }
   check_shape(shape_, name);
   for (const auto& [part, pose] : collision_.shapes) {
     if (part.kind == Shape::Kind::kMesh || part.kind == Shape::Kind::kNone ||
         (part.kind == Shape::Kind::kPlane && collision_.shapes.size() > 1)) {
-      throw std::invalid_argument("body '" + name +
-                                  "': compound parts must be primitives (a plane only alone)");
+      throw ArgumentError("body '" + name +
+                          "': compound parts must be primitives (a plane only alone)");
     }
     check_shape(part, name);
     checked_pose(pose);

@@ -1,4 +1,5 @@
 #include "ambfplus/scene/simulator.h"
+#include "ambfplus/errors.h"
 
 #include <cmath>
 #include <stdexcept>
@@ -7,8 +8,8 @@ namespace ambfplus {
 
 std::shared_ptr<Simulator> Simulator::create(const SimulatorOptions& options) {
   if (!(options.time_step > 0.0) || !std::isfinite(options.time_step)) {
-    throw std::invalid_argument("time_step must be a positive number of seconds, got " +
-                                std::to_string(options.time_step));
+    throw ArgumentError("time_step must be a positive number of seconds, got " +
+                        std::to_string(options.time_step));
   }
   return std::shared_ptr<Simulator>(new Simulator(options));
 }

@@ -16,16 +16,15 @@ namespace {
 // Throws unless lo <= value <= hi (and finite).
 void require_range(double value, double lo, double hi, const std::string& body, const char* key) {
   if (!(value >= lo && value <= hi)) {
-    throw std::invalid_argument("soft body '" + body + "': " + key + " must be in " +
-                                std::to_string(lo) + ".." + std::to_string(hi) + ", got " +
-                                std::to_string(value));
+    throw ArgumentError("soft body '" + body + "': " + key + " must be in " + std::to_string(lo) +
+                        ".." + std::to_string(hi) + ", got " + std::to_string(value));
   }
 }
 
 void require_at_least(double value, double lo, const std::string& body, const char* key) {
   if (!(value >= lo) || !std::isfinite(value)) {
-    throw std::invalid_argument("soft body '" + body + "': " + key + " must be >= " +
-                                std::to_string(lo) + ", got " + std::to_string(value));
+    throw ArgumentError("soft body '" + body + "': " + key + " must be >= " + std::to_string(lo) +
+                        ", got " + std::to_string(value));
   }
 }
 
@@ -38,7 +37,7 @@ void check_config(const SoftBodyConfig& c, const std::string& name) {
   require_at_least(c.drag, 0, name, "kDG (drag)");
   require_at_least(c.lift, 0, name, "kLF (lift)");
   if (!std::isfinite(c.pressure)) {
-    throw std::invalid_argument("soft body '" + name + "': kPR (pressure) must be finite");
+    throw ArgumentError("soft body '" + name + "': kPR (pressure) must be finite");
   }
   require_at_least(c.volume_conservation, 0, name, "kVC (volume conservation)");
   require_range(c.dynamic_friction, 0, 1, name, "kDF (dynamic friction)");
@@ -55,7 +54,7 @@ void check_config(const SoftBodyConfig& c, const std::string& name) {
   require_range(c.cluster_soft_impulse_split, 0, 1, name, "kSS_SPLT_CL");
   require_at_least(c.max_volume, 0, name, "maxvolume");
   if (!(c.time_scale > 0) || !std::isfinite(c.time_scale)) {
-    throw std::invalid_argument("soft body '" + name + "': timescale must be > 0");
+    throw ArgumentError("soft body '" + name + "': timescale must be > 0");
   }
   require_at_least(c.velocity_iterations, 0, name, "viterations");
   require_at_least(c.position_iterations, 0, name, "piterations");
@@ -63,10 +62,10 @@ void check_config(const SoftBodyConfig& c, const std::string& name) {
   require_at_least(c.cluster_iterations, 0, name, "citerations");
   require_at_least(c.collision_flags, 0, name, "flags");
   if (c.bending_constraint && *c.bending_constraint < 2) {
-    throw std::invalid_argument("soft body '" + name +
-                                "': bending constraint is a distance in links and must be >= 2, "
-                                "got " +
-                                std::to_string(*c.bending_constraint));
+    throw ArgumentError("soft body '" + name +
+                        "': bending constraint is a distance in links and must be >= 2, "
+                        "got " +
+                        std::to_string(*c.bending_constraint));
   }
   if (c.clusters) require_at_least(*c.clusters, 0, name, "clusters");
 }
@@ -74,8 +73,8 @@ void check_config(const SoftBodyConfig& c, const std::string& name) {
 // An integer config value: throws unless `value` is a whole number.
 int whole(double value, const std::string& key) {
   if (!std::isfinite(value) || std::floor(value) != value) {
-    throw std::invalid_argument("soft body config key '" + key + "' takes a whole number, got " +
-                                std::to_string(value));
+    throw ArgumentError("soft body config key '" + key + "' takes a whole number, got " +
+                        std::to_string(value));
   }
   return static_cast<int>(value);
 }
@@ -172,15 +171,15 @@ SoftBody::SoftBody(Model& model, const SoftBodySpec& spec, int id)
     : Object(model, spec.name, id), spec_(spec) {
   const std::string& name = spec.name;
   if (spec_.mesh.empty()) {
-    throw std::invalid_argument("soft body '" + name + "' needs a mesh file (STL, OBJ, ...)");
+    throw ArgumentError("soft body '" + name + "' needs a mesh file (STL, OBJ, ...)");
   }
   if (!(spec_.scale > 0) || !std::isfinite(spec_.scale)) {
-    throw std::invalid_argument("soft body '" + name + "': scale must be > 0, got " +
-                                std::to_string(spec_.scale));
+    throw ArgumentError("soft body '" + name + "': scale must be > 0, got " +
+                        std::to_string(spec_.scale));
   }
   if (!(spec_.mass > 0) || !std::isfinite(spec_.mass)) {
-    throw std::invalid_argument("soft body '" + name + "': mass must be > 0 kg, got " +
-                                std::to_string(spec_.mass));
+    throw ArgumentError("soft body '" + name + "': mass must be > 0 kg, got " +
+                        std::to_string(spec_.mass));
   }
   require_at_least(spec_.margin, 0, name, "collision margin");
   check_config(spec_.config, name);
@@ -217,9 +216,9 @@ SoftBody::SoftBody(Model& model, const SoftBodySpec& spec, int id)
   const int count = static_cast<int>(node_count());
   for (int n : spec_.config.fixed_nodes) {
     if (n < 0 || n >= count) {
-      throw std::invalid_argument("soft body '" + name + "': fixed node " + std::to_string(n) +
-                                  " is not a node; the mesh gives " + std::to_string(count) +
-                                  " (0.." + std::to_string(count - 1) + ")");
+      throw ArgumentError("soft body '" + name + "': fixed node " + std::to_string(n) +
+                          " is not a node; the mesh gives " + std::to_string(count) + " (0.." +
+                          std::to_string(count - 1) + ")");
     }
   }
   Eigen::Isometry3d start = pose;
@@ -237,9 +236,9 @@ Eigen::Vector3d SoftBody::node_position(int node) const {
 
 void SoftBody::check_node(int node) const {
   if (node < 0 || node >= static_cast<int>(node_count())) {
-    throw std::out_of_range("soft body '" + name() + "' has nodes 0.." +
-                            std::to_string(static_cast<int>(node_count()) - 1) + ", not " +
-                            std::to_string(node));
+    throw OutOfRange("soft body '" + name() + "' has nodes 0.." +
+                     std::to_string(static_cast<int>(node_count()) - 1) + ", not " +
+                     std::to_string(node));
   }
 }
 

@@ -1,4 +1,5 @@
 #include "ambfplus/scene/volume.h"
+#include "ambfplus/errors.h"
 
 #include <stdexcept>
 
@@ -12,15 +13,15 @@ Volume::Volume(Model& model, const VolumeSpec& spec, int id)
       optical_density_(spec.optical_density),
       specular_(spec.specular),
       shininess_(spec.shininess) {
-  if (!data_) throw std::invalid_argument("volume '" + spec.name + "' needs volume data");
+  if (!data_) throw ArgumentError("volume '" + spec.name + "' needs volume data");
   set_iso(spec.iso);
   set_pose(checked_pose(spec.pose));
 }
 
 void Volume::set_iso(double iso) {
   if (!(iso > 0.0 && iso < 1.0)) {
-    throw std::invalid_argument("volume '" + name() + "': iso must be in (0, 1), got " +
-                                std::to_string(iso));
+    throw ArgumentError("volume '" + name() + "': iso must be in (0, 1), got " +
+                        std::to_string(iso));
   }
   iso_ = iso;
 }

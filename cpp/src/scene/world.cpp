@@ -1,4 +1,5 @@
 #include "ambfplus/scene/world.h"
+#include "ambfplus/errors.h"
 
 #include <algorithm>
 #include <cmath>
@@ -72,7 +73,7 @@ World::~World() {
 }
 
 void World::add_system(std::unique_ptr<System> system) {
-  if (!system) throw std::invalid_argument("world '" + name_ + "': add_system needs a system");
+  if (!system) throw ArgumentError("world '" + name_ + "': add_system needs a system");
   for (int s = 0; s < kStepStageCount; ++s) {
     if (system->stages() & (1u << s)) schedule_[s].push_back(system.get());
   }
@@ -91,7 +92,7 @@ Eigen::Vector3d World::gravity() const { return physics_->gravity(); }
 
 Model& World::add_model(const std::string& name) {
   for (const auto& m : models_) {
-    if (m->name() == name) throw std::invalid_argument("a model named '" + name + "' exists");
+    if (m->name() == name) throw ArgumentError("a model named '" + name + "' exists");
   }
   models_.push_back(std::unique_ptr<Model>(new Model(*this, name)));
   return *models_.back();
@@ -109,6 +110,12 @@ Object* World::find(const std::string& name) const {
 }
 
 std::vector<Object*> World::objects() const { return objects_; }
+
+Object* World::object_with_id(int id) const {
+  const auto it = std::lower_bound(objects_.begin(), objects_.end(), id,
+                                   [](const Object* o, int wanted) { return o->id() < wanted; });
+  return it != objects_.end() && (*it)->id() == id ? *it : nullptr;
+}
 
 std::vector<Object*> World::lookup(const std::string& query, std::optional<ObjectKind> kind) const {
   std::vector<Object*> exact, partial;
@@ -156,11 +163,11 @@ std::vector<Joint*> World::descendant_joints(const RigidBody& root) const {
 
 void World::remove_model(Model& model) {
   if (&model == models_.front().get()) {
-    throw std::invalid_argument("the world's default model cannot be removed");
+    throw ArgumentError("the world's default model cannot be removed");
   }
   const auto it = std::find_if(models_.begin(), models_.end(),
                                [&](const auto& m) { return m.get() == &model; });
-  if (it == models_.end()) throw std::invalid_argument("the model is not in this world");
+  if (it == models_.end()) throw ArgumentError("the model is not in this world");
   plugins_->close_model(model);
   // Newest first (joints go before the bodies they hold), each heard of by the systems in the
   // reverse of the order they took it in, while it is whole.
@@ -177,11 +184,11 @@ void World::remove_model(Model& model) {
 }
 
 int World::claim_name(const std::string& name, const char* what) {
-  if (name.empty()) throw std::invalid_argument(std::string("a ") + what + " needs a name");
+  if (name.empty()) throw ArgumentError(std::string("a ") + what + " needs a name");
   if (Object* existing = find(name)) {
-    throw std::invalid_argument(std::string("cannot add ") + what + " '" + name +
-                                "': the world already has a " + object_kind_name(existing->kind()) +
-                                " with that name");
+    throw ArgumentError(std::string("cannot add ") + what + " '" + name +
+                        "': the world already has a " + object_kind_name(existing->kind()) +
+                        " with that name");
   }
   return next_id_;
 }
@@ -202,7 +209,7 @@ void World::register_object(Object* object) {
 }
 
 void World::step(std::int64_t n) {
-  if (n < 0) throw std::invalid_argument("step count must be >= 0, got " + std::to_string(n));
+  if (n < 0) throw ArgumentError("step count must be >= 0, got " + std::to_string(n));
   for (std::int64_t s = 0; s < n; ++s) {
     auto lock = lock_state();
     StepContext context;
@@ -225,7 +232,7 @@ void World::step(std::int64_t n) {
 void World::start_step_log(const std::vector<const Object*>& objects) {
   for (const Object* o : objects) {
     if (o == nullptr || &o->world() != this) {
-      throw std::invalid_argument("a step log can only log objects of its world");
+      throw ArgumentError("a step log can only log objects of its world");
     }
   }
   auto lock = lock_state();

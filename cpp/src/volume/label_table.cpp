@@ -20,12 +20,12 @@ LabelTable::LabelTable(std::vector<Label> labels) {
 }
 
 void LabelTable::add(const Label& label) {
-  if (label.id == 0) throw std::invalid_argument("label '" + label.name + "': id 0 means no label");
+  if (label.id == 0) throw ArgumentError("label '" + label.name + "': id 0 means no label");
   if (find(label.id)) {
-    throw std::invalid_argument("label id " + std::to_string(label.id) + " is used twice");
+    throw ArgumentError("label id " + std::to_string(label.id) + " is used twice");
   }
   if (!label.name.empty() && find(label.name)) {
-    throw std::invalid_argument("label name '" + label.name + "' is used twice");
+    throw ArgumentError("label name '" + label.name + "' is used twice");
   }
   labels_.push_back(label);
 }
@@ -149,7 +149,7 @@ LabelTable read_csv(const std::string& path) {
     }
     try {
       table.add(l);
-    } catch (const std::invalid_argument& e) {
+    } catch (const ArgumentError& e) {
       throw ConfigError(path, "line " + std::to_string(line) + ": " + e.what());
     }
   }
@@ -192,7 +192,7 @@ LabelTable read_yaml(const std::string& path) {
       table.add(l);
     } catch (const YAML::Exception& e) {
       throw ConfigError(path, where + e.msg);
-    } catch (const std::invalid_argument& e) {
+    } catch (const ArgumentError& e) {
       throw ConfigError(path, where + e.what());
     }
   }

@@ -260,7 +260,7 @@ std::vector<Segment> read_segments(const std::string& path, const Header& h) {
       } else if (what == "Color") {
         std::istringstream in(v);
         double rgb[3];
-        if (!(in >> rgb[0] >> rgb[1] >> rgb[2])) throw std::invalid_argument("colour");
+        if (!(in >> rgb[0] >> rgb[1] >> rgb[2])) throw ArgumentError("colour");
         for (int c = 0; c < 3; ++c) {
           s.color[c] = static_cast<std::uint8_t>(std::lround(std::clamp(rgb[c], 0.0, 1.0) * 255));
         }
@@ -576,14 +576,13 @@ void save_nrrd(const VolumeData& volume, const std::string& path, const std::str
     bytes = voxels * (volume.label_type() == LabelType::kUInt8 ? 1 : 2);
   } else if (what == "intensity") {
     if (volume.intensity_type() == IntensityType::kNone) {
-      throw std::invalid_argument("the volume has no intensity grid to save");
+      throw ArgumentError("the volume has no intensity grid to save");
     }
     type = volume.intensity_type() == IntensityType::kInt16 ? "int16" : "float";
     source = const_cast<VolumeData&>(volume).intensity_data();
     bytes = voxels * (volume.intensity_type() == IntensityType::kInt16 ? 2 : 4);
   } else {
-    throw std::invalid_argument("save_nrrd: what must be 'labels' or 'intensity', got '" + what +
-                                "'");
+    throw ArgumentError("save_nrrd: what must be 'labels' or 'intensity', got '" + what + "'");
   }
   // Geometry back to millimetres in the patient frame the grid came from.
   const Eigen::Matrix4d& p = volume.patient_from_volume();

@@ -2,6 +2,7 @@
 // voxels of its own bounding box only.
 
 #include "ambfplus/volume/phantom.h"
+#include "ambfplus/errors.h"
 
 #include <algorithm>
 #include <cmath>
@@ -187,8 +188,8 @@ LabelTable phantom_label_table() {
 
 std::shared_ptr<VolumeData> make_temporal_bone_phantom(int resolution, std::uint32_t seed) {
   if (resolution < 16 || resolution > 2048) {
-    throw std::invalid_argument("phantom resolution must be 16..2048 voxels, got " +
-                                std::to_string(resolution));
+    throw ArgumentError("phantom resolution must be 16..2048 voxels, got " +
+                        std::to_string(resolution));
   }
   auto volume = std::make_shared<VolumeData>(std::array<int, 3>{resolution, resolution, resolution},
                                              V3::Constant(kSizeMm / 1000.0), LabelType::kUInt8,

@@ -159,8 +159,7 @@ std::int64_t write_surface_mesh(VolumeData& volume, const std::string& path, std
   VolumeData* source = &volume;
   if (label != 0) {
     if (!volume.label_table().find(label)) {
-      throw std::invalid_argument("label " + std::to_string(label) +
-                                  " is not in the volume's table");
+      throw ArgumentError("label " + std::to_string(label) + " is not in the volume's table");
     }
     only = std::make_shared<VolumeData>(volume.shape(), volume.dimensions(), LabelType::kUInt8,
                                         LabelTable());

@@ -1,6 +1,8 @@
 #include "ambfplus/volume/volume_data.h"
+#include "ambfplus/errors.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -60,8 +62,8 @@ std::size_t label_bytes(LabelType t) { return t == LabelType::kUInt8 ? 1 : 2; }
 
 void check_table_fits(const LabelTable& table, LabelType type) {
   if (type == LabelType::kUInt8 && table.max_id() > 255) {
-    throw std::invalid_argument("label id " + std::to_string(table.max_id()) +
-                                " does not fit a uint8 label grid (use uint16)");
+    throw ArgumentError("label id " + std::to_string(table.max_id()) +
+                        " does not fit a uint8 label grid (use uint16)");
   }
 }
 
@@ -72,9 +74,9 @@ VolumeData::VolumeData(const std::array<int, 3>& shape, const Eigen::Vector3d& d
     : shape_(shape), dimensions_(dimensions), label_type_(type), table_(std::move(table)) {
   for (int a = 0; a < 3; ++a) {
     if (shape_[a] <= 0 || shape_[a] > 8192) {
-      throw std::invalid_argument("volume shape must be 1..8192 voxels per axis, got " +
-                                  std::to_string(shape_[0]) + "x" + std::to_string(shape_[1]) +
-                                  "x" + std::to_string(shape_[2]));
+      throw ArgumentError("volume shape must be 1..8192 voxels per axis, got " +
+                          std::to_string(shape_[0]) + "x" + std::to_string(shape_[1]) + "x" +
+                          std::to_string(shape_[2]));
     }
   }
   set_dimensions(dimensions);
@@ -85,7 +87,7 @@ VolumeData::VolumeData(const std::array<int, 3>& shape, const Eigen::Vector3d& d
 
 void VolumeData::set_dimensions(const Eigen::Vector3d& dimensions) {
   if (!(dimensions.minCoeff() > 0.0) || !dimensions.allFinite()) {
-    throw std::invalid_argument("volume dimensions must be positive metres");
+    throw ArgumentError("volume dimensions must be positive metres");
   }
   dimensions_ = dimensions;
 }
@@ -101,6 +103,48 @@ Eigen::Vector3d VolumeData::voxel_size() const {
 void VolumeData::set_label_table(LabelTable table) {
   check_table_fits(table, label_type_);
   table_ = std::move(table);
+}
+
+void VolumeData::name_labels_from(const LabelTable& named) {
+  check_table_fits(named, label_type_);
+  std::vector<std::uint16_t> to(static_cast<std::size_t>(table_.max_id()) + 1, 0);
+  for (const Label& l : table_.labels()) to[l.id] = named.nearest(l.color);
+  visit_labels(label_type_, labels_.data(), [&](auto* grid) {
+    using T = std::remove_pointer_t<decltype(grid)>;
+    const std::size_t n = static_cast<std::size_t>(voxel_count());
+    for (std::size_t v = 0; v < n; ++v) {
+      if (grid[v] != 0 && grid[v] < to.size()) grid[v] = static_cast<T>(to[grid[v]]);
+    }
+  });
+  table_ = named;
+  mark_dirty(VoxelBox{{0, 0, 0}, shape_});
+  commit();
+}
+
+void VolumeData::mark_critical_structures() {
+  std::vector<Label> labels = table_.labels();
+  if (std::any_of(labels.begin(), labels.end(), [](const Label& l) { return l.critical; })) {
+    return;
+  }
+  static const char* const kCritical[] = {"facial", "chorda", "nerve",     "ica",     "carotid",
+                                          "sinus",  "dura",   "labyrinth", "cochlea", "iac"};
+  bool named = false;
+  for (Label& l : labels) {
+    std::string lower = l.name;
+    std::transform(lower.begin(), lower.end(), lower.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    for (const char* word : kCritical) {
+      if (lower.find(word) != std::string::npos) l.critical = named = true;
+    }
+  }
+  if (!named) {
+    const std::vector<std::int64_t> counts = label_counts();
+    if (counts.size() < 2) return;
+    const auto commonest = static_cast<std::uint16_t>(
+        std::max_element(counts.begin() + 1, counts.end()) - counts.begin());
+    for (Label& l : labels) l.critical = l.id != commonest;
+  }
+  table_ = LabelTable(labels);
 }
 
 void VolumeData::set_intensity_type(IntensityType type) {
@@ -162,7 +206,7 @@ void VolumeData::log_edit(VolumeEdit edit) {
 std::int64_t VolumeData::remove_sphere(const Eigen::Vector3d& center, double radius,
                                        bool only_removable) {
   if (!(radius >= 0.0) || !center.allFinite()) {
-    throw std::invalid_argument("remove_sphere needs a finite centre and a radius >= 0");
+    throw ArgumentError("remove_sphere needs a finite centre and a radius >= 0");
   }
   const Eigen::Vector3d s = voxel_size();
   const Eigen::Vector3d u = to_voxel_units(center);
@@ -212,7 +256,7 @@ std::vector<std::uint16_t> VolumeData::remove_voxels(const std::vector<std::arra
       const auto& v = voxels[n];
       if (v[0] < 0 || v[1] < 0 || v[2] < 0 || v[0] >= shape_[0] || v[1] >= shape_[1] ||
           v[2] >= shape_[2]) {
-        throw std::invalid_argument("remove_voxels: voxel outside the grid");
+        throw ArgumentError("remove_voxels: voxel outside the grid");
       }
       auto& l = p[linear_index(v[0], v[1], v[2])];
       old[n] = l;
@@ -230,7 +274,7 @@ std::vector<std::uint16_t> VolumeData::remove_voxels(const std::vector<std::arra
 
 std::int64_t VolumeData::set_region(const VoxelBox& region, std::uint16_t label) {
   if (label_type_ == LabelType::kUInt8 && label > 255) {
-    throw std::invalid_argument("label " + std::to_string(label) + " does not fit a uint8 grid");
+    throw ArgumentError("label " + std::to_string(label) + " does not fit a uint8 grid");
   }
   const VoxelBox box = region.clipped(shape_);
   std::int64_t changed = 0;
@@ -472,7 +516,7 @@ VolumeHit VolumeData::raycast(const Eigen::Vector3d& origin, const Eigen::Vector
   update_derived();
   VolumeHit result;
   const double norm = direction.norm();
-  if (!(norm > 0.0)) throw std::invalid_argument("raycast needs a non-zero direction");
+  if (!(norm > 0.0)) throw ArgumentError("raycast needs a non-zero direction");
   const Eigen::Vector3d d = direction / norm;
   const Eigen::Vector3d s = voxel_size();
   const Eigen::Vector3d u0 = to_voxel_units(origin);

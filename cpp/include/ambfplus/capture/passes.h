@@ -50,7 +50,7 @@ struct PassInfo {
 AMBFPLUS_API const std::array<PassInfo, kPassCount>& capture_passes();
 /// A pass's name ("rgb" ... "points"), "?" for an index outside the table.
 AMBFPLUS_API const char* pass_name(int index);
-/// The bit of a pass name; throws std::invalid_argument naming every pass for an unknown one.
+/// The bit of a pass name; throws ArgumentError naming every pass for an unknown one.
 AMBFPLUS_API CapturePass parse_pass(const std::string& name);
 /// The names of a set of pass bits, comma separated in table order ("rgb, depth").
 AMBFPLUS_API std::string pass_names(unsigned passes);

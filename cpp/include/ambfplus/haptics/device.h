@@ -191,7 +191,7 @@ class AMBFPLUS_API NetworkDevice final : public Device {
  public:
   static constexpr std::size_t kPoseBytes = 80, kForceBytes = 48;
   /// Binds UDP `port` (0: any free port, see port()) on `address` (loopback unless another
-  /// address is given on purpose). Throws std::runtime_error naming the address if it cannot.
+  /// address is given on purpose). Throws Error naming the address if it cannot.
   explicit NetworkDevice(int port = 0, const std::string& address = "127.0.0.1",
                          double max_distance = 10.0);
   ~NetworkDevice() override;
@@ -298,7 +298,7 @@ struct AMBFPLUS_API DeviceRecord {
 /// Plays back logged readings: the reading logged for a step (held until the next logged one).
 class AMBFPLUS_API ReplayDevice final : public Device {
  public:
-  /// Records in increasing step order; throws std::invalid_argument otherwise.
+  /// Records in increasing step order; throws ArgumentError otherwise.
   explicit ReplayDevice(std::vector<DeviceRecord> records, DeviceSpec spec = {"replay"});
   DeviceState read(std::int64_t step, double time) override;
   /// Steps read beyond the last record.

@@ -141,12 +141,20 @@ class AMBFPLUS_API Drill : public Object {
   const std::vector<std::pair<std::uint16_t, double>>& critical_distances() const {
     return critical_distances_;
   }
-  /// Voxels removed so far and not yet taken; take_* hands them over.
+  /// Voxels removed so far and not yet taken; take_* hands them over. Bounded: the newest
+  /// kMaxRemoved voxels and kMaxEvents events are kept, older ones dropped and counted.
   const std::deque<RemovedVoxel>& removed() const { return removed_; }
   std::deque<RemovedVoxel> take_removed();
   const std::deque<DrillEvent>& events() const { return events_; }
   std::deque<DrillEvent> take_events();
-  /// Wall time of the last ticks, seconds (up to 100 000).
+  static constexpr std::size_t kMaxRemoved = 262144;  ///< about 6 MB
+  static constexpr std::size_t kMaxEvents = 65536;
+  /// Removed voxels and events dropped because nobody took them in time.
+  std::int64_t removed_dropped() const { return removed_dropped_; }
+  std::int64_t events_dropped() const { return events_dropped_; }
+  /// Ticks whose timings are kept.
+  static constexpr std::size_t kTickHistory = 16384;
+  /// Wall time of the last ticks, seconds (up to kTickHistory).
   const std::deque<double>& tick_seconds() const { return tick_seconds_; }
   /// CPU time of the thread for the same ticks: what the tick costs, whatever else the machine
   /// is doing.
@@ -161,6 +169,18 @@ class AMBFPLUS_API Drill : public Object {
   void follow_waypoints();
   // Brings the mesh collider up to date with the world's bodies and their poses.
   void sync_meshes();
+  // The parts of a tick, in order.
+  void update_cursors();
+  void place_drill();
+  /// The cursors' forces; returns the tip's, in the volume frame.
+  Eigen::Vector3d update_forces(double dt);
+  /// The voxels the burr touches, (squared distance to the goal, voxel), nearest first.
+  std::vector<std::pair<double, std::array<int, 3>>> cuttable_voxels() const;
+  void remove_tissue(double dt, std::int64_t step, const Eigen::Vector3d& tip_force_volume);
+  void update_critical_distances();
+  void log_removed(const RemovedVoxel& voxel);
+  void log_event(const DrillEvent& event);
+  void record_timing(double wall, double cpu);
 
   Volume* volume_;
   DrillSpec spec_;
@@ -181,6 +201,7 @@ class AMBFPLUS_API Drill : public Object {
   std::vector<std::pair<std::uint16_t, double>> critical_distances_;
   std::deque<RemovedVoxel> removed_;
   std::deque<DrillEvent> events_;
+  std::int64_t removed_dropped_ = 0, events_dropped_ = 0;
   std::deque<double> tick_seconds_;
   std::deque<double> tick_cpu_seconds_;
   std::vector<std::pair<RigidBody*, Eigen::Isometry3d>> attached_;

@@ -51,9 +51,13 @@ class AMBFPLUS_API InputDevice : public Object {
   /// Sends the drill's force to the device (the world calls it after the drill's tick).
   void post_step(double dt);
 
-  /// Readings since the last take_log(), oldest first.
+  /// Readings since the last take_log(), oldest first: the newest kMaxLog (a minute at 1 kHz,
+  /// about 6 MB) are kept, older ones dropped and counted; a recorder takes them more often.
   const std::deque<DeviceRecord>& log() const { return log_; }
   std::deque<DeviceRecord> take_log();
+  static constexpr std::size_t kMaxLog = 65536;
+  /// Readings dropped because nobody took them in time.
+  std::int64_t log_dropped() const { return log_dropped_; }
   /// The last reading.
   const DeviceState& state() const { return state_; }
   bool clutched() const { return clutched_; }
@@ -74,6 +78,7 @@ class AMBFPLUS_API InputDevice : public Object {
   bool clutched_ = false;
   Eigen::Vector3d force_ = Eigen::Vector3d::Zero();
   std::deque<DeviceRecord> log_;
+  std::int64_t log_dropped_ = 0;
 };
 
 }  // namespace ambfplus

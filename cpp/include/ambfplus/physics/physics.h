@@ -22,7 +22,7 @@ namespace physics {
 /// cannot simulate) and out again as they leave.
 class AMBFPLUS_API Physics : public System {
  public:
-  /// m/s^2; throws std::invalid_argument unless finite.
+  /// m/s^2; throws ArgumentError unless finite.
   virtual void set_gravity(const Eigen::Vector3d& gravity) = 0;
   virtual Eigen::Vector3d gravity() const = 0;
 };

@@ -10,10 +10,74 @@
 #include <vector>
 
 #include "ambfplus/export.h"
-#include "ambfplus/plugin/plugin.h"
 #include "ambfplus/scene/system.h"
 
 namespace ambfplus {
+
+class Model;
+class Object;
+class Simulator;
+class World;
+
+/// What a plugin is attached to.
+enum class PluginScope { kSimulator, kWorld, kModel, kObject };
+
+/// "simulator", "world", "model" or "object".
+AMBFPLUS_API const char* plugin_scope_name(PluginScope scope);
+
+/// Where a plugin sits: its scope and the simulator, world, model and object it belongs to
+/// (model is set for model and object scopes, object for object scope only).
+struct AMBFPLUS_API PluginSite {
+  PluginScope scope = PluginScope::kWorld;
+  Simulator* simulator = nullptr;
+  World* world = nullptr;
+  Model* model = nullptr;
+  Object* object = nullptr;
+
+  /// The site of a plugin attached to a simulator, a world, a model or an object.
+  static PluginSite of(Simulator& simulator);
+  static PluginSite of(World& world);
+  static PluginSite of(Model& model);
+  static PluginSite of(Object& object);
+};
+
+/// A plugin as the engine holds it: a C++ library's plugin behind its C entry (plugin.h), or
+/// another language's adapter (the Python bindings'). It is the engine's side of the ABI, for
+/// code built with the engine; plugin libraries never see it. A hook that throws has its
+/// plugin disabled by the registry.
+class AMBFPLUS_API PluginInstance {
+ public:
+  virtual ~PluginInstance();
+  /// >= 1 keeps the plugin (AMBF's rule); throwing fails the load.
+  virtual int init() = 0;
+  virtual void physics_update(double dt) = 0;
+  virtual void graphics_update() = 0;
+  virtual void keyboard(int key, int scancode, int action, int mods) = 0;
+  virtual void mouse_button(int button, int action, int mods) = 0;
+  virtual void mouse_move(double x, double y) = 0;
+  virtual void mouse_scroll(double dx, double dy) = 0;
+  virtual void reset() = 0;
+  virtual void close() = 0;
+  virtual void on_object_added(Object& object) = 0;
+  virtual void on_object_removed(Object& object) = 0;
+
+  const PluginSite& site() const { return site_; }
+  PluginScope scope() const { return site_.scope; }
+  Simulator& simulator() const { return *site_.simulator; }
+  World& world() const { return *site_.world; }
+  Model* model() const { return site_.model; }
+  Object* object() const { return site_.object; }
+  /// The name it was declared with (ADF `name`), else its file's stem.
+  const std::string& name() const { return name_; }
+  /// The file it was loaded from.
+  const std::string& file() const { return file_; }
+
+ private:
+  friend class PluginRegistry;
+  PluginSite site_;
+  std::string name_;
+  std::string file_;
+};
 
 /// A plugin to load: an ADF `plugins:` entry, a `--plugins` item or a load_plugin call.
 struct AMBFPLUS_API PluginSpec {
@@ -29,9 +93,9 @@ struct AMBFPLUS_API PluginLanguage {
   std::string name;       ///< "python"
   std::string extension;  ///< files it loads, ".py"
   /// A plugin from a file the search found.
-  std::function<std::shared_ptr<Plugin>(const std::string& file)> from_file;
+  std::function<std::shared_ptr<PluginInstance>(const std::string& file)> from_file;
   /// A plugin registered under a bare name (Python's entry points), or null when none is.
-  std::function<std::shared_ptr<Plugin>(const std::string& name)> from_name;
+  std::function<std::shared_ptr<PluginInstance>(const std::string& name)> from_name;
 };
 
 /// Makes a language known to every registry (replacing one of the same name).
@@ -62,17 +126,17 @@ class AMBFPLUS_API PluginRegistry : public System {
   /// Finds and loads a plugin (search order in cpp/README.md, "Plugins"), attaches it to site
   /// and calls its init(). Returns it, or nullptr when init() returned < 1 (it is dropped).
   /// Throws PluginError naming the file and every path tried, dlerror()'s message, or both ABI
-  /// versions; std::invalid_argument for a site of another world.
-  Plugin* load(const PluginSpec& spec, const PluginSite& site);
+  /// versions; ArgumentError for a site of another world.
+  PluginInstance* load(const PluginSpec& spec, const PluginSite& site);
   /// Attaches a plugin made elsewhere as load does; native is false for plugins of another
   /// language (a Python object's adapter), whose physics updates a real-time loop decimates.
-  Plugin* attach(std::shared_ptr<Plugin> plugin, const std::string& name, const std::string& file,
-                 const PluginSite& site, bool native = true);
+  PluginInstance* attach(std::shared_ptr<PluginInstance> plugin, const std::string& name,
+                         const std::string& file, const PluginSite& site, bool native = true);
 
   /// Attached plugins in call order, disabled ones included.
-  std::vector<Plugin*> plugins() const;
+  std::vector<PluginInstance*> plugins() const;
   /// False once a hook of the plugin threw.
-  bool enabled(const Plugin& plugin) const;
+  bool enabled(const PluginInstance& plugin) const;
   bool empty() const;
 
   /// physics_update(dt) of every plugin, or with native_only of C++ plugins alone (a real-time
@@ -103,6 +167,8 @@ class AMBFPLUS_API PluginRegistry : public System {
 
  private:
   struct Entry;
+  /// Throws ArgumentError unless site is whole and in this world.
+  void check_site(const std::string& name, const PluginSite& site) const;
   template <typename Call>
   void each(const char* hook, const Call& call, const Model* model_scope_of = nullptr,
             const std::function<bool(const Entry&)>& which = nullptr);

@@ -80,7 +80,7 @@ class AMBFPLUS_API Camera : public Object {
   Frame capture(const PoseRequest& poses = {});
   /// Renders into an existing frame: its buffers are reused (filled in place) and must match
   /// this camera's size. A frame without buffers gets the camera's passes; one with buffers is
-  /// refilled with exactly those. Throws std::invalid_argument on a mismatch.
+  /// refilled with exactly those. Throws ArgumentError on a mismatch.
   void capture(Frame& frame, const PoseRequest& poses = {});
   /// Renders into caller-owned memory and fills frame's metadata and poses (its buffers are
   /// left alone).

@@ -45,7 +45,7 @@ class AMBFPLUS_API ConstraintActuator : public Object {
   RigidBody& parent() const { return *spec_.parent; }
 
   /// Holds `body` where it is now relative to the actuator. A body already held is kept; another
-  /// one is released first. Throws std::invalid_argument for the parent itself, a body of another
+  /// one is released first. Throws ArgumentError for the parent itself, a body of another
   /// world, or one physics does not move (static or kinematic).
   void actuate(RigidBody& body);
   /// Holds `body` with the actuator frame at `offset` in the body's frame (for a point hold only

@@ -39,30 +39,30 @@ class AMBFPLUS_API Model {
   const std::optional<ShaderSpec>& shader() const { return shader_; }
   void set_shader(std::optional<ShaderSpec> shader) { shader_ = std::move(shader); }
 
-  /// Creates a body. Throws std::invalid_argument for a bad spec or a taken name, AssetNotFound
+  /// Creates a body. Throws ArgumentError for a bad spec or a taken name, AssetNotFound
   /// or ConfigError for a mesh that cannot be read.
   RigidBody& add_body(const RigidBodySpec& spec);
-  /// Creates a joint between two bodies of the world. Throws std::invalid_argument for a bad spec
+  /// Creates a joint between two bodies of the world. Throws ArgumentError for a bad spec
   /// or a taken name.
   Joint& add_joint(const JointSpec& spec);
-  /// Creates a camera. Throws std::invalid_argument for a bad spec or a taken name.
+  /// Creates a camera. Throws ArgumentError for a bad spec or a taken name.
   Camera& add_camera(const CameraSpec& spec);
-  /// Creates a light. Throws std::invalid_argument for a bad spec or a taken name.
+  /// Creates a light. Throws ArgumentError for a bad spec or a taken name.
   Light& add_light(const LightSpec& spec);
-  /// Places a volume. Throws std::invalid_argument for a bad spec or a taken name.
+  /// Places a volume. Throws ArgumentError for a bad spec or a taken name.
   Volume& add_volume(const VolumeSpec& spec);
   /// Creates a drill working on a volume of the same world.
   Drill& add_drill(const DrillSpec& spec);
-  /// Binds a device to a drill of the same world. Throws std::invalid_argument for a bad spec
+  /// Binds a device to a drill of the same world. Throws ArgumentError for a bad spec
   /// or a taken name.
   InputDevice& add_input_device(const InputDeviceSpec& spec);
-  /// Creates a soft body from a mesh file. Throws std::invalid_argument for a bad spec or a taken
+  /// Creates a soft body from a mesh file. Throws ArgumentError for a bad spec or a taken
   /// name, AssetNotFound or ConfigError for a mesh that cannot be read.
   SoftBody& add_soft_body(const SoftBodySpec& spec);
-  /// Creates a proximity sensor on a rigid body of the world. Throws std::invalid_argument for a
+  /// Creates a proximity sensor on a rigid body of the world. Throws ArgumentError for a
   /// bad spec or a taken name.
   ProximitySensor& add_sensor(const ProximitySensorSpec& spec);
-  /// Creates a constraint actuator on a rigid body of the world. Throws std::invalid_argument for
+  /// Creates a constraint actuator on a rigid body of the world. Throws ArgumentError for
   /// a bad spec or a taken name.
   ConstraintActuator& add_actuator(const ConstraintActuatorSpec& spec);
 

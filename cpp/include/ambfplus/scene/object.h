@@ -89,7 +89,7 @@ class AMBFPLUS_API Object {
   std::unique_ptr<ObjectState> physics_state_;
 };
 
-/// Throws std::invalid_argument unless m is a rigid transform (orthonormal rotation with det +1,
+/// Throws ArgumentError unless m is a rigid transform (orthonormal rotation with det +1,
 /// last row 0 0 0 1, finite), tolerating rounding of tol.
 AMBFPLUS_API Eigen::Isometry3d checked_pose(const Eigen::Matrix4d& m, double tol = 1e-6);
 

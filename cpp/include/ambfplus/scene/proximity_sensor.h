@@ -22,7 +22,7 @@ struct AMBFPLUS_API SensorRay {
 /// AMBF's `parametric` ray fan in the sensor frame: resolution x resolution rays about +x, spread
 /// over `horizontal angle` (about z) and `vertical angle` (about y), each starting `start offset`
 /// out along its own direction; ray (i, j) is element resolution * i + j (i horizontal).
-/// Throws std::invalid_argument for a resolution below 2.
+/// Throws ArgumentError for a resolution below 2.
 AMBFPLUS_API std::vector<SensorRay> parametric_sensor_rays(int resolution, double horizontal_angle,
                                                            double vertical_angle,
                                                            double start_offset);

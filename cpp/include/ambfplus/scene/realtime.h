@@ -28,11 +28,16 @@ struct AMBFPLUS_API RealTimeOptions {
   double poll_rate = 100.0;  ///< Hz of the polling thread (devices and plugins of Python)
 };
 
-/// Periods of a real-time loop, seconds between consecutive step starts.
+/// Periods of a real-time loop, seconds between consecutive step starts. Counts and maxima
+/// cover the whole run; percentiles and the periods listed cover the last kWindow steps (a
+/// minute at 1 kHz), so a session of any length keeps flat memory.
 struct AMBFPLUS_API RealTimeStats {
+  static constexpr std::size_t kWindow = 65536;
+  /// Late periods listed at most (the count over 2 ms covers them all).
+  static constexpr std::size_t kLateListed = 1024;
   std::int64_t steps = 0;
   double seconds = 0.0;         ///< wall time from the first step to the last
-  std::vector<double> periods;  ///< every period (steps - 1 of them)
+  std::vector<double> periods;  ///< the last periods (up to kWindow), oldest first
   double mean_rate = 0.0;       ///< steps per second
   double p99 = 0.0, max = 0.0;  ///< s
   std::int64_t over_2ms = 0;    ///< periods longer than 2 ms
@@ -42,7 +47,8 @@ struct AMBFPLUS_API RealTimeStats {
   /// s the loop's thread waited for the world's state lock before a step: the longest, and the
   /// 99th percentile (other threads hold it only to copy or change the scene).
   double lock_wait_max = 0.0, lock_wait_p99 = 0.0;
-  /// Periods over 2 ms: their index, the wall and CPU time of the step that began them.
+  /// Periods over 2 ms (the first kLateListed): their index, the wall and CPU time of the step
+  /// that began them.
   std::vector<std::int64_t> late;
   std::vector<double> late_step_wall, late_step_cpu;
 };
@@ -63,7 +69,7 @@ class AMBFPLUS_API RealTimeLoop {
   RealTimeLoop(const RealTimeLoop&) = delete;
   RealTimeLoop& operator=(const RealTimeLoop&) = delete;
 
-  /// Starts the threads; throws std::logic_error if running or if the world has another loop.
+  /// Starts the threads; throws StateError if running or if the world has another loop.
   void start();
   /// Stops after the step in progress and joins the threads. A step that threw ends the loop;
   /// stop() then throws its error again.
@@ -92,12 +98,25 @@ class AMBFPLUS_API RealTimeLoop {
   mutable std::mutex mutex_;  // guards what follows
   std::condition_variable wake_;
   std::string scheduling_;
-  std::vector<double> periods_;
-  std::vector<double> step_cpu_;
-  std::vector<double> step_wall_;
-  std::vector<double> lock_wait_;
+  /// The last kWindow values of something measured every step.
+  struct Window {
+    std::vector<double> values;
+    std::size_t next = 0;
+    void clear() {
+      values.clear();
+      next = 0;
+    }
+    void push(double v);
+    std::vector<double> in_order() const;  // oldest first
+  };
+  Window periods_, step_cpu_, step_wall_, lock_wait_;
+  double max_period_ = 0.0, max_cpu_ = 0.0, max_wall_ = 0.0, max_wait_ = 0.0;
+  std::int64_t over_2ms_ = 0;
+  std::vector<std::int64_t> late_;
+  std::vector<double> late_wall_, late_cpu_;
   std::int64_t steps_ = 0;
   double first_ = 0.0, last_ = 0.0;
+  double last_wall_ = 0.0, last_cpu_ = 0.0;  // the step before the current period
   std::string error_;
   std::function<void(double)> poll_hook_;
 };

@@ -68,7 +68,7 @@ struct AMBFPLUS_API SoftBodyConfig {
 /// Sets the SoftBodyConfig field an AMBF `config` key names (kLST ... kSS_SPLT_CL, maxvolume,
 /// timescale, viterations, piterations, diterations, citerations, flags, `bending constraint`,
 /// clusters; spaces or underscores). Returns false for a key it does not know; throws
-/// std::invalid_argument for an integer key given a fraction.
+/// ArgumentError for an integer key given a fraction.
 AMBFPLUS_API bool set_soft_body_config(SoftBodyConfig& config, const std::string& key,
                                        double value);
 

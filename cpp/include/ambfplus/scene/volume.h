@@ -30,7 +30,7 @@ class AMBFPLUS_API Volume : public Object {
   const std::shared_ptr<VolumeData>& data() const { return data_; }
 
   double iso() const { return iso_; }
-  /// Throws std::invalid_argument outside (0, 1).
+  /// Throws ArgumentError outside (0, 1).
   void set_iso(double iso);
   double quality() const { return quality_; }
   double optical_density() const { return optical_density_; }

@@ -49,13 +49,15 @@ class AMBFPLUS_API World {
 
   /// The model that holds objects added to the world directly.
   Model& default_model() { return *models_.front(); }
-  /// Creates an empty model. Throws std::invalid_argument if the name is taken.
+  /// Creates an empty model. Throws ArgumentError if the name is taken.
   Model& add_model(const std::string& name);
   /// Models in creation order, the default model first.
   std::vector<Model*> models() const;
 
   /// The object with exactly this name, or nullptr.
   Object* find(const std::string& name) const;
+  /// The object with this id, or nullptr (ids grow with creation, so this is a search).
+  Object* object_with_id(int id) const;
   /// Objects a name refers to, the way AMBF finds them: those whose name, qualified name
   /// ("/ambf/env/l1"), identifier ("BODY l1") or namespace + identifier equals the query; if
   /// none does, every object whose qualified name or identifier contains it. Optionally of one
@@ -77,7 +79,7 @@ class AMBFPLUS_API World {
   /// the step), then the clock, then the stages.
   void step(std::int64_t n = 1);
   /// Adds a system after those the world has: it runs in the stages it names after theirs and
-  /// hears of objects added from now on. Throws std::invalid_argument for a null system.
+  /// hears of objects added from now on. Throws ArgumentError for a null system.
   void add_system(std::unique_ptr<System> system);
   /// The systems in the order they hear of objects and run within a stage.
   std::vector<System*> systems() const;
@@ -102,7 +104,7 @@ class AMBFPLUS_API World {
   void set_shader(std::optional<ShaderSpec> shader) { shader_ = std::move(shader); }
 
   /// Starts logging every step's state of these objects (replacing a log in progress); the
-  /// log's rows are taken with take_step_log(). Throws std::invalid_argument for an object of
+  /// log's rows are taken with take_step_log(). Throws ArgumentError for an object of
   /// another world.
   void start_step_log(const std::vector<const Object*>& objects);
   /// Stops logging; rows not taken are dropped.
@@ -123,6 +125,8 @@ class AMBFPLUS_API World {
   std::unique_lock<StateMutex> lock_state() const {
     return std::unique_lock<StateMutex>(state_mutex_);
   }
+  /// The state lock itself, for callers that cannot hold a unique_lock (the plugin C API).
+  StateMutex& state_mutex() const { return state_mutex_; }
 
   /// True while a RealTimeLoop steps this world: steps then leave polled devices and plugins of
   /// other languages to the loop's low-rate thread.

@@ -22,7 +22,7 @@ struct AMBFPLUS_API Label {
 class AMBFPLUS_API LabelTable {
  public:
   LabelTable() = default;
-  /// Throws std::invalid_argument for a duplicate or zero id, or a duplicate name.
+  /// Throws ArgumentError for a duplicate or zero id, or a duplicate name.
   explicit LabelTable(std::vector<Label> labels);
 
   const std::vector<Label>& labels() const { return labels_; }
@@ -36,7 +36,7 @@ class AMBFPLUS_API LabelTable {
   std::uint16_t max_id() const;
   /// The id whose colour is nearest (Euclidean in RGB) to this one; 0 if the table is empty.
   std::uint16_t nearest(const std::array<std::uint8_t, 3>& rgb) const;
-  /// Adds a label; throws std::invalid_argument on a duplicate id or name.
+  /// Adds a label; throws ArgumentError on a duplicate id or name.
   void add(const Label& label);
 
  private:

@@ -66,7 +66,7 @@ struct AMBFPLUS_API VolumeHit {
 /// In "voxel units" u = (p + D/2) / s a voxel covers [i, i + 1) with its centre at i + 0.5.
 class AMBFPLUS_API VolumeData {
  public:
-  /// A grid of zeros. Throws std::invalid_argument for a non-positive shape or dimension, or a
+  /// A grid of zeros. Throws ArgumentError for a non-positive shape or dimension, or a
   /// table whose ids do not fit the label type.
   VolumeData(const std::array<int, 3>& shape, const Eigen::Vector3d& dimensions, LabelType type,
              LabelTable table);
@@ -76,13 +76,22 @@ class AMBFPLUS_API VolumeData {
   const std::array<int, 3>& shape() const { return shape_; }
   std::int64_t voxel_count() const;
   const Eigen::Vector3d& dimensions() const { return dimensions_; }
-  /// Resizes the physical box (metres, full extents); throws std::invalid_argument if not > 0.
+  /// Resizes the physical box (metres, full extents); throws ArgumentError if not > 0.
   void set_dimensions(const Eigen::Vector3d& dimensions);
   Eigen::Vector3d voxel_size() const;
   LabelType label_type() const { return label_type_; }
   const LabelTable& label_table() const { return table_; }
-  /// Replaces the table; throws std::invalid_argument if an id does not fit the label type.
+  /// Replaces the table; throws ArgumentError if an id does not fit the label type.
   void set_label_table(LabelTable table);
+  /// Names the labels from another table: each label becomes the id of named's label with the
+  /// nearest colour (the voxels are relabelled), the table becomes named, and that is what
+  /// reset() restores (how the original system's labels.csv names a volume's colours).
+  void name_labels_from(const LabelTable& named);
+  /// Marks critical structures, unless some label is critical already: the labels whose names
+  /// speak of nerves, vessels, the sinus and dura, the labyrinth or the IAC (facial, chorda,
+  /// nerve, ica, carotid, sinus, dura, labyrinth, cochlea, iac), else every label but the
+  /// commonest (bone).
+  void mark_critical_structures();
 
   /// The label grid (1 or 2 bytes per voxel, by label_type()). Writes through it are not seen by
   /// renderers until mark_dirty() names the changed box.

@@ -1,0 +1,223 @@
+"""Running one episode: its scene built from its plan, filmed and recorded into a shard, the
+shard checked and moved into the dataset. Runs in a worker (a spawned process or a Ray worker),
+which creates its EGL context on its first render."""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import os
+import shutil
+import socket
+import time
+from pathlib import Path
+
+import numpy as np
+
+from .. import NullDevice, ScriptedDevice, __version__, gl_info
+from ..recording_schema import find_parts
+from ..scenarios import DrillScript
+from ..scenes import anatomy_data, drilling_scene
+from ..session import record_session
+from ..stereo import StereoFrame
+from .manifest import shard_checksum
+from .sampling import EpisodePlan, jitter_label_colors, sample_episode
+from .spec import SCHEMA_VERSION, spec_hash
+
+SHARDS = "shards"
+PARTIAL = ".partial"
+# Shards are reproducible files: their recording id comes from the spec and the episode, and
+# their creation time is the epoch (as SOURCE_DATE_EPOCH=0 builds); the manifest says when each
+# was made.
+REPRODUCIBLE_CREATED = "1970-01-01T00:00:00+00:00"
+# One part per shard: a part closes only when the recorder does.
+SHARD_FLUSH_INTERVAL_S = 1e6
+_FRAME_FIELDS = ("camera", "time", "step", "intrinsics", "pose")
+
+
+class EpisodeError(RuntimeError):
+    """An episode whose shard could not be made (the message says which and why)."""
+
+
+def shard_name(index: int) -> str:
+    """``episode_000012.h5``: the head file of episode 12's shard."""
+    return f"episode_{index:06d}.h5"
+
+
+def record_episode(spec_data: dict, index: int, path, plan: EpisodePlan | None = None) -> dict:
+    """Builds episode `index` of a normalised spec and records it to `path` (a reproducible
+    recording). Returns its summary: frames, label pixel counts, what was drawn."""
+    plan = plan or sample_episode(spec_data, index)
+    source = plan.scene["anatomy"]
+    table = anatomy_data(source).label_table
+    label_colors = jitter_label_colors(table, plan.label_color_jitter, plan.rngs["colors"])
+    scene = drilling_scene(**plan.scene, label_colors=label_colors)
+    target = np.asarray(scene.target)
+    path_plan = dataclasses.replace(
+        plan.camera_path, target=tuple(float(v) for v in target + plan.camera_path.target)
+    )
+    seconds = plan.frames * plan.capture_every * scene.world.time_step
+    device, motion = (
+        NullDevice(),
+        (path_plan if path_plan.azimuth_swing or path_plan.elevation_swing else None),
+    )
+    scene.rig.aim(*path_plan(0.0))
+    if plan.scenario["kind"] in ("drilling", "mixed"):
+        drill = scene.drill
+        script = DrillScript(
+            drill.volume, drill.goal[:3, 3], drill.burr_radius, plan.rngs["motion"]
+        )
+        script.plunge_until(seconds)
+        device = ScriptedDevice()
+        device.set_callback(script, every=10)
+    counter = _LabelCounter(table)
+    noise = _RgbNoise(plan.rgb_noise)
+    sampled = plan.describe()
+    sampled["camera_path"] = dataclasses.asdict(path_plan)
+    sampled["label_colors"] = label_colors
+    metadata = {
+        "dataset": {
+            "episode": index,
+            "seed": plan.seed,
+            "base_seed": int(spec_data["seed"]),
+            "spec_sha256": spec_hash(spec_data),
+            "schema_version": SCHEMA_VERSION,
+            "name": spec_data.get("name", ""),
+        },
+        "sampled": sampled,
+    }
+    recording_id = hashlib.sha256(f"{spec_hash(spec_data)}/{index}".encode()).hexdigest()[:32]
+    summary = record_session(
+        scene,
+        path,
+        device,
+        seconds,
+        capture_every=plan.capture_every,
+        passes=plan.passes,
+        camera_motion=motion,
+        metadata=metadata,
+        transform=lambda pair: noise(counter(pair)),
+        recorder_options={
+            "recording_id": recording_id,
+            "created": REPRODUCIBLE_CREATED,
+            "flush_interval_s": SHARD_FLUSH_INTERVAL_S,
+        },
+    )
+    return {
+        "frames": summary["frames"],
+        "label_pixels": counter.by_name(),
+        "anatomy": plan.anatomy["name"],
+        "scenario": plan.scenario["kind"],
+        "seed": plan.seed,
+    }
+
+
+class _LabelCounter:
+    """Pixels per anatomy label over every recorded label image (both views)."""
+
+    def __init__(self, table) -> None:
+        self.names = {label.id: label.name for label in table}
+        self.counts = np.zeros(1, dtype=np.int64)
+
+    def __call__(self, pair: StereoFrame) -> StereoFrame:
+        for frame in (pair.left, pair.right):
+            label = getattr(frame, "label", None)
+            if label is not None:
+                counts = np.bincount(np.asarray(label).ravel())
+                if len(counts) > len(self.counts):
+                    self.counts = np.pad(self.counts, (0, len(counts) - len(self.counts)))
+                self.counts[: len(counts)] += counts
+        return pair
+
+    def by_name(self) -> dict[str, int]:
+        return {
+            self.names.get(i, f"label_{i}"): int(n)
+            for i, n in enumerate(self.counts)
+            if n and i != 0
+        }
+
+
+class _RgbNoise:
+    """Gaussian sensor noise on the RGB images (rounded, clipped to 0..255), drawn from the
+    episode's noise seed, the pair's number and the view; every other pass stays exact."""
+
+    def __init__(self, spec: dict) -> None:
+        self.sigma = float(spec["sigma"])
+        self.seed = int(spec["seed"])
+        self.pairs = 0
+
+    def __call__(self, pair: StereoFrame) -> StereoFrame:
+        if self.sigma <= 0 or getattr(pair.left, "rgb", None) is None:
+            return pair
+        views = []
+        for side, frame in enumerate((pair.left, pair.right)):
+            rng = np.random.default_rng(
+                np.random.SeedSequence(self.seed, spawn_key=(self.pairs, side))
+            )
+            rgb = np.asarray(frame.rgb, dtype=np.float32)
+            noisy = rgb + rng.normal(0.0, self.sigma, rgb.shape).astype(np.float32)
+            views.append(_replace_rgb(frame, np.clip(np.rint(noisy), 0, 255).astype(np.uint8)))
+        self.pairs += 1
+        return StereoFrame(views[0], views[1], pair.baseline, pair.dcx)
+
+
+def _replace_rgb(frame, rgb: np.ndarray) -> dict:
+    """A frame as a mapping (as the recorder takes it) with another RGB image."""
+    out = {name: getattr(frame, name) for name in _FRAME_FIELDS}
+    for name in ("depth", "label", "instance", "voxel", "segmentation", "points"):
+        value = getattr(frame, name, None)
+        if value is not None:
+            out[name] = value
+    out["rgb"] = rgb
+    return out
+
+
+def partial_folder(out, index: int, attempt: int) -> Path:
+    """Where attempt `attempt` at episode `index` records its shard before it is complete (the
+    executor deletes it when the attempt fails)."""
+    return Path(out) / PARTIAL / f"{shard_name(index)[:-3]}.attempt{attempt}"
+
+
+def run_episode(spec_data: dict, out, index: int, attempt: int = 0, worker: str = "") -> dict:
+    """Makes episode `index`'s shard in dataset folder `out`: recorded under ``.partial/``,
+    validated, then moved into ``shards/`` (its parts first, its head last). Returns the
+    episode's manifest record."""
+    from ..recording import validate
+
+    started, cpu_started = time.perf_counter(), time.process_time()
+    out = Path(out)
+    name = shard_name(index)
+    partial = partial_folder(out, index, attempt)
+    shutil.rmtree(partial, ignore_errors=True)
+    partial.mkdir(parents=True)
+    head = partial / name
+    summary = record_episode(spec_data, index, head)
+    report = validate(head, match_images=False)
+    if not report.ok:
+        failed = "; ".join(f"{c.name}: {c.detail}" for c in report.failed)
+        raise EpisodeError(f"episode {index}: its shard does not validate: {failed}")
+    files = [head] + [p for _, p in find_parts(head)]
+    digest, size = shard_checksum(files)
+    shards = out / SHARDS
+    shards.mkdir(exist_ok=True)
+    for file in files[1:] + files[:1]:  # the head last: it names a complete shard
+        os.replace(file, shards / file.name)
+    partial.rmdir()
+    return {
+        "episode": index,
+        "seed": summary["seed"],
+        "anatomy": summary["anatomy"],
+        "scenario": summary["scenario"],
+        "frames": summary["frames"],
+        "bytes": size,
+        "sha256": digest,
+        "file": f"{SHARDS}/{name}",
+        "parts": [f"{SHARDS}/{file.name}" for file in files[1:]],
+        "version": __version__,
+        "renderer": gl_info()["renderer"],
+        "label_pixels": summary["label_pixels"],
+        "seconds": round(time.perf_counter() - started, 3),
+        "cpu_seconds": round(time.process_time() - cpu_started, 3),
+        "worker": worker or f"{socket.gethostname()}:{os.getpid()}",
+        "attempt": attempt,
+    }

@@ -1,0 +1,202 @@
+"""The default executor: spawned worker processes on this machine, each with its own EGL
+context (created on its first render), fed one episode at a time through a pipe.
+
+A worker that dies (SIGKILL, a crash) is noticed through its process sentinel: its episode goes
+back to the queue and a new worker takes its place. Workers die with the driver (Linux's
+parent-death signal, and a check of their parent), so a killed driver leaves no orphans.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import multiprocessing
+import os
+import signal
+import time
+import traceback
+from collections import deque
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from multiprocessing.connection import wait
+
+from .executor import Done, Executor, Failed, Retry, WorkerStartError
+
+PR_SET_PDEATHSIG = 1
+
+
+def _die_with_parent(parent: int) -> None:
+    """Asks Linux to SIGKILL this process when its parent exits (no-op elsewhere)."""
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+    except (OSError, AttributeError):
+        pass
+    if os.getppid() != parent:  # the parent died before the request took effect
+        os._exit(1)
+
+
+def _worker_main(connection, spec_data: dict, out: str, name: str, parent: int) -> None:
+    """A worker's loop: receive (episode, attempt), make the shard, send back its record."""
+    _die_with_parent(parent)
+    from .episode import run_episode
+
+    connection.send(("ready", None, None, os.getpid()))
+    while True:
+        try:
+            task = connection.recv()
+        except (EOFError, OSError):
+            return
+        if task is None:
+            return
+        index, attempt = task
+        try:
+            record = run_episode(spec_data, out, index, attempt, worker=name)
+            connection.send(("done", index, attempt, record))
+        except Exception:
+            connection.send(("failed", index, attempt, traceback.format_exc()))
+
+
+@dataclass
+class _Slot:
+    number: int
+    process: multiprocessing.Process
+    connection: object
+    task: tuple[int, int] | None = None
+    since: float = field(default_factory=time.monotonic)
+    ready: bool = False
+
+    @property
+    def name(self) -> str:
+        return f"local-{self.number}:{self.process.pid}"
+
+
+class LocalExecutor(Executor):
+    """Runs episodes in `workers` spawned processes on this machine."""
+
+    name = "local"
+
+    def __init__(self, workers: int = 1, retries: int = 3, timeout: float | None = None) -> None:
+        super().__init__(retries, timeout)
+        if workers < 1:
+            raise ValueError(f"workers must be >= 1, got {workers}")
+        self.workers = int(workers)
+        self._context = multiprocessing.get_context("spawn")
+        self._started = 0
+        self._start_failures = 0  # workers in a row that died before they were ready
+
+    def describe(self) -> dict:
+        return {"executor": self.name, "workers": self.workers}
+
+    def _start(self, spec_data: dict, out: str) -> _Slot:
+        ours, theirs = self._context.Pipe()
+        self._started += 1
+        number = self._started
+        process = self._context.Process(
+            target=_worker_main,
+            args=(theirs, spec_data, out, f"local-{number}", os.getpid()),
+            name=f"ambfplus-generate-{number}",
+            daemon=True,
+        )
+        process.start()
+        theirs.close()
+        return _Slot(number, process, ours)
+
+    def run(self, spec_data: dict, out, todo: list[int]) -> Iterator:
+        queue = deque((index, 0) for index in todo)
+        self._out = out
+        slots: list[_Slot] = []
+        try:
+            slots = [self._start(spec_data, str(out)) for _ in range(min(self.workers, len(queue)))]
+            while queue or any(slot.task for slot in slots):
+                for slot in slots:
+                    if slot.task is None and queue:
+                        slot.task, slot.since = queue.popleft(), time.monotonic()
+                        slot.connection.send(slot.task)
+                waitables = [s.connection for s in slots] + [s.process.sentinel for s in slots]
+                ready = set(wait(waitables, timeout=1.0))
+                for k, slot in enumerate(slots):
+                    if slot.connection in ready:
+                        yield from self._receive(slot, queue)
+                    if slot.process.sentinel in ready or not slot.process.is_alive():
+                        yield from self._replace(k, slots, queue, spec_data, str(out))
+                    elif self._overdue(slot):
+                        slot.process.kill()  # noticed as a death on the next round
+        finally:
+            _stop(slots)
+
+    def _receive(self, slot: _Slot, queue: deque) -> Iterator:
+        try:
+            message = slot.connection.recv()
+        except (EOFError, OSError):
+            return  # the worker died; its sentinel says so
+        kind, index, attempt, payload = message
+        if kind == "ready":
+            slot.ready = True
+            self._start_failures = 0
+            return
+        slot.task = None
+        if kind == "done":
+            yield Done(payload)
+        else:
+            yield from self._failed(index, attempt, payload, queue)
+
+    def _failed(self, index: int, attempt: int, reason: str, queue: deque) -> Iterator:
+        self.discard(self._out, index, attempt)
+        if attempt >= self.retries:
+            yield Failed(index, attempt + 1, reason)
+            return
+        queue.append((index, attempt + 1))
+        yield Retry(index, attempt + 1, reason)
+
+    def _replace(self, k: int, slots: list, queue: deque, spec_data: dict, out: str) -> Iterator:
+        slot = slots[k]
+        slot.process.join(timeout=5)
+        code = slot.process.exitcode
+        slot.connection.close()
+        if not slot.ready:
+            self._start_failures += 1
+        # A worker that exits by itself before it is ready cannot start (an import error, a
+        # script without the main guard); killed ones are faults like any other, unless they
+        # keep dying before they are ready.
+        killed = code is not None and code < 0
+        if not slot.ready and (
+            not killed or self._start_failures > self.workers * (self.retries + 1)
+        ):
+            raise WorkerStartError(
+                f"a worker process could not start (exit code {code}; its error is above). "
+                "Workers are spawned: they import the main module again, so a script that "
+                "calls generate() must be a file and call it under "
+                '`if __name__ == "__main__":`'
+            )
+        if slot.task is not None:
+            index, attempt = slot.task
+            how = f"signal {-code}" if code is not None and code < 0 else f"exit code {code}"
+            overdue = self._overdue(slot)
+            reason = f"worker {slot.name} " + (
+                f"took more than {self.timeout} s and was killed" if overdue else f"died ({how})"
+            )
+            yield from self._failed(index, attempt, reason, queue)
+        slots[k] = self._start(spec_data, out)
+
+    def _overdue(self, slot: _Slot) -> bool:
+        return (
+            slot.task is not None
+            and self.timeout is not None
+            and time.monotonic() - slot.since > self.timeout
+        )
+
+
+def _stop(slots: list[_Slot]) -> None:
+    """Asks idle workers to finish, then kills whatever is still running."""
+    for slot in slots:
+        try:
+            slot.connection.send(None)
+        except (OSError, ValueError):
+            pass
+    deadline = time.monotonic() + 10
+    for slot in slots:
+        slot.process.join(timeout=max(0.0, deadline - time.monotonic()))
+        if slot.process.is_alive():
+            slot.process.kill()
+            slot.process.join(timeout=5)
+        slot.connection.close()

@@ -1,0 +1,138 @@
+"""Datasets on a real Ray cluster: a head and a second node started with `ray start` on this
+machine (tests/ray_cluster.py). The same spec gives the same shards as the local executor, Ray
+workers killed on either node are replaced and their episodes redone, and a killed driver
+resumes. Skipped without the ray extra (pip install "ambfplus[ray]")."""
+
+from __future__ import annotations
+
+import json
+import os
+import random
+import signal
+import subprocess
+import sys
+import threading
+import time
+
+import pytest
+
+pytest.importorskip("ray", reason='the Ray tests need the ray extra: pip install "ambfplus[ray]"')
+pytest.importorskip("psutil", reason="the Ray tests need psutil (in the ray extra)")
+
+from ray_cluster import RayCluster  # noqa: E402
+from test_dataset import manifest, shard_bytes  # noqa: E402
+
+from ambfplus.dataset import generate, read_manifest, validate_dataset  # noqa: E402
+from ambfplus.dataset.ray_executor import check_reachable  # noqa: E402
+
+TASK = "ambfplus_episode"
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    cluster = RayCluster(cpus_per_node=1)
+    try:
+        cluster.start()
+        yield cluster
+    finally:
+        cluster.stop()
+
+
+def nodes_used(folder) -> set[str]:
+    return {r["worker"].split(":")[0] for r in read_manifest(folder)[0]}
+
+
+def test_ray_makes_the_same_shards_as_local_workers(
+    cluster, dataset_spec, reference_dataset, tmp_path
+):
+    report = generate(dataset_spec, tmp_path / "ray", ray=cluster.address, progress=False)
+    assert report.generated == 12 and report.executor["nodes"] == 2
+    assert manifest(tmp_path / "ray") == manifest(reference_dataset)
+    assert shard_bytes(tmp_path / "ray") == shard_bytes(reference_dataset)
+    assert len(nodes_used(tmp_path / "ray")) == 2  # both nodes rendered
+    environment = json.loads((tmp_path / "ray" / "environment.json").read_text())
+    assert environment["runs"][0]["executor"] == "ray"
+    assert environment["runs"][0]["address"] == cluster.address
+
+
+def test_ray_workers_killed_on_both_nodes_are_retried(
+    cluster, dataset_spec, reference_dataset, tmp_path
+):
+    out = tmp_path / "ray"
+    killed: dict[str, int] = {}
+    stop = threading.Event()
+
+    def killer():
+        rng = random.Random(20)
+        while not stop.is_set() and sum(killed.values()) < 4:
+            time.sleep(rng.uniform(0.2, 0.8))
+            running = cluster.workers_running(TASK)
+            # the second node's workers first, until one of each node is gone
+            ips = [ip for ip in sorted(running, reverse=True) if running[ip]]
+            wanted = [ip for ip in ips if not killed.get(ip)] or ips
+            if wanted:
+                ip = wanted[0]
+                os.kill(rng.choice(running[ip]), signal.SIGKILL)
+                killed[ip] = killed.get(ip, 0) + 1
+
+    thread = threading.Thread(target=killer)
+    thread.start()
+    try:
+        report = generate(dataset_spec, out, ray=cluster.address, retries=8, progress=False)
+    finally:
+        stop.set()
+        thread.join()
+    assert len(killed) == 2, f"kills by node: {killed}"
+    assert report.retries >= 2
+    assert manifest(out) == manifest(reference_dataset)
+    assert shard_bytes(out) == shard_bytes(reference_dataset)
+    check = validate_dataset(out, match_images=False)
+    assert check.ok and not check.warnings, str(check)
+
+
+def test_a_killed_ray_driver_resumes_to_the_same_dataset(
+    cluster, dataset_spec, reference_dataset, tmp_path
+):
+    out = tmp_path / "ray"
+    driver = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "ambfplus",
+            "generate",
+            str(dataset_spec),
+            "--out",
+            str(out),
+            "--ray",
+            cluster.address,
+            "--quiet",
+        ],
+        cwd="/",
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
+    deadline = time.monotonic() + 180
+    while time.monotonic() < deadline and len(read_manifest(out)[0]) < 3:
+        if driver.poll() is not None:
+            pytest.fail(f"the driver ended early: {driver.communicate()[1].decode()}")
+        time.sleep(0.05)
+    driver.kill()
+    driver.wait(timeout=30)
+    assert 3 <= len(read_manifest(out)[0]) < 12
+    resumed = generate(dataset_spec, out, ray=cluster.address, progress=False)
+    assert resumed.skipped >= 3 and resumed.skipped + resumed.generated == 12
+    assert manifest(out) == manifest(reference_dataset)
+    assert shard_bytes(out) == shard_bytes(reference_dataset)
+
+
+def test_an_unreachable_ray_address_says_so(tmp_path):
+    with pytest.raises(ConnectionError, match=r"cannot reach a Ray cluster at 127\.0\.0\.1:9"):
+        generate(
+            {"version": 1, "episodes": 1, "anatomies": [{"phantom": {}}]},
+            tmp_path / "out",
+            ray="127.0.0.1:9",
+            progress=False,
+        )
+    assert not (tmp_path / "out").exists()
+    with pytest.raises(ConnectionError, match="expected host:port"):
+        check_reachable("nowhere")

@@ -72,14 +72,17 @@ def wheel(args) -> Iterator[dict]:
             "from a local wheelhouse (no compiler, no download)",
         }
         runs = {"wheel": [], "source": []}
-        for _ in range(rounds):
-            runs["wheel"].append(capture_figures(str(python), args.quick))
-            runs["source"].append(capture_figures(sys.executable, args.quick))
+        engines = {"wheel": str(python), "source": sys.executable}
+        for i in range(rounds):
+            # Each goes first in every other round, so whatever the machine does over time
+            # falls on both alike.
+            for name in ("wheel", "source") if i % 2 == 0 else ("source", "wheel"):
+                runs[name].append(capture_figures(engines[name], args.quick))
     for name, what in (("capture_640x480_cpu", "process CPU"), ("capture_640x480_wall", "wall")):
         ours = [r[name] for r in runs["wheel"]]
         base = [r[name] for r in runs["source"]]
         value, baseline = statistics.median(ours), statistics.median(base)
-        # Each round runs the wheel's engine and then the source build's, back to back.
+        # Each round runs both engines back to back.
         paired = [o / b for o, b in zip(ours, base)]
         yield {
             "bench": f"wheel_{name}",

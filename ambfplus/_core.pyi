@@ -392,9 +392,14 @@ class Simulator:
         """
         world.get(name, kind)
         """
-    def load_plugin(self, plugin: typing.Any, name: str | None = None) -> typing.Any:
+    def load_plugin(self, plugin, *args, probe: bool = False, **kwargs):
         """
+        load_plugin(self: ambfplus._core.Simulator, plugin: object, name: str | None = None) -> object
+        
         Loads a plugin and calls its init(): `plugin` is a C++ library (libx.so, or a name searched in AMBFPLUS_PLUGIN_PATH, the package's plugin folder and the linker's path), a Python file (x.py), an `ambfplus.plugins` entry-point name, or an ambfplus.Plugin object. Returns its PluginInfo, or None when init() declined. Raises PluginError. The plugin is attached to the simulator.
+        
+        
+        probe=True loads a plugin file in a probe process first and raises PluginError with the probe's output when that process crashes, hangs or fails.
         """
     def step(self, n: typing.SupportsInt | typing.SupportsIndex = 1) -> None:
         """
@@ -564,9 +569,14 @@ class World:
         """
         Loads an AMBF launch file: its world file, then the model files at the launch indices `models` (AMBF's -l; None: index 1 unless `extra` is given), then `extra` files (-a), then the simulated multibodies of input `devices` (-i), then the launch file's and `plugins`' simulator plugins (--plugins). A model that fails is reported in the result's errors and leaves nothing behind, a plugin that fails is reported there too; strict=True raises instead.
         """
-    def load_plugin(self, plugin: typing.Any, scope_object: typing.Any = None, name: str | None = None) -> typing.Any:
+    def load_plugin(self, plugin, *args, probe: bool = False, **kwargs):
         """
+        load_plugin(self: ambfplus._core.World, plugin: object, scope_object: object = None, name: str | None = None) -> object
+        
         Loads a plugin and calls its init(): `plugin` is a C++ library (libx.so, or a name searched in AMBFPLUS_PLUGIN_PATH, the package's plugin folder and the linker's path), a Python file (x.py), an `ambfplus.plugins` entry-point name, or an ambfplus.Plugin object. Returns its PluginInfo, or None when init() declined. Raises PluginError. scope_object: None (this world), the simulator, a model or an object.
+        
+        
+        probe=True loads a plugin file in a probe process first and raises PluginError with the probe's output when that process crashes, hangs or fails.
         """
     def load_volumes(self, path: os.PathLike | str | bytes, labels: os.PathLike | str | bytes | None = None) -> list:
         """

@@ -1,6 +1,11 @@
+#include <algorithm>
+
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+
+#include <filesystem>
+#include <system_error>
 
 #include "ambfplus/errors.h"
 #include "ambfplus/io/image.h"
@@ -33,6 +38,44 @@ void write_image(const std::string& path, const void* pixels, int height, int wi
     reason = e.what();
   }
   if (!ok) throw ConfigError(path, "cannot write image: " + reason);
+}
+
+RgbaImage read_image_rgba(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) throw AssetNotFound(path, "image");
+  cv::Mat in;
+  try {
+    in = cv::imread(path, cv::IMREAD_UNCHANGED);
+  } catch (const cv::Exception& e) {
+    throw ConfigError(path, std::string("cannot read image: ") + e.what());
+  }
+  if (in.empty()) throw ConfigError(path, "cannot read image: not a format OpenCV decodes");
+  if (in.depth() == CV_16U) in.convertTo(in, CV_8U, 1.0 / 257.0);
+  if (in.depth() != CV_8U) throw ConfigError(path, "image must hold 8- or 16-bit pixels");
+  cv::Mat rgba;
+  switch (in.channels()) {
+    case 1:
+      cv::cvtColor(in, rgba, cv::COLOR_GRAY2RGBA);
+      break;
+    case 3:
+      cv::cvtColor(in, rgba, cv::COLOR_BGR2RGBA);
+      break;
+    case 4:
+      cv::cvtColor(in, rgba, cv::COLOR_BGRA2RGBA);
+      break;
+    default:
+      throw ConfigError(
+          path, "image has " + std::to_string(in.channels()) + " channels: expected 1, 3 or 4");
+  }
+  RgbaImage out;
+  out.width = rgba.cols;
+  out.height = rgba.rows;
+  out.pixels.resize(static_cast<std::size_t>(rgba.cols) * rgba.rows * 4);
+  for (int r = 0; r < rgba.rows; ++r) {
+    std::copy_n(rgba.ptr<std::uint8_t>(r), rgba.cols * 4,
+                out.pixels.data() + static_cast<std::size_t>(r) * rgba.cols * 4);
+  }
+  return out;
 }
 
 }  // namespace ambfplus

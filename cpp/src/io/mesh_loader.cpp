@@ -2,6 +2,7 @@
 #include <assimp/scene.h>
 #include <assimp/Importer.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -12,6 +13,26 @@
 #include "ambfplus/io/mesh.h"
 
 namespace ambfplus {
+namespace {
+
+// The diffuse texture a material names, relative to the mesh file; "" for none or an embedded
+// one ("*0"), which is not read.
+std::string diffuse_texture(const aiMaterial& material, const std::string& mesh_path) {
+  aiString name;
+  if (material.GetTextureCount(aiTextureType_DIFFUSE) == 0 ||
+      material.GetTexture(aiTextureType_DIFFUSE, 0, &name) != AI_SUCCESS || name.length == 0 ||
+      name.C_Str()[0] == '*') {
+    return "";
+  }
+  std::string file = name.C_Str();
+  std::replace(file.begin(), file.end(), '\\', '/');
+  const std::filesystem::path p(file);
+  return (p.is_absolute() ? p : std::filesystem::path(mesh_path).parent_path() / p)
+      .lexically_normal()
+      .string();
+}
+
+}  // namespace
 
 MeshData load_mesh(const std::string& path, double scale) {
   std::error_code ec;
@@ -33,6 +54,11 @@ MeshData load_mesh(const std::string& path, double scale) {
     throw ConfigError(path, std::string("cannot read mesh: ") + importer.GetErrorString());
   }
   MeshData mesh;
+  // Texture coordinates when any mesh has them (0, 0 for those that do not, to stay aligned).
+  bool textured = false;
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+    textured = textured || scene->mMeshes[m]->HasTextureCoords(0);
+  }
   for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
     const aiMesh* in = scene->mMeshes[m];
     if (!(in->mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) continue;
@@ -45,6 +71,14 @@ MeshData load_mesh(const std::string& path, double scale) {
         mesh.positions.push_back(static_cast<float>(c * scale));
       }
       mesh.normals.insert(mesh.normals.end(), {n.x, n.y, n.z});
+      if (textured) {
+        const aiVector3D t = in->HasTextureCoords(0) ? in->mTextureCoords[0][v] : aiVector3D();
+        mesh.texcoords.insert(mesh.texcoords.end(), {t.x, t.y});
+      }
+    }
+    if (mesh.texture.empty() && in->HasTextureCoords(0) && scene->mMaterials != nullptr &&
+        in->mMaterialIndex < scene->mNumMaterials) {
+      mesh.texture = diffuse_texture(*scene->mMaterials[in->mMaterialIndex], path);
     }
     for (unsigned f = 0; f < in->mNumFaces; ++f) {
       const aiFace& face = in->mFaces[f];

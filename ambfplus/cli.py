@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import ScriptedDevice, Simulator, __version__, gl_info, write_image
+from . import PluginError, ScriptedDevice, Simulator, __version__, gl_info, write_image
 from .plugins import cmake_dir
 from .volumes import convert_volume
 
@@ -194,10 +194,33 @@ def indices(text: str) -> list[int]:
         raise argparse.ArgumentTypeError(f"expected launch indices like 0,2 got '{text}'") from None
 
 
+def run_check_plugins(args: argparse.Namespace) -> int:
+    """Loads each plugin file in a probe process; exit code 1 if any is refused."""
+    from .plugin_probe import probe_plugin
+
+    refused = 0
+    for plugin in args.plugins:
+        try:
+            result = probe_plugin(plugin, timeout=args.timeout)
+        except PluginError as error:
+            print(error)
+            refused += 1
+            continue
+        print(result.message)
+        refused += not result.ok
+    return 1 if refused else 0
+
+
 def run_launch(args: argparse.Namespace) -> int:
     """Loads an AMBF launch file headless like AMBF's -l/-a, steps it, prints what loaded."""
     extra = [Path(p) for p in args.a.split(",") if p] if args.a else []
     plugins = [p for p in args.plugins.split(",") if p] if args.plugins else []
+    if args.check_plugins:
+        from .plugin_probe import check_plugin, resolve
+
+        for plugin in plugins:
+            if resolve(plugin) is not None:
+                check_plugin(plugin)
     sim = Simulator.from_launch(
         args.launch_file,
         models=args.l,
@@ -387,6 +410,19 @@ def main(argv: list[str] | None = None) -> int:
         help="simulator plugins to load after the launch file's, comma separated "
         "(libx.so, x.py, a path, or a name searched in AMBFPLUS_PLUGIN_PATH)",
     )
+    launch.add_argument(
+        "--check-plugins",
+        action="store_true",
+        help="load each --plugins file in a probe process first and refuse one whose probe "
+        "crashes, hangs or fails",
+    )
+    check = commands.add_parser(
+        "check-plugins",
+        help="load plugin files in probe processes (their static initialisers run there, not "
+        "here); exit 1 if any crashes, hangs or fails",
+    )
+    check.add_argument("plugins", nargs="+", help="plugin files (.so, .py) or names")
+    check.add_argument("--timeout", type=float, default=60.0, help="seconds a probe may take")
     validate = commands.add_parser(
         "validate",
         help="check a recording (ambfplus.recording) or a dataset folder (its manifest and "
@@ -475,6 +511,8 @@ def main(argv: list[str] | None = None) -> int:
         return run_dataset(args)
     if args.command == "launch":
         return run_launch(args)
+    if args.command == "check-plugins":
+        return run_check_plugins(args)
     if args.command == "export":
         return run_export(args)
     if args.command == "demo":

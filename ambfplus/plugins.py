@@ -11,6 +11,13 @@ first :class:`Plugin` subclass the file defines. The engine calls its hooks with
 each call only (``World.step`` releases it). A hook that raises is logged once with its traceback
 and the plugin is disabled; the simulation goes on. ``init`` raising is a :class:`PluginError`.
 
+Trust: a plugin runs inside the process that loads it. A C++ plugin's static initialisers (global
+objects' constructors) run during ``dlopen``, before the engine can check its entry point, and a
+Python plugin's module-level code runs on import: one that throws or crashes there takes the
+process down, whatever the engine does. For a plugin you do not trust, ``load_plugin(path,
+probe=True)`` (or ``ambfplus check-plugins FILE...``, ``ambfplus launch --check-plugins``) loads
+it in a probe process first and refuses it with the probe's output when that process fails.
+
 Handles (``self.world``, ``self.object``, ...) are made on each access and each keeps the
 simulator alive, as every handle does. The simulator keeps its plugins, so a handle stored on a
 plugin is a cycle the garbage collector cannot see (the simulator then lives until the process
@@ -179,6 +186,29 @@ def _from_entry_point(name: str):
 
 # The engine makes Python plugins through these (it never imports this package itself).
 _core._register_plugin_support(Plugin, _from_file, _from_entry_point)
+
+
+def _with_probe(native):
+    """World/Simulator.load_plugin with ``probe=``: a plugin file is first loaded in a probe
+    process (``ambfplus.plugin_probe``) and refused with the probe's message unless that ends
+    cleanly, since a C++ plugin's static initialisers run inside the process that loads it."""
+
+    def load_plugin(self, plugin, *args, probe: bool = False, **kwargs):
+        if probe and isinstance(plugin, (str, os.PathLike)):
+            from .plugin_probe import check_plugin
+
+            check_plugin(plugin)
+        return native(self, plugin, *args, **kwargs)
+
+    load_plugin.__doc__ = (native.__doc__ or "") + (
+        "\n\nprobe=True loads a plugin file in a probe process first and raises PluginError "
+        "with the probe's output when that process crashes, hangs or fails."
+    )
+    return load_plugin
+
+
+_core.World.load_plugin = _with_probe(_core.World.load_plugin)
+_core.Simulator.load_plugin = _with_probe(_core.Simulator.load_plugin)
 
 
 def cmake_dir() -> str:

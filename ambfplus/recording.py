@@ -101,6 +101,14 @@ start, replaced atomically), every renamed part, and at most one ``.tmp`` file t
 ignore: every frame up to the last flush survives with its exact bytes. The price is one file per
 flush interval; raise ``flush_interval_s`` for long sessions if that matters more than the
 seconds at risk. Surviving power loss as well would need fsync, which this does not do.
+
+Failed writes: a part is built in memory (HDF5's core driver) and its bytes are written to its
+``.tmp`` file in one go when it closes, so HDF5 never meets a failing disk (after such errors its
+open objects crash the process when they are freed). A full disk or an I/O error removes that
+``.tmp``, ends the recording at its last closed part and raises ``RecordingError`` from the next
+call (``add_*``, ``flush``, ``close``, every later ``close`` too); the process exits cleanly
+whichever way the recorder is then closed, or if it is not. The price is one part's data in
+memory (``flush_interval_s`` of the session, compressed).
 """
 
 from __future__ import annotations
@@ -154,7 +162,7 @@ from .recording_schema import (
     temporary_name,
     to_json,
 )
-from .recording_validate import Check, ValidationReport, validate
+from .recording_validate import Check, ValidationReport, leftover_files, validate
 from .stereo import legend as object_legend
 
 __all__ = [
@@ -221,6 +229,20 @@ class _Rows:
 class _Legend:
     text: str
     nbytes: int = 0
+
+
+@dataclass
+class _Batch:
+    """Rows that must land in the same part (a stereo pair's two views and its rig row): a part
+    boundary never splits them, so a recording cut at any moment holds whole pairs."""
+
+    items: list
+    nbytes: int = 0
+    frames: int = 0
+
+    def __post_init__(self) -> None:
+        self.nbytes = sum(item.nbytes for item in self.items)
+        self.frames = sum(getattr(item, "frames", 0) for item in self.items)
 
 
 @dataclass
@@ -393,7 +415,7 @@ class Recorder:
         producer lock, so that a stereo pair's row indices stay right)."""
         for item in rows:
             self._register(item)
-        self._enqueue(rows)
+        self._enqueue([_Batch(rows)] if len(rows) > 1 else rows)
         for item in rows:
             self._rows_queued[item.group] = self._rows_queued.get(item.group, 0) + item.count
 
@@ -491,7 +513,10 @@ class Recorder:
 
     def _write(self, item) -> None:
         """Writes one queued item (runs on the writer thread)."""
-        if isinstance(item, _Rows):
+        if isinstance(item, _Batch):
+            for rows in item.items:
+                self._write(rows)
+        elif isinstance(item, _Rows):
             if self._part is None:
                 number = len(self._parts) + 1
                 self._part = _PartFile(part_name(self.path, number), self._head, self.compression)
@@ -521,7 +546,8 @@ class Recorder:
         write_head(self.path, self._head, self._parts, complete=True)
 
     def _abandon_part(self) -> None:
-        """After a failure the open part is left as its .tmp file, which readers ignore."""
+        """After a failure the part being built (in memory) is dropped: the recording ends at
+        its last closed part."""
         if self._part is not None:
             try:
                 self._part.file.close()
@@ -740,14 +766,39 @@ class _HeadInfo:
     legend: str = "{}"
 
 
+def _memory_file(path: Path, **options) -> h5py.File:
+    """An HDF5 file built in memory (HDF5's core driver, nothing on disk): HDF5 itself then never
+    meets a failing disk, whose errors leave its open objects in a state that crashes the
+    process when they are freed (at interpreter exit at the latest)."""
+    return h5py.File(path, "w", driver="core", backing_store=False, block_size=4 * MiB, **options)
+
+
+def _store(file: h5py.File, path: Path) -> None:
+    """Closes an in-memory file and writes its bytes to ``path`` atomically: as ``<path>.tmp``,
+    renamed into place. A failed write (disk full, I/O error) removes the partial ``.tmp`` and
+    raises the OSError."""
+    file.flush()
+    image = file.id.get_file_image()
+    file.close()
+    tmp = temporary_name(path)
+    try:
+        with open(tmp, "wb") as out:
+            out.write(image)
+    except OSError:
+        tmp.unlink(missing_ok=True)
+        raise
+    os.replace(tmp, path)
+
+
 class _PartFile:
-    """The segment being written, as ``<part>.tmp`` until ``close`` renames it into place."""
+    """The segment being written, built in memory until ``close`` writes it to ``<part>.tmp``
+    and renames it into place."""
 
     def __init__(self, path: Path, head: _HeadInfo, compression: str | None) -> None:
         self.path = path
         self.compression = compression
         self.tmp = temporary_name(path)
-        self.file = h5py.File(self.tmp, "w")
+        self.file = _memory_file(self.tmp)
         self.file.attrs.update(
             {
                 "format": FORMAT,
@@ -807,8 +858,7 @@ class _PartFile:
         for group, name in list(self._buffers):
             self._write_buffer(group, name)
         self._datasets.clear()
-        self.file.close()
-        os.replace(self.tmp, self.path)
+        _store(self.file, self.path)
         return self.summary
 
 
@@ -860,8 +910,8 @@ def _prepare_path(path: Path, overwrite: bool) -> None:
 def write_head(path: Path, head: _HeadInfo, parts: list[PartSummary], complete: bool) -> None:
     """Writes the head file atomically: description, and when complete, virtual datasets that
     concatenate the parts."""
-    tmp = temporary_name(path)
-    with h5py.File(tmp, "w", libver=("v110", "latest")) as f:
+    f = _memory_file(path, libver=("v110", "latest"))
+    try:
         f.attrs.update(
             {
                 "format": FORMAT,
@@ -880,7 +930,10 @@ def write_head(path: Path, head: _HeadInfo, parts: list[PartSummary], complete: 
         f.create_group("conventions").attrs.update(CONVENTIONS)
         if complete:
             _write_virtual_datasets(f, parts)
-    os.replace(tmp, path)
+    except BaseException:
+        f.close()
+        raise
+    _store(f, path)
 
 
 def _write_virtual_datasets(f: h5py.File, parts: list[PartSummary]) -> None:
@@ -922,9 +975,11 @@ def _virtual_dataset(group: h5py.Group, name: str, dtype, shape: tuple, sources:
 
 def repair(path) -> Recording:
     """Completes the head of a recording whose recorder did not close (a crash): virtual
-    datasets over every closed part, so that plain h5py reads it as one file. Returns it
-    opened."""
+    datasets over every closed part, so that plain h5py reads it as one file, and removes the
+    unfinished files it left (its last part's ``.tmp``). Returns it opened."""
     path = Path(path)
+    for leftover in leftover_files(path):
+        leftover.unlink()
     with open_recording(path) as recording:
         parts = scan_parts(path, recording.recording_id)
         with h5py.File(path, "r") as f:

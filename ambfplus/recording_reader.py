@@ -7,6 +7,7 @@ import bisect
 import json
 from collections import OrderedDict
 from collections.abc import Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -77,12 +78,34 @@ class RecordedFrame:
         )
 
 
+# What h5py raises where a file is damaged: HDF5's errors surface as any of these, depending on
+# where the damage is met (metadata, chunk index, attributes, data).
+_DAMAGE = (OSError, RuntimeError, KeyError, ValueError, TypeError, AttributeError, IndexError)
+
+
+@contextmanager
+def _damage_is_an_error(path, what: str):
+    """Turns what h5py raises for a damaged file into a RecordingError naming the file."""
+    try:
+        yield
+    except RecordingError:
+        raise
+    except _DAMAGE as error:
+        raise RecordingError(
+            f"{path}: damaged file: {what} failed ({type(error).__name__}: {error})"
+        ) from error
+
+
 class Recording:
     """A recording opened for reading: ``cameras``, ``rigs``, ``steps``, ``removed``,
     ``events``, ``metadata``, ``legend``, ``version``. Arrays are read when indexed."""
 
     def __init__(self, path) -> None:
         self.path = Path(path)
+        with _damage_is_an_error(self.path, "reading the recording's structure"):
+            self._open()
+
+    def _open(self) -> None:
         head = _read_head(self.path)
         self.version: int = head["version"]
         self.recording_id: str = head["recording_id"]
@@ -144,15 +167,16 @@ class Recording:
         if "events" not in self._groups:
             return []
         c = {name: column[:] for name, column in self._columns("events").items()}
-        return [
-            {
-                "step": int(c["step"][i]),
-                "kind": str(c["kind"][i]),
-                "label": int(c["label"][i]),
-                "voxel": tuple(int(v) for v in c["voxel"][i]),
-            }
-            for i in range(len(c["step"]))
-        ]
+        with _damage_is_an_error(self.path, "reading events"):
+            return [
+                {
+                    "step": int(c["step"][i]),
+                    "kind": str(c["kind"][i]),
+                    "label": int(c["label"][i]),
+                    "voxel": tuple(int(v) for v in c["voxel"][i]),
+                }
+                for i in range(len(c["step"]))
+            ]
 
     def close(self) -> None:
         self._files.close()
@@ -227,7 +251,8 @@ class Column(Sequence):
 
     def _read_row(self, index: int):
         piece = bisect.bisect_right(self._starts, index) - 1
-        return self._dataset(piece)[index - self._starts[piece]]
+        with _damage_is_an_error(self._files.path(self._parts[piece]), f"reading {self.path}"):
+            return self._dataset(piece)[index - self._starts[piece]]
 
     def _read_rows(self, indices) -> np.ndarray:
         rows = [self._read_row(i) for i in indices]
@@ -239,7 +264,9 @@ class Column(Sequence):
             lo, hi = max(start, self._starts[piece]), min(stop, self._starts[piece + 1])
             if lo < hi:
                 offset = self._starts[piece]
-                chunks.append(np.asarray(self._dataset(piece)[lo - offset : hi - offset]))
+                part = self._files.path(self._parts[piece])
+                with _damage_is_an_error(part, f"reading {self.path}"):
+                    chunks.append(np.asarray(self._dataset(piece)[lo - offset : hi - offset]))
         return np.concatenate(chunks) if chunks else self._empty()
 
     def _empty(self) -> np.ndarray:
@@ -329,6 +356,9 @@ class _PartFiles:
     def __init__(self, paths: list[Path]) -> None:
         self._paths = paths
         self._open: OrderedDict[int, h5py.File] = OrderedDict()
+
+    def path(self, index: int) -> Path:
+        return self._paths[index]
 
     def get(self, index: int) -> h5py.File:
         f = self._open.get(index)

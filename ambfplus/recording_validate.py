@@ -8,8 +8,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .recording_reader import CameraStream, Recording, RigStream, open_recording
-from .recording_schema import RecordingError
+from .recording_reader import _DAMAGE, CameraStream, Recording, RigStream, open_recording
+from .recording_schema import RecordingError, glob_escape
 from .stereo import disparity_agreement
 
 POINTS_RELATIVE_TOLERANCE = 1e-4
@@ -89,16 +89,20 @@ def validate(path, match_images: bool = True) -> ValidationReport:
     except (RecordingError, OSError) as error:
         return ValidationReport(path, [Check("open", "fail", str(error))])
     with recording:
-        checks = [_open_check(recording)]
-        for name, stream in recording.cameras.items():
-            checks += _stream_checks(f"cameras/{name}", stream)
-        for name, rig in recording.rigs.items():
-            checks += _rig_checks(f"rigs/{name}", rig, match_images)
-        checks += _steps_checks(recording.steps)
-        checks += _removed_checks(recording)
-        checks += _log_order_checks(recording)
-        for name, stream in recording.cameras.items():
-            checks.append(_removed_visibility_check(f"cameras/{name}", stream, recording))
+        checks = [_open_check(recording), _leftover_check(path)]
+        try:
+            for name, stream in recording.cameras.items():
+                checks += _stream_checks(f"cameras/{name}", stream)
+            for name, rig in recording.rigs.items():
+                checks += _rig_checks(f"rigs/{name}", rig, match_images)
+            checks += _steps_checks(recording.steps)
+            checks += _removed_checks(recording)
+            checks += _log_order_checks(recording)
+            for name, stream in recording.cameras.items():
+                checks.append(_removed_visibility_check(f"cameras/{name}", stream, recording))
+        except (RecordingError, *_DAMAGE) as error:
+            # Data that cannot be read or does not have the layout's shapes and types.
+            checks.append(Check("read", "fail", f"{type(error).__name__}: {error}"))
     return ValidationReport(path, checks)
 
 
@@ -195,6 +199,7 @@ def _rig_checks(name: str, rig: RigStream, match_images: bool = True) -> list[Ch
         checks.append(Check(f"{name}: frame indices", "fail", "a pair points past its streams"))
         return checks
     checks.append(Check(f"{name}: frame indices", "pass", "", {"pairs": len(left)}))
+    checks.append(_views_paired_check(name, rig, left, right))
     checks.append(_pair_steps_check(name, rig, left, right))
     checks += _rig_geometry_checks(name, rig, left, right)
     if match_images:
@@ -229,6 +234,51 @@ def _disparity_check(name: str, rig: RigStream) -> Check:
         f"median error {median:.2f} px (<= {DISPARITY_MEDIAN_PX}), baseline off by "
         f"{baseline_error:.1%} (<= {DISPARITY_BASELINE_REL:.0%})",
         numbers,
+    )
+
+
+def _views_paired_check(name: str, rig: RigStream, left, right) -> Check:
+    """The rig's two streams hold the same number of frames and every frame is in a pair: a
+    view without its other half means a pair was cut (a recording interrupted inside it)."""
+    title = f"{name}: both views of every pair recorded"
+    counts = {"left": len(rig.left), "right": len(rig.right), "pairs": len(left)}
+    unpaired = {
+        "left": len(rig.left) - len(np.unique(left)),
+        "right": len(rig.right) - len(np.unique(right)),
+    }
+    if counts["left"] == counts["right"] and not any(unpaired.values()):
+        return Check(title, "pass", "", counts)
+    detail = (
+        f"stream {rig.left.name} has {counts['left']} frames and {rig.right.name} "
+        f"{counts['right']} for {counts['pairs']} pairs ({unpaired['left']} and "
+        f"{unpaired['right']} frames in no pair): a stereo pair was cut"
+    )
+    return Check(
+        title, "fail", detail, {**counts, **{f"unpaired_{k}": v for k, v in unpaired.items()}}
+    )
+
+
+def leftover_files(path: Path) -> list[Path]:
+    """Unfinished files a recorder that did not close left beside ``path``: its last part's
+    ``.partNNNN.tmp`` and a head being rewritten (``.tmp``). Readers ignore them."""
+    escaped = glob_escape(path.name)
+    found = list(path.parent.glob(escaped + ".part*.tmp")) + list(
+        path.parent.glob(escaped + ".tmp")
+    )
+    return sorted(found)
+
+
+def _leftover_check(path: Path) -> Check:
+    found = leftover_files(path)
+    if not found:
+        return Check("no unfinished files", "pass")
+    names = ", ".join(p.name for p in found)
+    return Check(
+        "no unfinished files",
+        "warn",
+        f"{names}: left by a recorder that did not close; readers ignore them and "
+        "ambfplus.recording.repair(path) removes them",
+        {"files": len(found)},
     )
 
 

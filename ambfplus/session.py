@@ -95,6 +95,7 @@ def record_session(
             "name": scene.device_name,
             "kind": type(device).__name__,
             "options": _serialisable_options(scene.device_options),
+            "spec": dict(device.spec),
         },
         "capture_every": capture_every,
         "passes": list(passes),
@@ -190,13 +191,25 @@ def replay(
         scene = build_scene(spec)
         world, drill, rig = scene.world, scene.drill, scene.rig
         device = meta["device"]
-        binding = _bind(scene, ReplayDevice(device_log(steps, device["name"])), device["options"])
+        replay_device = ReplayDevice(device_log(steps, device["name"]))
+        options = _replay_options(device)
+        binding = _bind(scene, replay_device, options)
         passes = tuple(passes or meta.get("passes", PASSES))
         step_to = _stepper(world, steps, device["options"].get("reference"))
         world.start_step_log(list(scene.logged) + [binding])
         recorder = None
         if out is not None:
-            recorder = Recorder(out, metadata={**meta, "scene": spec, "replay_of": str(path)})
+            replayed_device = {
+                "name": device["name"],
+                "kind": type(replay_device).__name__,
+                "options": _serialisable_options(options),
+                "spec": dict(replay_device.spec),
+                "replays": {k: v for k, v in device.items() if k != "replays"},
+            }
+            recorder = Recorder(
+                out,
+                metadata={**meta, "scene": spec, "device": replayed_device, "replay_of": str(path)},
+            )
             recorder.set_legend(world)
         identical_frames, new_forces, new_removed = 0, [], []
         started = time.perf_counter()
@@ -243,6 +256,16 @@ def replay(
         output=Path(out) if out is not None else None,
         differences=differences,
     )
+
+
+def _replay_options(device: dict) -> dict:
+    """The recorded binding's options, with the force limit the recorded device set (a
+    ReplayDevice sets none), so that the replay's device force equals the recording's."""
+    options = dict(device["options"])
+    recorded_limit = device.get("spec", {}).get("max_force")
+    if recorded_limit is not None:
+        options["max_force"] = min(float(options.get("max_force", np.inf)), float(recorded_limit))
+    return options
 
 
 def _stepper(world, steps: dict, reference: str | None) -> Callable[[int], None]:

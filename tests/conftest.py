@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import subprocess
 import time
@@ -130,3 +131,19 @@ def reference_dataset(dataset_spec, tmp_path_factory) -> Path:
     out = tmp_path_factory.mktemp("reference") / "data"
     generate(dataset_spec, out, workers=1, progress=False)
     return out
+
+
+# Long measurements run only when asked for: `pytest -m benchmark`. (Fuzz-marked tests run
+# wherever atheris is installed, as in CI; `-m "not fuzz"` leaves them out.)
+OPT_IN_MARKS = ("benchmark",)
+
+
+def pytest_collection_modifyitems(config, items):
+    asked = config.getoption("markexpr") or ""
+    for mark in OPT_IN_MARKS:
+        if re.search(rf"(?<!not )\b{mark}\b", asked):
+            continue
+        skip = pytest.mark.skip(reason=f"long test: run it with pytest -m {mark}")
+        for item in items:
+            if mark in item.keywords:
+                item.add_marker(skip)

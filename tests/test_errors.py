@@ -185,7 +185,14 @@ def test_write_image_errors(tmp_path):
     with pytest.raises(TypeError, match="uint8 or uint16"):
         ambfplus.write_image(str(tmp_path / "x.png"), np.zeros((4, 4), np.float32))
     with pytest.raises(ambfplus.ConfigError, match="channels"):
-        ambfplus.write_image(str(tmp_path / "x.png"), np.zeros((4, 4, 2), np.uint8))
+        ambfplus.write_image(str(tmp_path / "x.png"), np.zeros((4, 4, 5), np.uint8))
+    with pytest.raises(ambfplus.ConfigError, match="expected .png, .jpg or .jpeg"):
+        ambfplus.write_image(str(tmp_path / "x.bmp"), np.zeros((4, 4), np.uint8))
+    with pytest.raises(ambfplus.ConfigError, match="JPEG has no alpha"):
+        ambfplus.write_image(str(tmp_path / "x.jpg"), np.zeros((4, 4, 4), np.uint8))
+    with pytest.raises(ambfplus.ConfigError, match="JPEG holds 8-bit pixels only"):
+        ambfplus.write_image(str(tmp_path / "x.jpg"), np.zeros((4, 4), np.uint16))
+    assert not list(tmp_path.iterdir()), "no partial file is left behind"
 
 
 def test_negative_step_is_refused():

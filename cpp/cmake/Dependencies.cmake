@@ -21,25 +21,13 @@ add_library(ambfplus_dep_assimp INTERFACE)
 target_link_libraries(ambfplus_dep_assimp INTERFACE assimp::assimp)
 add_library(ambfplus::dep_assimp ALIAS ambfplus_dep_assimp)
 
-# OpenCV: image files; only the modules the engine uses. Debian ships OpenCVConfig.cmake only in
-# the all-modules libopencv-dev, so without it the per-module -dev packages are found directly.
-set(_opencv_modules core imgproc imgcodecs)
-add_library(ambfplus_dep_opencv INTERFACE)
-find_package(OpenCV QUIET CONFIG COMPONENTS ${_opencv_modules})
-if(OpenCV_FOUND)
-  foreach(_m ${_opencv_modules})
-    target_link_libraries(ambfplus_dep_opencv INTERFACE opencv_${_m})
-  endforeach()
-else()
-  find_path(AMBFPLUS_OPENCV_INCLUDE_DIR opencv2/core.hpp PATH_SUFFIXES opencv4 REQUIRED)
-  target_include_directories(ambfplus_dep_opencv INTERFACE ${AMBFPLUS_OPENCV_INCLUDE_DIR})
-  foreach(_m ${_opencv_modules})
-    find_library(AMBFPLUS_OPENCV_${_m}_LIBRARY opencv_${_m} REQUIRED)
-    target_link_libraries(ambfplus_dep_opencv INTERFACE ${AMBFPLUS_OPENCV_${_m}_LIBRARY})
-  endforeach()
-  message(STATUS "OpenCV modules ${_opencv_modules} in ${AMBFPLUS_OPENCV_INCLUDE_DIR}")
-endif()
-add_library(ambfplus::dep_opencv ALIAS ambfplus_dep_opencv)
+# libpng and libjpeg(-turbo): image files (PNG, JPEG), read and written directly, permissively
+# licensed and without the codecs, geodata and video libraries a general image library brings.
+find_package(PNG REQUIRED)
+find_package(JPEG REQUIRED)
+add_library(ambfplus_dep_image INTERFACE)
+target_link_libraries(ambfplus_dep_image INTERFACE PNG::PNG JPEG::JPEG)
+add_library(ambfplus::dep_image ALIAS ambfplus_dep_image)
 
 # OpenGL through EGL; libepoxy resolves GL and EGL entry points at run time.
 find_package(OpenGL REQUIRED COMPONENTS EGL OpenGL)

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstddef>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -8,10 +9,76 @@
 
 namespace ambfplus {
 
-/// Base of every error the engine raises on purpose.
+namespace detail {
+
+/// Length of the well-formed UTF-8 sequence starting at s[i] (1 to 4), or 0 when none starts there.
+inline std::size_t utf8_sequence_length(const std::string& s, std::size_t i) {
+  const auto byte = [&](std::size_t k) { return static_cast<unsigned char>(s[k]); };
+  const unsigned char c = byte(i);
+  if (c < 0x80) return 1;
+  std::size_t n = 0;
+  unsigned char lo = 0x80, hi = 0xBF;  // the allowed range of the second byte
+  if (c >= 0xC2 && c <= 0xDF) {
+    n = 2;
+  } else if (c >= 0xE0 && c <= 0xEF) {
+    n = 3;
+    if (c == 0xE0) lo = 0xA0;  // no overlong forms
+    if (c == 0xED) hi = 0x9F;  // no surrogates
+  } else if (c >= 0xF0 && c <= 0xF4) {
+    n = 4;
+    if (c == 0xF0) lo = 0x90;
+    if (c == 0xF4) hi = 0x8F;  // nothing beyond U+10FFFF
+  } else {
+    return 0;
+  }
+  if (i + n > s.size() || byte(i + 1) < lo || byte(i + 1) > hi) return 0;
+  for (std::size_t k = 2; k < n; ++k) {
+    if (byte(i + k) < 0x80 || byte(i + k) > 0xBF) return 0;
+  }
+  return n;
+}
+
+/// Offset of the first byte of s that is not valid UTF-8, or s.size() when all of it is.
+inline std::size_t utf8_error_offset(const std::string& s) {
+  std::size_t i = 0;
+  while (i < s.size()) {
+    const std::size_t n = utf8_sequence_length(s, i);
+    if (n == 0) return i;
+    i += n;
+  }
+  return i;
+}
+
+/// s with every byte that is not valid UTF-8 written as \xNN, so that a message quoting a
+/// broken file still reaches Python as text.
+inline std::string printable_utf8(const std::string& s) {
+  if (utf8_error_offset(s) == s.size()) return s;
+  static const char kHex[] = "0123456789abcdef";
+  std::string out;
+  std::size_t i = 0;
+  while (i < s.size()) {
+    const std::size_t n = utf8_sequence_length(s, i);
+    if (n > 0) {
+      out.append(s, i, n);
+      i += n;
+      continue;
+    }
+    const auto c = static_cast<unsigned char>(s[i++]);
+    out += "\\x";
+    out += kHex[c >> 4];
+    out += kHex[c & 15];
+  }
+  return out;
+}
+
+}  // namespace detail
+
+/// Base of every error the engine raises on purpose. Its message is always valid UTF-8 (bytes
+/// that are not are escaped as \xNN).
 class AMBFPLUS_API Error : public std::runtime_error {
  public:
-  explicit Error(const std::string& message) : std::runtime_error(message) {}
+  explicit Error(const std::string& message)
+      : std::runtime_error(detail::printable_utf8(message)) {}
 };
 
 /// A scene or data file that cannot be used: names the file, the key or line, and what was

@@ -1,6 +1,7 @@
 #include "ambfplus/adf/volume_adf.h"
 #include "ambfplus/errors.h"
 
+#include <cmath>
 #include <filesystem>
 
 #include "adf/adf_internal.h"
@@ -13,6 +14,27 @@ namespace ambfplus {
 
 using adf::Doc;
 
+namespace {
+
+// A volume's size: {x, y, z} in metres, each given, finite and positive (1 m each when absent).
+Eigen::Vector3d volume_dimensions(const Doc& doc, const YAML::Node& node, const std::string& id) {
+  if (!node) return Eigen::Vector3d::Ones();
+  if (!node.IsMap()) adf::fail(doc, node, id, "'dimensions' must be {x, y, z} in metres");
+  Eigen::Vector3d v;
+  const char* axes[3] = {"x", "y", "z"};
+  for (int a = 0; a < 3; ++a) {
+    const std::string key = std::string("dimensions.") + axes[a];
+    if (!node[axes[a]]) adf::fail(doc, node, id, "'" + key + "' is missing");
+    v[a] = adf::number(doc, node[axes[a]], id, key);
+    if (!std::isfinite(v[a]) || !(v[a] > 0)) {
+      adf::fail(doc, node[axes[a]], id, "'" + key + "' must be a positive finite length (m)");
+    }
+  }
+  return v;
+}
+
+}  // namespace
+
 std::vector<AdfVolumeBlock> read_adf_volumes(const std::string& path) {
   const Doc doc = adf::load(path, "ADF file");
   std::vector<AdfVolumeBlock> out;
@@ -22,8 +44,10 @@ std::vector<AdfVolumeBlock> read_adf_volumes(const std::string& path) {
     v.name = adf::block_name(doc, id, block);
     v.pose = adf::frame(doc, block["location"], id, "location");
     const double scale = adf::number_or(doc, block, "scale", id, 1.0);
-    v.images.dimensions =
-        adf::xyz(doc, block["dimensions"], id, "dimensions", Eigen::Vector3d::Ones()) * scale;
+    if (!std::isfinite(scale) || !(scale > 0)) {
+      adf::fail(doc, block["scale"], id, "'scale' must be a positive finite number");
+    }
+    v.images.dimensions = volume_dimensions(doc, block["dimensions"], id) * scale;
     const YAML::Node images = block["images"];
     if (!images || !images["path"]) {
       adf::fail(doc, block, id, "needs images: {path, prefix, format, count}");
@@ -31,7 +55,14 @@ std::vector<AdfVolumeBlock> read_adf_volumes(const std::string& path) {
     v.images.folder = adf::resolve(doc.dir, adf::text(doc, images["path"], id, "images.path"));
     if (images["prefix"]) v.images.prefix = adf::text(doc, images["prefix"], id, "images.prefix");
     if (images["format"]) v.images.format = adf::text(doc, images["format"], id, "images.format");
-    if (images["count"]) v.images.count = adf::integer(doc, images["count"], id, "images.count");
+    if (images["count"]) {
+      v.images.count = adf::integer(doc, images["count"], id, "images.count");
+      if (v.images.count < 1) {
+        adf::fail(doc, images["count"], id,
+                  "'images.count' must be the number of slices (>= 1), got " +
+                      std::to_string(v.images.count));
+      }
+    }
     if (block["labels"]) {
       v.labels = adf::resolve(doc.dir, adf::text(doc, block["labels"], id, "labels"));
     }
@@ -137,7 +168,11 @@ std::vector<Volume*> adf::add_adf_volumes(Model& model, const std::string& path,
     if (!table.empty()) images.labels = read_label_table(table);
     VolumeSpec spec;
     spec.name = b.name;
-    spec.data = load_slice_stack(images);
+    try {
+      spec.data = load_slice_stack(images);
+    } catch (const ArgumentError& e) {
+      throw ConfigError(path, b.identifier + ": " + e.what());
+    }
     spec.pose = b.pose;
     spec.iso = b.iso;
     spec.quality = b.quality;

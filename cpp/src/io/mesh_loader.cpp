@@ -3,16 +3,22 @@
 #include <assimp/Importer.hpp>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <mutex>
+#include <sstream>
 #include <system_error>
 
 #include "ambfplus/errors.h"
 #include "ambfplus/io/mesh.h"
+#include "io/ply_check.h"
 
 namespace ambfplus {
+
 namespace {
 
 // The diffuse texture a material names, relative to the mesh file; "" for none or an embedded
@@ -32,6 +38,66 @@ std::string diffuse_texture(const aiMaterial& material, const std::string& mesh_
       .string();
 }
 
+// The file's bytes, for the checks assimp cannot be trusted to make itself.
+std::string read_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw ConfigError(path, std::string("cannot open the mesh: ") + std::strerror(errno));
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+bool starts_with_ply(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  char head[5] = {};
+  in.read(head, sizeof(head));
+  return io::looks_like_ply(std::string(head, static_cast<std::size_t>(in.gcount())));
+}
+
+// Our own checks of what assimp produced: faces name vertices of their mesh, and every position
+// is finite (normals of degenerate triangles are replaced, not trusted).
+// With textured, texture coordinates too ((0, 0) for a mesh without them).
+void append_mesh(const std::string& path, const aiMesh& in, double scale, bool textured,
+                 MeshData& mesh) {
+  const auto base = static_cast<std::uint32_t>(mesh.vertex_count());
+  for (unsigned v = 0; v < in.mNumVertices; ++v) {
+    const aiVector3D& p = in.mVertices[v];
+    for (float c : {p.x, p.y, p.z}) {
+      if (!std::isfinite(c)) {
+        throw ConfigError(path, "vertex " + std::to_string(v) + " of mesh '" +
+                                    std::string(in.mName.C_Str()) + "' has non-finite coordinates");
+      }
+      const double scaled = c * scale;
+      if (!std::isfinite(static_cast<float>(scaled))) {
+        throw ConfigError(path, "vertex " + std::to_string(v) + " scaled by " +
+                                    std::to_string(scale) + " is not a finite float");
+      }
+      mesh.positions.push_back(static_cast<float>(scaled));
+    }
+    aiVector3D n = in.mNormals ? in.mNormals[v] : aiVector3D(0, 0, 1);
+    if (!std::isfinite(n.x) || !std::isfinite(n.y) || !std::isfinite(n.z) || n.Length() == 0) {
+      n = aiVector3D(0, 0, 1);
+    }
+    mesh.normals.insert(mesh.normals.end(), {n.x, n.y, n.z});
+    if (textured) {
+      const aiVector3D t = in.HasTextureCoords(0) ? in.mTextureCoords[0][v] : aiVector3D();
+      mesh.texcoords.insert(mesh.texcoords.end(), {t.x, t.y});
+    }
+  }
+  for (unsigned f = 0; f < in.mNumFaces; ++f) {
+    const aiFace& face = in.mFaces[f];
+    if (face.mNumIndices != 3) continue;
+    for (unsigned i = 0; i < 3; ++i) {
+      if (face.mIndices[i] >= in.mNumVertices) {
+        throw ConfigError(path, "face " + std::to_string(f) + " names vertex " +
+                                    std::to_string(face.mIndices[i]) + " of " +
+                                    std::to_string(in.mNumVertices));
+      }
+      mesh.indices.push_back(base + face.mIndices[i]);
+    }
+  }
+}
+
 }  // namespace
 
 MeshData load_mesh(const std::string& path, double scale) {
@@ -42,13 +108,21 @@ MeshData load_mesh(const std::string& path, double scale) {
     }
     throw AssetNotFound(path, "mesh");
   }
+  if (!std::isfinite(scale) || !(scale > 0)) {
+    throw ArgumentError("mesh " + path + ": scale must be a positive finite number, got " +
+                        std::to_string(scale));
+  }
+  // Debian's assimp hangs or corrupts memory on some malformed PLY files before any of its
+  // checks run, so PLY structure is checked here first.
+  if (starts_with_ply(path)) io::check_ply(path, read_bytes(path));
   Assimp::Importer importer;
   // Points and lines carry no surface; drop them so a file of only those reads as empty.
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
                               aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-  const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                         aiProcess_GenSmoothNormals | aiProcess_PreTransformVertices |
-                         aiProcess_SortByPType | aiProcess_FindInvalidData;
+  const unsigned flags = aiProcess_ValidateDataStructure | aiProcess_Triangulate |
+                         aiProcess_JoinIdenticalVertices | aiProcess_GenSmoothNormals |
+                         aiProcess_PreTransformVertices | aiProcess_SortByPType |
+                         aiProcess_FindInvalidData;
   const aiScene* scene = importer.ReadFile(path, flags);
   if (scene == nullptr) {
     throw ConfigError(path, std::string("cannot read mesh: ") + importer.GetErrorString());
@@ -62,28 +136,10 @@ MeshData load_mesh(const std::string& path, double scale) {
   for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
     const aiMesh* in = scene->mMeshes[m];
     if (!(in->mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) continue;
-    const auto base = static_cast<std::uint32_t>(mesh.vertex_count());
-    for (unsigned v = 0; v < in->mNumVertices; ++v) {
-      const aiVector3D& p = in->mVertices[v];
-      const aiVector3D n = in->mNormals ? in->mNormals[v] : aiVector3D(0, 0, 1);
-      for (float c : {p.x, p.y, p.z}) {
-        if (!std::isfinite(c)) throw ConfigError(path, "mesh has non-finite vertex coordinates");
-        mesh.positions.push_back(static_cast<float>(c * scale));
-      }
-      mesh.normals.insert(mesh.normals.end(), {n.x, n.y, n.z});
-      if (textured) {
-        const aiVector3D t = in->HasTextureCoords(0) ? in->mTextureCoords[0][v] : aiVector3D();
-        mesh.texcoords.insert(mesh.texcoords.end(), {t.x, t.y});
-      }
-    }
+    append_mesh(path, *in, scale, textured, mesh);
     if (mesh.texture.empty() && in->HasTextureCoords(0) && scene->mMaterials != nullptr &&
         in->mMaterialIndex < scene->mNumMaterials) {
       mesh.texture = diffuse_texture(*scene->mMaterials[in->mMaterialIndex], path);
-    }
-    for (unsigned f = 0; f < in->mNumFaces; ++f) {
-      const aiFace& face = in->mFaces[f];
-      if (face.mNumIndices != 3) continue;
-      for (unsigned i = 0; i < 3; ++i) mesh.indices.push_back(base + face.mIndices[i]);
     }
   }
   if (mesh.indices.empty()) {

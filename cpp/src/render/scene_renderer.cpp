@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <optional>
 #include <string>
 #include <vector>
@@ -275,13 +276,29 @@ GLuint SceneRenderer::texture_for(const std::string& path) {
   if (it != textures_.end()) return it->second;
   GLuint texture = 0;
   try {
-    const RgbaImage image = read_image_rgba(path);
-    // Rows bottom first: texture coordinate v = 0 is the image's bottom row (OBJ's, AMBF's).
-    std::vector<std::uint8_t> rows(image.pixels.size());
-    const std::size_t stride = static_cast<std::size_t>(image.width) * 4;
+    const Image image = read_image(path);
+    // 8-bit RGBA, rows bottom first: texture coordinate v = 0 is the image's bottom row (OBJ's,
+    // AMBF's).
+    std::vector<std::uint8_t> rows(std::size_t(image.width) * image.height * 4);
     for (int r = 0; r < image.height; ++r) {
-      std::copy_n(image.pixels.data() + static_cast<std::size_t>(image.height - 1 - r) * stride,
-                  stride, rows.data() + static_cast<std::size_t>(r) * stride);
+      const std::uint8_t* in = image.row(image.height - 1 - r);
+      std::uint8_t* out = rows.data() + std::size_t(r) * image.width * 4;
+      for (int c = 0; c < image.width; ++c, out += 4) {
+        // The most significant byte of a 16-bit sample (machine order).
+        auto sample = [&](int k) -> std::uint8_t {
+          const std::size_t i = (std::size_t(c) * image.channels + k) * image.sample_bytes();
+          if (image.sample_bytes() == 1) return in[i];
+          std::uint16_t v = 0;
+          std::memcpy(&v, in + i, 2);
+          return static_cast<std::uint8_t>(v >> 8);
+        };
+        const bool colour = image.channels >= 3;
+        const bool alpha = image.channels == 2 || image.channels == 4;
+        out[0] = sample(0);
+        out[1] = colour ? sample(1) : out[0];
+        out[2] = colour ? sample(2) : out[0];
+        out[3] = alpha ? sample(image.channels - 1) : 255;
+      }
     }
     glGenTextures(1, &texture);
     glBindTexture(GL_TEXTURE_2D, texture);

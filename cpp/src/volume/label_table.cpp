@@ -105,6 +105,8 @@ LabelTable read_csv(const std::string& path) {
   std::ifstream in(path);
   std::string text;
   std::getline(in, text);
+  if (text.rfind("\xEF\xBB\xBF", 0) == 0) text.erase(0, 3);  // a UTF-8 byte-order mark
+  require_utf8(path, 1, text);
   const std::vector<std::string> header = split_csv(text);
   auto column = [&](const char* name) {
     for (std::size_t i = 0; i < header.size(); ++i) {
@@ -125,6 +127,7 @@ LabelTable read_csv(const std::string& path) {
   int next_id = 1;
   while (std::getline(in, text)) {
     ++line;
+    require_utf8(path, line, text);
     if (text.find_first_not_of(" \t\r") == std::string::npos) continue;
     const std::vector<std::string> cells = split_csv(text);
     const int needed = std::max({c_id, c_name, c_r, c_g, c_b, c_removable, c_critical}) + 1;
@@ -178,6 +181,7 @@ LabelTable read_yaml(const std::string& path) {
       if (id < 1 || id > 65535) throw ConfigError(path, where + "id must be in 1..65535");
       l.id = static_cast<std::uint16_t>(id);
       l.name = n["name"].as<std::string>();
+      require_utf8(path, n["name"].Mark().line + 1, l.name);
       const YAML::Node c = n["color"];
       if (!c.IsSequence() || c.size() != 3) {
         throw ConfigError(path, where + "color must be [r, g, b] in 0..255");

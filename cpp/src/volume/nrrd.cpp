@@ -9,9 +9,10 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-#include <cstring>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <regex>
 #include <set>
@@ -89,10 +90,42 @@ Scalar parse_type(const std::string& path, const std::string& value) {
   return it->second;
 }
 
+// Integer range of a scalar type (the range a Slicer label value must lie in).
+std::pair<double, double> scalar_range(Scalar s) {
+  switch (s) {
+    case Scalar::kInt8:
+      return {-128, 127};
+    case Scalar::kUInt8:
+      return {0, 255};
+    case Scalar::kInt16:
+      return {-32768, 32767};
+    case Scalar::kUInt16:
+      return {0, 65535};
+    case Scalar::kInt32:
+      return {-2147483648.0, 2147483647.0};
+    case Scalar::kUInt32:
+      return {0, 4294967295.0};
+    case Scalar::kFloat:
+    case Scalar::kDouble:
+      break;
+  }
+  return {-std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+}
+
 struct Header {
   std::map<std::string, std::string> fields;      // lower-case field names
+  std::map<std::string, int> field_lines;         // where each field was given
   std::map<std::string, std::string> key_values;  // key:=value pairs
   std::size_t data_offset = 0;                    // bytes to the data in the same file
+  bool ended = false;                             // a blank line closed the header
+
+  bool has(const std::string& name) const { return fields.count(name) > 0; }
+  /// "field 'sizes' (line 4)", for messages.
+  std::string where(const std::string& name) const {
+    auto it = field_lines.find(name);
+    return "field '" + name + "'" +
+           (it == field_lines.end() ? "" : " (line " + std::to_string(it->second) + ")");
+  }
 };
 
 std::string trim(const std::string& s) {
@@ -120,7 +153,11 @@ Header read_header(const std::string& path, const std::string& bytes) {
     throw ConfigError(path, "line 1: not an NRRD file (expected the magic 'NRRD000x')");
   }
   while (next_line(line)) {
-    if (line.empty()) break;  // the header ends at the first blank line
+    if (line.empty()) {  // the header ends at the first blank line
+      h.ended = true;
+      break;
+    }
+    require_utf8(path, line_no, line);
     if (line[0] == '#') continue;
     const std::size_t kv = line.find(":=");
     if (kv != std::string::npos) {
@@ -132,7 +169,14 @@ Header read_header(const std::string& path, const std::string& bytes) {
       throw ConfigError(path, "line " + std::to_string(line_no) +
                                   ": expected 'field: value' or 'key:=value', got '" + line + "'");
     }
-    h.fields[to_lower(line.substr(0, colon))] = trim(line.substr(colon + 2));
+    const std::string name = to_lower(line.substr(0, colon));
+    if (h.fields.count(name)) {
+      throw ConfigError(path, "line " + std::to_string(line_no) + ": field '" + name +
+                                  "' is given twice (first on line " +
+                                  std::to_string(h.field_lines[name]) + ")");
+    }
+    h.fields[name] = trim(line.substr(colon + 2));
+    h.field_lines[name] = line_no;
   }
   h.data_offset = pos;
   return h;
@@ -144,6 +188,29 @@ std::vector<std::string> words(const std::string& s) {
   std::string w;
   while (in >> w) out.push_back(w);
   return out;
+}
+
+// A whole word as an integer in [lo, hi]; what it is and what was expected go in the message.
+long long parse_integer(const std::string& path, const std::string& what, const std::string& text,
+                        long long lo, long long hi) {
+  errno = 0;
+  char* end = nullptr;
+  const long long v = std::strtoll(text.c_str(), &end, 10);
+  if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE || v < lo || v > hi) {
+    throw ConfigError(path, what + ": expected an integer in " + std::to_string(lo) + ".." +
+                                std::to_string(hi) + ", got '" + text + "'");
+  }
+  return v;
+}
+
+// A whole word as a finite number.
+double parse_finite(const std::string& path, const std::string& what, const std::string& text) {
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(v)) {
+    throw ConfigError(path, what + ": expected a finite number, got '" + text + "'");
+  }
+  return v;
 }
 
 // "(a,b,c) (d,e,f) none ..." -> vectors (NaN for none)
@@ -160,50 +227,88 @@ std::vector<Eigen::Vector3d> parse_vectors(const std::string& path, const std::s
       continue;
     }
     if (value[pos] != '(') {
-      throw ConfigError(path,
-                        "field '" + field + "': expected (x,y,z) vectors, got '" + value + "'");
+      throw ConfigError(path, field + ": expected (x,y,z) vectors, got '" + value + "'");
     }
     const std::size_t close = value.find(')', pos);
     if (close == std::string::npos) {
-      throw ConfigError(path, "field '" + field + "': unbalanced parenthesis in '" + value + "'");
+      throw ConfigError(path, field + ": unbalanced parenthesis in '" + value + "'");
     }
-    std::string inside = value.substr(pos + 1, close - pos - 1);
-    std::replace(inside.begin(), inside.end(), ',', ' ');
+    const std::string inside = value.substr(pos + 1, close - pos - 1);
+    std::vector<std::string> parts;
     std::istringstream in(inside);
-    Eigen::Vector3d v;
-    if (!(in >> v[0] >> v[1] >> v[2])) {
-      throw ConfigError(path, "field '" + field + "': expected 3 numbers in '(" + inside + ")'");
+    for (std::string part; std::getline(in, part, ',');) parts.push_back(trim(part));
+    if (parts.size() != 3) {
+      throw ConfigError(path, field + ": expected 3 numbers in '(" + inside + ")'");
     }
+    Eigen::Vector3d v;
+    for (int c = 0; c < 3; ++c) v[c] = parse_finite(path, field, parts[c]);
     out.push_back(v);
     pos = close + 1;
   }
   return out;
 }
 
-std::string read_file(const std::string& path) {
+std::string read_file(const std::string& path, const char* what) {
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) {
+    throw ConfigError(path, std::string("is a folder, expected ") + what);
+  }
+  if (!fs::is_regular_file(path, ec)) throw AssetNotFound(path, "NRRD");
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw AssetNotFound(path, "NRRD");
+  if (!in) throw ConfigError(path, std::string("cannot open: ") + std::strerror(errno));
   std::ostringstream s;
   s << in.rdbuf();
+  if (in.bad()) throw ConfigError(path, std::string("cannot read: ") + std::strerror(errno));
   return s.str();
 }
 
-std::string gunzip(const std::string& path, const char* data, std::size_t size,
-                   std::size_t expected) {
-  std::string out(expected, '\0');
+// Every byte of the gzip stream (one member or several, as concatenated gzip files are), but no
+// more than `limit`: a stream that inflates to more is reported as such without being kept.
+std::string gunzip(const std::string& path, const char* data, std::size_t size, std::size_t limit) {
+  std::string out;
   z_stream z{};
-  z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(data));
-  z.avail_in = static_cast<uInt>(size);
   if (inflateInit2(&z, 15 + 32) != Z_OK) throw ConfigError(path, "cannot start gzip decoding");
-  z.next_out = reinterpret_cast<Bytef*>(out.data());
-  z.avail_out = static_cast<uInt>(expected);
-  const int rc = inflate(&z, Z_FINISH);
-  const std::size_t produced = expected - z.avail_out;
+  std::size_t consumed = 0;
+  int rc = Z_OK;
+  char chunk[1 << 16];
+  while (true) {
+    const std::size_t in_now = std::min<std::size_t>(size - consumed, 1u << 30);
+    z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(data + consumed));
+    z.avail_in = static_cast<uInt>(in_now);
+    z.next_out = reinterpret_cast<Bytef*>(chunk);
+    z.avail_out = sizeof(chunk);
+    rc = inflate(&z, Z_NO_FLUSH);
+    consumed += in_now - z.avail_in;
+    out.append(chunk, sizeof(chunk) - z.avail_out);
+    if (out.size() > limit) break;
+    if (rc == Z_STREAM_END) {
+      if (consumed == size) break;
+      // Another member follows, or trailing bytes that are not gzip.
+      if (size - consumed < 2 || static_cast<unsigned char>(data[consumed]) != 0x1f ||
+          static_cast<unsigned char>(data[consumed + 1]) != 0x8b) {
+        inflateEnd(&z);
+        throw ConfigError(path, std::to_string(size - consumed) +
+                                    " bytes follow the end of the gzip data (expected none)");
+      }
+      inflateReset(&z);
+      continue;
+    }
+    if (rc != Z_OK) break;
+    if (consumed == size && z.avail_out != 0) {
+      rc = Z_BUF_ERROR;  // the input ended inside the stream
+      break;
+    }
+  }
+  const std::string message = z.msg ? z.msg : "";
   inflateEnd(&z);
-  if (rc != Z_STREAM_END && !(rc == Z_BUF_ERROR && produced == expected)) {
-    throw ConfigError(path, "gzip data is corrupt or shorter than the header says: got " +
-                                std::to_string(produced) + " of " + std::to_string(expected) +
-                                " bytes (zlib: " + (z.msg ? z.msg : std::to_string(rc)) + ")");
+  if (out.size() > limit) return out;
+  if (rc != Z_STREAM_END) {
+    throw ConfigError(path, "gzip data is corrupt or cut short after " +
+                                std::to_string(out.size()) + " decoded bytes (zlib: " +
+                                (!message.empty()    ? message
+                                 : rc == Z_BUF_ERROR ? std::string("unexpected end of the stream")
+                                                     : "error " + std::to_string(rc)) +
+                                ")");
   }
   return out;
 }
@@ -237,40 +342,325 @@ double value_at(Scalar s, const char* p) {
   return 0;
 }
 
+// What the header says the data is: its type, axes and how it is stored.
+struct Layout {
+  Scalar type = Scalar::kUInt8;
+  std::string type_name;
+  int dimension = 3;
+  int layers = 1;  // the first axis of a 4D layered segmentation
+  std::array<int, 3> shape{1, 1, 1};
+  std::size_t voxels = 0;
+  std::size_t bytes = 0;  // of the decoded data
+  std::string encoding;
+  bool big_endian = false;
+};
+
+const std::string& required(const std::string& path, const Header& h, const std::string& name) {
+  auto it = h.fields.find(name);
+  if (it == h.fields.end()) throw ConfigError(path, "missing required field '" + name + "'");
+  return it->second;
+}
+
+Layout read_layout(const std::string& path, const Header& h) {
+  Layout l;
+  l.type_name = required(path, h, "type");
+  l.type = parse_type(path, l.type_name);
+  const std::string dimension = required(path, h, "dimension");
+  if (dimension != "3" && dimension != "4") {
+    throw ConfigError(path, h.where("dimension") +
+                                ": expected 3 (or 4 for a layered segmentation), got '" +
+                                dimension + "'");
+  }
+  l.dimension = dimension == "3" ? 3 : 4;
+  const std::vector<std::string> size_words = words(required(path, h, "sizes"));
+  if (static_cast<int>(size_words.size()) != l.dimension) {
+    throw ConfigError(path, h.where("sizes") + ": expected " + std::to_string(l.dimension) +
+                                " sizes, got '" + h.fields.at("sizes") + "'");
+  }
+  std::vector<int> sizes;
+  for (const std::string& w : size_words) {
+    sizes.push_back(static_cast<int>(parse_integer(path, h.where("sizes"), w, 1, 8192)));
+  }
+  l.layers = l.dimension == 4 ? sizes[0] : 1;
+  l.shape = l.dimension == 4 ? std::array<int, 3>{sizes[1], sizes[2], sizes[3]}
+                             : std::array<int, 3>{sizes[0], sizes[1], sizes[2]};
+  l.voxels = std::size_t(l.shape[0]) * l.shape[1] * l.shape[2];
+  l.bytes = l.voxels * l.layers * scalar_size(l.type);
+  l.encoding = to_lower(h.has("encoding") ? h.fields.at("encoding") : "raw");
+  if (l.encoding == "gz") l.encoding = "gzip";
+  if (l.encoding != "raw" && l.encoding != "gzip") {
+    throw ConfigError(path, h.where("encoding") + ": '" + l.encoding +
+                                "' is not supported (expected raw or gzip)");
+  }
+  if (h.has("endian")) {
+    const std::string endian = to_lower(h.fields.at("endian"));
+    if (endian != "little" && endian != "big") {
+      throw ConfigError(path, h.where("endian") + ": expected little or big, got '" +
+                                  h.fields.at("endian") + "'");
+    }
+    l.big_endian = endian == "big";
+  }
+  return l;
+}
+
+// Skips `lines` lines of the data, as the header's `line skip` asks.
+std::size_t skip_lines(const std::string& source, const Header& h, const char* data,
+                       std::size_t available, long long lines) {
+  std::size_t pos = 0;
+  for (long long n = 0; n < lines; ++n) {
+    const void* nl = std::memchr(data + pos, '\n', available - pos);
+    if (nl == nullptr) {
+      throw ConfigError(source, h.where("line skip") + ": asks to skip " + std::to_string(lines) +
+                                    " lines but the data has only " + std::to_string(n));
+    }
+    pos = static_cast<const char*>(nl) - data + 1;
+  }
+  return pos;
+}
+
+// The decoded data: exactly the bytes the header promises, in the machine's byte order.
+std::string read_payload(const std::string& path, const std::string& file, const Header& h,
+                         const Layout& l) {
+  std::string detached;
+  const char* data = file.data() + h.data_offset;
+  std::size_t available = file.size() - h.data_offset;
+  std::string source = path;
+  for (const char* key : {"data file", "datafile"}) {
+    if (!h.has(key)) continue;
+    const std::string name = h.fields.at(key);
+    if (name.rfind("LIST", 0) == 0 || name.find('%') != std::string::npos) {
+      throw ConfigError(path, h.where(key) + ": data split over several files ('" + name +
+                                  "') is not supported (expected one file)");
+    }
+    fs::path p = name;
+    if (p.is_relative()) p = fs::path(path).parent_path() / p;
+    source = p.string();
+    detached = read_file(source, "the NRRD's data file");
+    data = detached.data();
+    available = detached.size();
+  }
+  if (source == path && !h.ended) {
+    throw ConfigError(path, "the header does not end with a blank line, so the file holds no data");
+  }
+  const long long line_skip =
+      h.has("line skip") ? parse_integer(path, h.where("line skip"), h.fields.at("line skip"), 0,
+                                         std::numeric_limits<int>::max())
+                         : 0;
+  const std::size_t after_lines = skip_lines(source, h, data, available, line_skip);
+  data += after_lines;
+  available -= after_lines;
+  const long long byte_skip =
+      h.has("byte skip") ? parse_integer(path, h.where("byte skip"), h.fields.at("byte skip"), -1,
+                                         std::numeric_limits<long long>::max() / 2)
+                         : 0;
+  if (byte_skip == -1 && l.encoding != "raw") {
+    throw ConfigError(path, h.where("byte skip") + ": -1 (data at the end) needs raw encoding");
+  }
+  const std::string sizes = "sizes " + h.fields.at("sizes") + " of " + l.type_name;
+  std::string decoded;
+  if (l.encoding == "gzip") {
+    // The byte skip applies to the decoded data.
+    const std::size_t skip = static_cast<std::size_t>(byte_skip);
+    decoded = gunzip(source, data, available, skip + l.bytes);
+    if (decoded.size() != skip + l.bytes) {
+      throw ConfigError(
+          source, "gzip data decodes to " +
+                      (decoded.size() > skip + l.bytes ? "more than " : std::string()) +
+                      std::to_string(decoded.size()) + " bytes but the header needs " +
+                      std::to_string(l.bytes) +
+                      (skip ? " after skipping " + std::to_string(skip) : std::string()) + " (" +
+                      sizes + ")");
+    }
+    decoded.erase(0, skip);
+  } else {
+    if (byte_skip == -1) {
+      if (available < l.bytes) {
+        throw ConfigError(source, "raw data holds " + std::to_string(available) +
+                                      " bytes but the header needs " + std::to_string(l.bytes) +
+                                      " (" + sizes + ")");
+      }
+      data += available - l.bytes;  // byte skip -1: the data is the file's last bytes
+      available = l.bytes;
+    } else if (static_cast<unsigned long long>(byte_skip) > available) {
+      throw ConfigError(source, h.where("byte skip") + ": " + std::to_string(byte_skip) +
+                                    " is beyond the " + std::to_string(available) +
+                                    " bytes of data");
+    } else {
+      data += byte_skip;
+      available -= static_cast<std::size_t>(byte_skip);
+    }
+    if (available != l.bytes) {
+      throw ConfigError(source, "raw data holds " + std::to_string(available) +
+                                    " bytes but the header needs " + std::to_string(l.bytes) +
+                                    " (" + sizes + ")");
+    }
+    decoded.assign(data, l.bytes);
+  }
+  if (l.big_endian && scalar_size(l.type) > 1) {
+    const std::size_t w = scalar_size(l.type);
+    for (std::size_t v = 0; v < decoded.size(); v += w) {
+      std::reverse(&decoded[v], &decoded[v] + w);
+    }
+  }
+  return decoded;
+}
+
+// Where the grid sits: its physical size, the patient-from-volume pose, and whether k is
+// reversed to make a left-handed grid right-handed.
+struct Geometry {
+  Eigen::Vector3d dimensions = Eigen::Vector3d::Ones();
+  Eigen::Matrix4d patient = Eigen::Matrix4d::Identity();
+  bool flip_k = false;
+};
+
+double length_unit(const std::string& path, const Header& h) {
+  if (!h.has("space units")) return 0.001;  // millimetres unless said otherwise
+  static const std::map<std::string, double> units = {
+      {"mm", 0.001}, {"m", 1.0}, {"cm", 0.01}, {"um", 1e-6}, {"\xc2\xb5m", 1e-6}};
+  double unit = 0;
+  for (std::string w : words(h.fields.at("space units"))) {
+    w.erase(std::remove(w.begin(), w.end(), '"'), w.end());
+    auto it = units.find(w);
+    if (it == units.end() || (unit != 0 && it->second != unit)) {
+      throw ConfigError(path, h.where("space units") + ": expected one length unit (mm, m, cm, " +
+                                  "um) for every axis, got '" + h.fields.at("space units") + "'");
+    }
+    unit = it->second;
+  }
+  return unit != 0 ? unit : 0.001;
+}
+
+Geometry read_geometry(const std::string& path, const Header& h, const Layout& l) {
+  // Space directions give the voxel axes, space origin the first voxel's centre.
+  Eigen::Matrix3d directions = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+  const double unit = length_unit(path, h);
+  if (h.has("space directions")) {
+    const std::string what = h.where("space directions");
+    std::vector<Eigen::Vector3d> v = parse_vectors(path, what, h.fields.at("space directions"));
+    if (l.dimension == 4 && v.size() == 4 && std::isnan(v[0][0])) v.erase(v.begin());
+    if (v.size() != 3 || !v[0].allFinite() || !v[1].allFinite() || !v[2].allFinite()) {
+      throw ConfigError(path, what + ": expected a vector for each spatial axis" +
+                                  (l.dimension == 4 ? " after 'none' for the layers" : "") +
+                                  ", got '" + h.fields.at("space directions") + "'");
+    }
+    for (int a = 0; a < 3; ++a) directions.col(a) = v[a];
+  } else if (h.has("spacings")) {
+    const std::string what = h.where("spacings");
+    const auto w = words(h.fields.at("spacings"));
+    if (static_cast<int>(w.size()) != l.dimension) {
+      throw ConfigError(path, what + ": expected " + std::to_string(l.dimension) +
+                                  " spacings, got '" + h.fields.at("spacings") + "'");
+    }
+    for (int a = 0; a < 3; ++a) {
+      const double s = parse_finite(path, what, w[a + l.dimension - 3]);
+      if (!(s > 0)) {
+        throw ConfigError(path, what + ": spacing " + w[a + l.dimension - 3] + " of axis " +
+                                    std::to_string(a) + " must be > 0");
+      }
+      directions(a, a) = s;
+    }
+  }
+  if (h.has("space origin")) {
+    const auto v = parse_vectors(path, h.where("space origin"), h.fields.at("space origin"));
+    if (v.size() != 1 || !v[0].allFinite()) {
+      throw ConfigError(path, h.where("space origin") + ": expected one (x,y,z) vector");
+    }
+    origin = v[0];
+  }
+  directions *= unit;
+  origin *= unit;
+  Eigen::Vector3d spacing;
+  for (int a = 0; a < 3; ++a) spacing[a] = directions.col(a).norm();
+  if (!(spacing.minCoeff() > 0) || !spacing.allFinite()) {
+    throw ConfigError(path, h.where("space directions") + ": a direction has zero length");
+  }
+  // Nearest rotation to the (possibly slightly sheared) axes; a left-handed grid is made
+  // right-handed by reversing k.
+  Eigen::Matrix3d axes = directions * spacing.cwiseInverse().asDiagonal();
+  if (std::abs(axes.determinant()) < 1e-6) {
+    throw ConfigError(path, h.where("space directions") + ": the axes are (nearly) parallel");
+  }
+  Geometry g;
+  g.flip_k = axes.determinant() < 0;
+  if (g.flip_k) {
+    origin += directions.col(2) * (l.shape[2] - 1);
+    axes.col(2) = -axes.col(2);
+  }
+  Eigen::JacobiSVD<Eigen::Matrix3d> svd(axes, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const Eigen::Matrix3d rotation = svd.matrixU() * svd.matrixV().transpose();
+  g.dimensions = spacing.cwiseProduct(Eigen::Vector3d(l.shape[0], l.shape[1], l.shape[2]));
+  g.patient.topLeftCorner<3, 3>() = rotation;
+  g.patient.topRightCorner<3, 1>() = origin + rotation * (g.dimensions / 2 - spacing / 2);
+  if (!g.patient.allFinite() || !g.dimensions.allFinite()) {
+    throw ConfigError(path, "space directions and origin give a non-finite geometry");
+  }
+  return g;
+}
+
+// The decoded samples, read by layer and voxel (i, j, k) of the right-handed grid.
+struct Samples {
+  const Layout& layout;
+  const char* data;
+  bool flip_k;
+
+  double at(int layer, int i, int j, int k) const {
+    const int kk = flip_k ? layout.shape[2] - 1 - k : k;
+    const std::size_t v =
+        static_cast<std::size_t>(i) +
+        std::size_t(layout.shape[0]) * (std::size_t(j) + std::size_t(layout.shape[1]) * kk);
+    return value_at(layout.type, data + (v * layout.layers + layer) * scalar_size(layout.type));
+  }
+  double linear(std::size_t n) const {
+    return value_at(layout.type, data + n * scalar_size(layout.type));
+  }
+};
+
 struct Segment {
   int index = 0;
   std::string name;
   std::array<std::uint8_t, 3> color{255, 255, 255};
-  int label_value = 1;
+  long long label_value = 1;
   int layer = 0;
 };
 
-std::vector<Segment> read_segments(const std::string& path, const Header& h) {
+std::vector<Segment> read_segments(const std::string& path, const Header& h, const Layout& l) {
   std::map<int, Segment> by_index;
   static const std::regex key("Segment([0-9]+)_(ID|Name|Color|LabelValue|Layer)");
+  const auto [lowest, highest] = scalar_range(l.type);
   for (const auto& [k, v] : h.key_values) {
     std::smatch m;
     if (!std::regex_match(k, m, key)) continue;
-    Segment& s = by_index[std::stoi(m[1])];
-    s.index = std::stoi(m[1]);
-    const std::string what = m[2];
-    try {
-      if (what == "Name") {
-        s.name = v;
-      } else if (what == "Color") {
-        std::istringstream in(v);
-        double rgb[3];
-        if (!(in >> rgb[0] >> rgb[1] >> rgb[2])) throw ArgumentError("colour");
-        for (int c = 0; c < 3; ++c) {
-          s.color[c] = static_cast<std::uint8_t>(std::lround(std::clamp(rgb[c], 0.0, 1.0) * 255));
-        }
-      } else if (what == "LabelValue") {
-        s.label_value = std::stoi(v);
-      } else if (what == "Layer") {
-        s.layer = std::stoi(v);
+    const std::string what = "key '" + k + "'";
+    // Segment n becomes label n + 1 when label values cannot serve as ids.
+    const int index =
+        static_cast<int>(parse_integer(path, what + ": segment number", m[1], 0, 65534));
+    Segment& s = by_index[index];
+    s.index = index;
+    const std::string field = m[2];
+    if (field == "Name") {
+      s.name = v;
+    } else if (field == "Color") {
+      const auto rgb = words(v);
+      if (rgb.size() != 3) {
+        throw ConfigError(path, what + ": expected three numbers 0..1, got '" + v + "'");
       }
-    } catch (const std::exception&) {
-      throw ConfigError(path, "key '" + k + "': cannot read '" + v + "'");
+      for (int c = 0; c < 3; ++c) {
+        const double x = parse_finite(path, what, rgb[c]);
+        s.color[c] = static_cast<std::uint8_t>(std::lround(std::clamp(x, 0.0, 1.0) * 255));
+      }
+    } else if (field == "LabelValue") {
+      s.label_value = parse_integer(path, what, trim(v), std::numeric_limits<long long>::min(),
+                                    std::numeric_limits<long long>::max());
+      if (is_integer(l.type) &&
+          (s.label_value < std::max(1.0, lowest) || static_cast<double>(s.label_value) > highest)) {
+        throw ConfigError(path, what + ": label value " + std::to_string(s.label_value) +
+                                    " cannot occur in " + l.type_name + " data (expected " +
+                                    std::to_string(static_cast<long long>(std::max(1.0, lowest))) +
+                                    ".." + std::to_string(static_cast<long long>(highest)) + ")");
+      }
+    } else if (field == "Layer") {
+      s.layer = static_cast<int>(parse_integer(path, what, trim(v), 0, l.layers - 1));
     }
   }
   std::vector<Segment> out;
@@ -281,283 +671,178 @@ std::vector<Segment> read_segments(const std::string& path, const Header& h) {
   return out;
 }
 
+NrrdOptions::Kind classify(const Layout& l, const Samples& samples,
+                           const std::vector<Segment>& segments) {
+  if (!segments.empty()) return NrrdOptions::Kind::kSegmentation;
+  if (!is_integer(l.type) || l.layers != 1) return NrrdOptions::Kind::kIntensity;
+  // Integer data in 0..65535 with few distinct values is a label map.
+  std::set<long> distinct;
+  for (std::size_t v = 0; v < l.voxels; ++v) {
+    const double x = samples.linear(v);
+    if (x < 0 || x > 65535) return NrrdOptions::Kind::kIntensity;
+    if (distinct.size() <= 256) distinct.insert(static_cast<long>(x));
+  }
+  return distinct.size() <= 256 ? NrrdOptions::Kind::kLabels : NrrdOptions::Kind::kIntensity;
+}
+
+std::shared_ptr<VolumeData> build_intensity(const std::string& path, const Layout& l,
+                                            const Samples& samples, const Geometry& g,
+                                            const NrrdOptions& options) {
+  if (!options.threshold) {
+    throw ConfigError(path, "holds intensities (type " + l.type_name +
+                                "): give a threshold to segment it (e.g. 300 for bone in HU)");
+  }
+  if (!std::isfinite(*options.threshold)) {
+    throw ArgumentError("load_nrrd: threshold must be a finite number, got " +
+                        std::to_string(*options.threshold));
+  }
+  LabelTable table;
+  table.add(Label{1, "Segmented", {255, 249, 219}, true, false});
+  auto volume = std::make_shared<VolumeData>(l.shape, g.dimensions, LabelType::kUInt8, table);
+  const bool wide = l.type == Scalar::kFloat || l.type == Scalar::kDouble ||
+                    l.type == Scalar::kInt32 || l.type == Scalar::kUInt32;
+  volume->set_intensity_type(wide ? IntensityType::kFloat32 : IntensityType::kInt16);
+  auto* labels = static_cast<std::uint8_t*>(volume->label_data());
+  for (int k = 0; k < l.shape[2]; ++k) {
+    for (int j = 0; j < l.shape[1]; ++j) {
+      for (int i = 0; i < l.shape[0]; ++i) {
+        const double x = samples.at(0, i, j, k);
+        if (!std::isfinite(x) || (!wide && (x < -32768 || x > 32767))) {
+          throw ConfigError(path, "voxel (" + std::to_string(i) + ", " + std::to_string(j) + ", " +
+                                      std::to_string(k) + ") holds " + std::to_string(x) +
+                                      ", which is not a usable intensity");
+        }
+        const std::size_t n = volume->linear_index(i, j, k);
+        if (volume->intensity_type() == IntensityType::kInt16) {
+          static_cast<std::int16_t*>(volume->intensity_data())[n] = static_cast<std::int16_t>(x);
+        } else {
+          static_cast<float*>(volume->intensity_data())[n] = static_cast<float>(x);
+        }
+        labels[n] = x >= *options.threshold ? 1 : 0;
+      }
+    }
+  }
+  return volume;
+}
+
+std::shared_ptr<VolumeData> build_label_map(const std::string& path, const Layout& l,
+                                            const Samples& samples, const Geometry& g) {
+  if (!is_integer(l.type)) {
+    throw ConfigError(path, "a label map needs an integer type, got " + l.type_name);
+  }
+  std::uint16_t max_id = 0;
+  std::vector<bool> seen(65536, false);
+  for (std::size_t v = 0; v < l.voxels; ++v) {
+    const double x = samples.linear(v);
+    if (x < 0 || x > 65535) {
+      throw ConfigError(path, "label map value " + std::to_string(static_cast<long long>(x)) +
+                                  " is outside 0..65535");
+    }
+    seen[static_cast<std::size_t>(x)] = true;
+    max_id = std::max(max_id, static_cast<std::uint16_t>(x));
+  }
+  LabelTable table;
+  for (int id = 1; id <= max_id; ++id) {
+    if (!seen[id]) continue;
+    // A colour per id that stays the same from file to file.
+    const std::uint32_t hsh = static_cast<std::uint32_t>(id) * 2654435761u;
+    table.add(Label{static_cast<std::uint16_t>(id),
+                    "label_" + std::to_string(id),
+                    {std::uint8_t(64 + (hsh >> 24) % 192), std::uint8_t(64 + (hsh >> 16) % 192),
+                     std::uint8_t(64 + (hsh >> 8) % 192)},
+                    true,
+                    false});
+  }
+  auto volume = std::make_shared<VolumeData>(
+      l.shape, g.dimensions, max_id > 255 ? LabelType::kUInt16 : LabelType::kUInt8, table);
+  visit_labels(volume->label_type(), volume->label_data(), [&](auto* labels) {
+    using T = std::remove_pointer_t<decltype(labels)>;
+    for (int k = 0; k < l.shape[2]; ++k)
+      for (int j = 0; j < l.shape[1]; ++j)
+        for (int i = 0; i < l.shape[0]; ++i)
+          labels[volume->linear_index(i, j, k)] = static_cast<T>(samples.at(0, i, j, k));
+  });
+  return volume;
+}
+
+// Slicer segmentation: segment s is where its layer holds its label value. In one layer with
+// distinct label values those values are the ids; across layers (values repeat) the ids are the
+// segment numbers + 1.
+std::shared_ptr<VolumeData> build_segmentation(const std::string& path, const Layout& l,
+                                               const Samples& samples, const Geometry& g,
+                                               const std::vector<Segment>& segments) {
+  if (segments.empty()) throw ConfigError(path, "no Segment<N>_* keys: not a segmentation");
+  if (!is_integer(l.type)) throw ConfigError(path, "a segmentation needs an integer type");
+  std::set<long long> values;
+  bool keep_values = l.layers == 1;
+  for (const Segment& s : segments) {
+    keep_values = keep_values && s.label_value >= 1 && s.label_value <= 65535 &&
+                  values.insert(s.label_value).second;
+  }
+  std::vector<std::uint16_t> ids;
+  LabelTable table;
+  for (const Segment& s : segments) {
+    ids.push_back(static_cast<std::uint16_t>(keep_values ? s.label_value : s.index + 1));
+    try {
+      table.add(Label{ids.back(), s.name, s.color, true, false});
+    } catch (const ArgumentError& e) {
+      throw ConfigError(path, "Segment" + std::to_string(s.index) + ": " + e.what());
+    }
+  }
+  auto volume = std::make_shared<VolumeData>(
+      l.shape, g.dimensions, table.max_id() > 255 ? LabelType::kUInt16 : LabelType::kUInt8, table);
+  std::int64_t overlaps = 0;
+  visit_labels(volume->label_type(), volume->label_data(), [&](auto* labels) {
+    using T = std::remove_pointer_t<decltype(labels)>;
+    for (int k = 0; k < l.shape[2]; ++k)
+      for (int j = 0; j < l.shape[1]; ++j)
+        for (int i = 0; i < l.shape[0]; ++i) {
+          T& out = labels[volume->linear_index(i, j, k)];
+          for (std::size_t n = 0; n < segments.size(); ++n) {
+            const Segment& s = segments[n];
+            if (samples.at(s.layer, i, j, k) != static_cast<double>(s.label_value)) continue;
+            overlaps += out != 0;
+            out = static_cast<T>(ids[n]);
+          }
+        }
+  });
+  if (overlaps > 0) {
+    log(LogLevel::kWarning, path + ": " + std::to_string(overlaps) +
+                                " voxels belong to more than one segment; the later segment wins");
+  }
+  return volume;
+}
+
 }  // namespace
 
 std::shared_ptr<VolumeData> load_nrrd(const std::string& path, const NrrdOptions& options) {
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec)) throw AssetNotFound(path, "NRRD");
-  const std::string file = read_file(path);
-  const Header h = read_header(path, file);
-  auto field = [&](const char* name) -> const std::string& {
-    auto it = h.fields.find(name);
-    if (it == h.fields.end())
-      throw ConfigError(path, std::string("missing required field '") + name + "'");
-    return it->second;
-  };
-  const Scalar type = parse_type(path, field("type"));
-  const int dimension = std::atoi(field("dimension").c_str());
-  const std::vector<std::string> size_words = words(field("sizes"));
-  if (dimension != 3 && dimension != 4) {
-    throw ConfigError(path,
-                      "field 'dimension': expected 3 (or 4 for a layered segmentation), got " +
-                          field("dimension"));
-  }
-  if (static_cast<int>(size_words.size()) != dimension) {
-    throw ConfigError(path, "field 'sizes': expected " + std::to_string(dimension) +
-                                " sizes, got '" + field("sizes") + "'");
-  }
-  std::vector<int> sizes;
-  for (const std::string& w : size_words) {
-    const long v = std::strtol(w.c_str(), nullptr, 10);
-    if (v <= 0 || v > 8192) throw ConfigError(path, "field 'sizes': bad size '" + w + "'");
-    sizes.push_back(static_cast<int>(v));
-  }
-  const int layers = dimension == 4 ? sizes[0] : 1;
-  const std::array<int, 3> shape = dimension == 4
-                                       ? std::array<int, 3>{sizes[1], sizes[2], sizes[3]}
-                                       : std::array<int, 3>{sizes[0], sizes[1], sizes[2]};
-  const std::string encoding =
-      to_lower(h.fields.count("encoding") ? h.fields.at("encoding") : "raw");
-  const bool big_endian = h.fields.count("endian") && to_lower(h.fields.at("endian")) == "big";
-  const std::size_t voxels = std::size_t(shape[0]) * shape[1] * shape[2];
-  const std::size_t bytes = voxels * layers * scalar_size(type);
+  const std::string file = read_file(path, "an NRRD file");
+  const Header header = read_header(path, file);
+  const Layout layout = read_layout(path, header);
+  const Geometry geometry = read_geometry(path, header, layout);
+  const std::vector<Segment> segments = read_segments(path, header, layout);
+  const std::string payload = read_payload(path, file, header, layout);
+  const Samples samples{layout, payload.data(), geometry.flip_k};
 
-  // The data: attached after the header, or in a detached file next to it.
-  std::string detached;
-  const char* data = file.data() + h.data_offset;
-  std::size_t available = file.size() - h.data_offset;
-  std::string data_source = path;
-  for (const char* key : {"data file", "datafile"}) {
-    if (!h.fields.count(key)) continue;
-    fs::path p = h.fields.at(key);
-    if (p.is_relative()) p = fs::path(path).parent_path() / p;
-    data_source = p.string();
-    detached = read_file(data_source);
-    data = detached.data();
-    available = detached.size();
-  }
-  std::string decoded;
-  if (encoding == "gzip" || encoding == "gz") {
-    decoded = gunzip(data_source, data, available, bytes);
-    data = decoded.data();
-    available = decoded.size();
-  } else if (encoding == "raw") {
-    // Raw data may follow extra bytes: it is the last `bytes` of the file.
-    if (available < bytes) {
-      throw ConfigError(data_source, "raw data holds " + std::to_string(available) +
-                                         " bytes but the header needs " + std::to_string(bytes) +
-                                         " (sizes " + field("sizes") + " of " + field("type") +
-                                         ")");
-    }
-    data += available - bytes;
-  } else {
-    throw ConfigError(path, "field 'encoding': '" + encoding + "' is not supported (raw or gzip)");
-  }
-  std::string swapped;
-  if (big_endian && scalar_size(type) > 1) {
-    swapped.assign(data, bytes);
-    const std::size_t w = scalar_size(type);
-    for (std::size_t v = 0; v < bytes; v += w) std::reverse(&swapped[v], &swapped[v + w]);
-    data = swapped.data();
-  }
-
-  // Geometry: space directions give the voxel axes (mm), space origin the first voxel's centre.
-  Eigen::Matrix3d directions = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d origin = Eigen::Vector3d::Zero();
-  double unit = 0.001;  // millimetres unless said otherwise
-  if (h.fields.count("space units")) {
-    const auto u = words(h.fields.at("space units"));
-    if (!u.empty() && (u[0] == "\"m\"" || u[0] == "m")) unit = 1.0;
-  }
-  if (h.fields.count("space directions")) {
-    std::vector<Eigen::Vector3d> v =
-        parse_vectors(path, "space directions", h.fields.at("space directions"));
-    if (dimension == 4 && !v.empty() && std::isnan(v[0][0])) v.erase(v.begin());
-    if (v.size() != 3 || !v[0].allFinite() || !v[1].allFinite() || !v[2].allFinite()) {
-      throw ConfigError(path,
-                        "field 'space directions': expected three (x,y,z) vectors for the "
-                        "spatial axes, got '" +
-                            h.fields.at("space directions") + "'");
-    }
-    for (int a = 0; a < 3; ++a) directions.col(a) = v[a];
-  } else if (h.fields.count("spacings")) {
-    const auto w = words(h.fields.at("spacings"));
-    for (int a = 0; a < 3 && a + (dimension - 3) < static_cast<int>(w.size()); ++a) {
-      directions(a, a) = std::atof(w[a + dimension - 3].c_str());
-    }
-  }
-  if (h.fields.count("space origin")) {
-    const auto v = parse_vectors(path, "space origin", h.fields.at("space origin"));
-    if (v.size() != 1 || !v[0].allFinite()) {
-      throw ConfigError(path, "field 'space origin': expected one (x,y,z) vector");
-    }
-    origin = v[0];
-  }
-  directions *= unit;
-  origin *= unit;
-  Eigen::Vector3d spacing;
-  for (int a = 0; a < 3; ++a) spacing[a] = directions.col(a).norm();
-  if (!(spacing.minCoeff() > 0)) throw ConfigError(path, "a space direction has zero length");
-  // Nearest rotation to the (possibly slightly sheared) axes; a left-handed grid is made
-  // right-handed by reversing k.
-  Eigen::Matrix3d axes = directions * spacing.cwiseInverse().asDiagonal();
-  bool flip_k = axes.determinant() < 0;
-  if (flip_k) {
-    origin += directions.col(2) * (shape[2] - 1);
-    axes.col(2) = -axes.col(2);
-  }
-  Eigen::JacobiSVD<Eigen::Matrix3d> svd(axes, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  const Eigen::Matrix3d rotation = svd.matrixU() * svd.matrixV().transpose();
-  const Eigen::Vector3d dims = spacing.cwiseProduct(Eigen::Vector3d(shape[0], shape[1], shape[2]));
-  Eigen::Matrix4d patient = Eigen::Matrix4d::Identity();
-  patient.topLeftCorner<3, 3>() = rotation;
-  patient.topRightCorner<3, 1>() = origin + rotation * (dims / 2 - spacing / 2);
-
-  auto at = [&](std::size_t layer, int i, int j, int k) {
-    const int kk = flip_k ? shape[2] - 1 - k : k;
-    const std::size_t v = static_cast<std::size_t>(i) +
-                          std::size_t(shape[0]) * (std::size_t(j) + std::size_t(shape[1]) * kk);
-    return value_at(type, data + (v * layers + layer) * scalar_size(type));
-  };
-
-  // What the file is.
-  std::vector<Segment> segments = read_segments(path, h);
   NrrdOptions::Kind kind = options.kind;
-  double lo = 0, hi = 0;
-  std::set<long> distinct;
-  if (kind == NrrdOptions::Kind::kAuto) {
-    if (!segments.empty()) {
-      kind = NrrdOptions::Kind::kSegmentation;
-    } else {
-      lo = hi = at(0, 0, 0, 0);
-      bool integral = is_integer(type);
-      for (std::size_t v = 0; v < voxels * layers && integral; ++v) {
-        const double x = value_at(type, data + v * scalar_size(type));
-        lo = std::min(lo, x);
-        hi = std::max(hi, x);
-        if (distinct.size() <= 256) distinct.insert(static_cast<long>(x));
-      }
-      kind = integral && layers == 1 && lo >= 0 && hi <= 65535 && distinct.size() <= 256
-                 ? NrrdOptions::Kind::kLabels
-                 : NrrdOptions::Kind::kIntensity;
-    }
-  }
-  if (layers > 1 && kind != NrrdOptions::Kind::kSegmentation) {
+  if (kind == NrrdOptions::Kind::kAuto) kind = classify(layout, samples, segments);
+  if (layout.layers > 1 && kind != NrrdOptions::Kind::kSegmentation) {
     throw ConfigError(path,
                       "4D data is read only as a layered segmentation (Segment keys missing)");
   }
-
   std::shared_ptr<VolumeData> volume;
-  if (kind == NrrdOptions::Kind::kIntensity) {
-    if (!options.threshold) {
-      throw ConfigError(path, "holds intensities (type " + field("type") +
-                                  "): give a threshold to segment it (e.g. 300 for bone in HU)");
-    }
-    LabelTable table;
-    table.add(Label{1, "Segmented", {255, 249, 219}, true, false});
-    volume = std::make_shared<VolumeData>(shape, dims, LabelType::kUInt8, table);
-    volume->set_intensity_type(type == Scalar::kFloat || type == Scalar::kDouble ||
-                                       type == Scalar::kInt32 || type == Scalar::kUInt32
-                                   ? IntensityType::kFloat32
-                                   : IntensityType::kInt16);
-    auto* labels = static_cast<std::uint8_t*>(volume->label_data());
-    for (int k = 0; k < shape[2]; ++k) {
-      for (int j = 0; j < shape[1]; ++j) {
-        for (int i = 0; i < shape[0]; ++i) {
-          const double x = at(0, i, j, k);
-          const std::size_t n = volume->linear_index(i, j, k);
-          if (volume->intensity_type() == IntensityType::kInt16) {
-            static_cast<std::int16_t*>(volume->intensity_data())[n] =
-                static_cast<std::int16_t>(std::clamp(x, -32768.0, 32767.0));
-          } else {
-            static_cast<float*>(volume->intensity_data())[n] = static_cast<float>(x);
-          }
-          labels[n] = x >= *options.threshold ? 1 : 0;
-        }
-      }
-    }
-  } else if (kind == NrrdOptions::Kind::kLabels) {
-    if (!is_integer(type))
-      throw ConfigError(path, "a label map needs an integer type, got " + field("type"));
-    LabelTable table;
-    std::uint16_t max_id = 0;
-    std::vector<bool> seen(65536, false);
-    for (std::size_t v = 0; v < voxels; ++v) {
-      const double x = value_at(type, data + v * scalar_size(type));
-      if (x < 0 || x > 65535) {
-        throw ConfigError(path, "label map value " + std::to_string(static_cast<long>(x)) +
-                                    " is outside 0..65535");
-      }
-      seen[static_cast<std::size_t>(x)] = true;
-      max_id = std::max(max_id, static_cast<std::uint16_t>(x));
-    }
-    for (int id = 1; id <= max_id; ++id) {
-      if (!seen[id]) continue;
-      // A colour per id that stays the same from file to file.
-      const std::uint32_t hsh = static_cast<std::uint32_t>(id) * 2654435761u;
-      table.add(Label{static_cast<std::uint16_t>(id),
-                      "label_" + std::to_string(id),
-                      {std::uint8_t(64 + (hsh >> 24) % 192), std::uint8_t(64 + (hsh >> 16) % 192),
-                       std::uint8_t(64 + (hsh >> 8) % 192)},
-                      true,
-                      false});
-    }
-    volume = std::make_shared<VolumeData>(
-        shape, dims, max_id > 255 ? LabelType::kUInt16 : LabelType::kUInt8, table);
-    visit_labels(volume->label_type(), volume->label_data(), [&](auto* labels) {
-      using T = std::remove_pointer_t<decltype(labels)>;
-      for (int k = 0; k < shape[2]; ++k)
-        for (int j = 0; j < shape[1]; ++j)
-          for (int i = 0; i < shape[0]; ++i)
-            labels[volume->linear_index(i, j, k)] = static_cast<T>(at(0, i, j, k));
-    });
-  } else {
-    // Slicer segmentation: segment s is where its layer holds its label value. In one layer
-    // with distinct label values those values are the ids; across layers (values repeat) the
-    // ids are the segment numbers + 1.
-    if (segments.empty()) throw ConfigError(path, "no Segment<N>_* keys: not a segmentation");
-    if (!is_integer(type)) throw ConfigError(path, "a segmentation needs an integer type");
-    std::set<int> values;
-    bool keep_values = layers == 1;
-    for (const Segment& s : segments) {
-      if (s.layer < 0 || s.layer >= layers) {
-        throw ConfigError(path, "Segment" + std::to_string(s.index) + "_Layer is " +
-                                    std::to_string(s.layer) + " but the file has " +
-                                    std::to_string(layers) + " layer(s)");
-      }
-      keep_values = keep_values && s.label_value >= 1 && s.label_value <= 65535 &&
-                    values.insert(s.label_value).second;
-    }
-    std::vector<std::uint16_t> ids;
-    LabelTable table;
-    for (const Segment& s : segments) {
-      ids.push_back(static_cast<std::uint16_t>(keep_values ? s.label_value : s.index + 1));
-      table.add(Label{ids.back(), s.name, s.color, true, false});
-    }
-    volume = std::make_shared<VolumeData>(
-        shape, dims, table.max_id() > 255 ? LabelType::kUInt16 : LabelType::kUInt8, table);
-    std::int64_t overlaps = 0;
-    visit_labels(volume->label_type(), volume->label_data(), [&](auto* labels) {
-      using T = std::remove_pointer_t<decltype(labels)>;
-      for (int k = 0; k < shape[2]; ++k)
-        for (int j = 0; j < shape[1]; ++j)
-          for (int i = 0; i < shape[0]; ++i) {
-            T& out = labels[volume->linear_index(i, j, k)];
-            for (std::size_t n = 0; n < segments.size(); ++n) {
-              const Segment& s = segments[n];
-              if (at(s.layer, i, j, k) != s.label_value) continue;
-              overlaps += out != 0;
-              out = static_cast<T>(ids[n]);
-            }
-          }
-    });
-    if (overlaps > 0) {
-      log(LogLevel::kWarning,
-          path + ": " + std::to_string(overlaps) +
-              " voxels belong to more than one segment; the later segment wins");
-    }
+  switch (kind) {
+    case NrrdOptions::Kind::kIntensity:
+      volume = build_intensity(path, layout, samples, geometry, options);
+      break;
+    case NrrdOptions::Kind::kLabels:
+      volume = build_label_map(path, layout, samples, geometry);
+      break;
+    default:
+      volume = build_segmentation(path, layout, samples, geometry, segments);
+      break;
   }
-  volume->set_patient_from_volume(patient);
+  volume->set_patient_from_volume(geometry.patient);
   volume->set_source(path);
   volume->commit();
   return volume;

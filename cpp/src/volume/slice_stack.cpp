@@ -1,12 +1,10 @@
-#include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
-
 #include <algorithm>
 #include <filesystem>
 #include <map>
 #include <unordered_map>
 
 #include "ambfplus/errors.h"
+#include "ambfplus/io/image.h"
 #include "ambfplus/volume/volume_io.h"
 #include "util/strings.h"
 #include "volume/grid_access.h"
@@ -43,20 +41,28 @@ std::map<int, fs::path> find_slices(const SliceStackSpec& spec) {
   return slices;
 }
 
-cv::Mat read_slice(const fs::path& path) {
-  cv::Mat image;
-  try {
-    image = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
-  } catch (const cv::Exception& e) {
-    throw ConfigError(path.string(), std::string("cannot decode the image: ") + e.what());
+// A slice as 8-bit grey, RGB or RGBA: 16-bit samples rounded to 8 bits, grey and alpha as RGBA.
+Image read_slice(const fs::path& path) {
+  Image image = read_image(path.string());
+  if (image.type == PixelType::kUInt16) {
+    const std::size_t n = image.pixels.size() / 2;
+    std::vector<std::uint8_t> narrow(n);
+    const auto* wide = reinterpret_cast<const std::uint16_t*>(image.pixels.data());
+    // round(v / 257): 65535 maps to 255, and every 8-bit value v * 257 back to v.
+    for (std::size_t i = 0; i < n; ++i)
+      narrow[i] = static_cast<std::uint8_t>((wide[i] + 128) / 257);
+    image.pixels = std::move(narrow);
+    image.type = PixelType::kUInt8;
   }
-  if (image.empty())
-    throw ConfigError(path.string(),
-                      "cannot decode the image (corrupt or not "
-                      "an image)");
-  if (image.depth() == CV_16U) image.convertTo(image, CV_8U, 1.0 / 257.0);
-  if (image.depth() != CV_8U) {
-    throw ConfigError(path.string(), "expected 8- or 16-bit pixels");
+  if (image.channels == 2) {
+    const std::size_t n = std::size_t(image.width) * image.height;
+    std::vector<std::uint8_t> rgba(4 * n);
+    for (std::size_t i = 0; i < n; ++i) {
+      rgba[4 * i] = rgba[4 * i + 1] = rgba[4 * i + 2] = image.pixels[2 * i];
+      rgba[4 * i + 3] = image.pixels[2 * i + 1];
+    }
+    image.pixels = std::move(rgba);
+    image.channels = 4;
   }
   return image;
 }
@@ -68,7 +74,24 @@ std::uint32_t pack(std::uint8_t r, std::uint8_t g, std::uint8_t b) {
 }  // namespace
 
 std::shared_ptr<VolumeData> load_slice_stack(const SliceStackSpec& spec) {
+  if (spec.count == 0 || spec.count < -1) {
+    throw ArgumentError("slice stack " + spec.folder + ": count " + std::to_string(spec.count) +
+                        " leaves no slice (expected the largest slice index, >= 1, or -1 for "
+                        "every slice)");
+  }
+  if (spec.alpha_threshold < 0 || spec.alpha_threshold > 255) {
+    throw ArgumentError("slice stack " + spec.folder + ": alpha_threshold " +
+                        std::to_string(spec.alpha_threshold) + " is outside 0..255");
+  }
+  if (!spec.dimensions.allFinite() || !(spec.dimensions.minCoeff() > 0)) {
+    throw ArgumentError("slice stack " + spec.folder +
+                        ": dimensions must be three positive finite metres");
+  }
   const std::map<int, fs::path> slices = find_slices(spec);
+  if (slices.size() > 8192) {
+    throw ConfigError(
+        spec.folder, std::to_string(slices.size()) + " slices, more than a volume may have (8192)");
+  }
   if (slices.empty() || slices.begin()->first != 0) {
     throw AssetNotFound((fs::path(spec.folder) / (spec.prefix + "0." + spec.format)).string(),
                         "first slice of the stack");
@@ -85,37 +108,43 @@ std::shared_ptr<VolumeData> load_slice_stack(const SliceStackSpec& spec) {
   }
 
   // Read every slice once; colours map to labels through a cache.
-  std::vector<cv::Mat> images;
+  std::vector<Image> images;
   images.reserve(n);
   for (int k = 0; k < n; ++k) {
-    cv::Mat image = read_slice(slices.at(k));
-    if (k > 0 && (image.rows != images[0].rows || image.cols != images[0].cols)) {
-      throw ConfigError(slices.at(k).string(), "slice is " + std::to_string(image.cols) + "x" +
-                                                   std::to_string(image.rows) + " but slice 0 is " +
-                                                   std::to_string(images[0].cols) + "x" +
-                                                   std::to_string(images[0].rows));
+    Image image = read_slice(slices.at(k));
+    if (k > 0 && (image.height != images[0].height || image.width != images[0].width)) {
+      throw ConfigError(slices.at(k).string(), "slice is " + std::to_string(image.width) + "x" +
+                                                   std::to_string(image.height) +
+                                                   " but slice 0 is " +
+                                                   std::to_string(images[0].width) + "x" +
+                                                   std::to_string(images[0].height));
     }
-    if (k > 0 && image.channels() != images[0].channels()) {
-      throw ConfigError(slices.at(k).string(), "slice has " + std::to_string(image.channels()) +
+    if (image.width > 8192 || image.height > 8192) {
+      throw ConfigError(slices.at(k).string(), "slice is " + std::to_string(image.width) + "x" +
+                                                   std::to_string(image.height) +
+                                                   ", larger than a volume may be (8192)");
+    }
+    if (k > 0 && image.channels != images[0].channels) {
+      throw ConfigError(slices.at(k).string(), "slice has " + std::to_string(image.channels) +
                                                    " channels but slice 0 has " +
-                                                   std::to_string(images[0].channels()));
+                                                   std::to_string(images[0].channels));
     }
     images.push_back(std::move(image));
   }
-  const int width = images[0].cols, height = images[0].rows, channels = images[0].channels();
+  const int width = images[0].width, height = images[0].height, channels = images[0].channels;
 
   LabelTable table = spec.labels;
   std::unordered_map<std::uint32_t, std::uint16_t> colour_to_label;
   if (channels >= 3 && table.empty()) {
     // One label per colour found, most frequent first (ties by colour value).
     std::unordered_map<std::uint32_t, std::int64_t> counts;
-    for (const cv::Mat& image : images) {
+    for (const Image& image : images) {
       for (int r = 0; r < height; ++r) {
-        const std::uint8_t* px = image.ptr<std::uint8_t>(r);
+        const std::uint8_t* px = image.row(r);
         for (int c = 0; c < width; ++c, px += channels) {
           const bool solid =
               channels == 4 ? px[3] >= spec.alpha_threshold : (px[0] | px[1] | px[2]) != 0;
-          if (solid) ++counts[pack(px[2], px[1], px[0])];
+          if (solid) ++counts[pack(px[0], px[1], px[2])];
         }
       }
     }
@@ -140,9 +169,9 @@ std::shared_ptr<VolumeData> load_slice_stack(const SliceStackSpec& spec) {
   if (channels == 1 && table.empty()) {
     // Grey slices carry label ids; name the ids found.
     std::vector<bool> seen(256, false);
-    for (const cv::Mat& image : images) {
+    for (const Image& image : images) {
       for (int r = 0; r < height; ++r) {
-        const std::uint8_t* px = image.ptr<std::uint8_t>(r);
+        const std::uint8_t* px = image.row(r);
         for (int c = 0; c < width; ++c) seen[px[c]] = true;
       }
     }
@@ -155,19 +184,15 @@ std::shared_ptr<VolumeData> load_slice_stack(const SliceStackSpec& spec) {
       table.add(l);
     }
   }
-  if (channels == 2) {
-    throw ConfigError(slices.at(0).string(), "grey+alpha slices are not supported: use RGBA");
-  }
-
   const LabelType type = table.max_id() > 255 ? LabelType::kUInt16 : LabelType::kUInt8;
   auto volume = std::make_shared<VolumeData>(std::array<int, 3>{width, height, n}, spec.dimensions,
                                              type, table);
   visit_labels(type, volume->label_data(), [&](auto* labels) {
     using T = std::remove_pointer_t<decltype(labels)>;
     for (int k = 0; k < n; ++k) {
-      const cv::Mat& image = images[k];
+      const Image& image = images[k];
       for (int r = 0; r < height; ++r) {
-        const std::uint8_t* px = image.ptr<std::uint8_t>(r);
+        const std::uint8_t* px = image.row(r);
         T* out = labels + volume->linear_index(0, height - 1 - r, k);
         for (int c = 0; c < width; ++c, px += channels) {
           if (channels == 1) {
@@ -180,10 +205,10 @@ std::shared_ptr<VolumeData> load_slice_stack(const SliceStackSpec& spec) {
             out[c] = 0;
             continue;
           }
-          const std::uint32_t rgb = pack(px[2], px[1], px[0]);  // OpenCV reads BGR(A)
+          const std::uint32_t rgb = pack(px[0], px[1], px[2]);
           auto it = colour_to_label.find(rgb);
           if (it == colour_to_label.end()) {
-            it = colour_to_label.emplace(rgb, table.nearest({px[2], px[1], px[0]})).first;
+            it = colour_to_label.emplace(rgb, table.nearest({px[0], px[1], px[2]})).first;
           }
           out[c] = static_cast<T>(it->second);
         }
@@ -204,29 +229,28 @@ void save_slice_stack(const VolumeData& volume, const std::string& folder,
   const int width = shape[0], height = shape[1];
   std::vector<std::array<std::uint8_t, 3>> colours(65536, {255, 255, 255});
   for (const Label& l : volume.label_table().labels()) colours[l.id] = l.color;
-  cv::Mat image(height, width, CV_8UC4);
+  Image image;
+  image.width = width;
+  image.height = height;
+  image.channels = 4;
+  image.pixels.resize(image.row_bytes() * height);
   visit_labels(volume.label_type(), volume.label_data(), [&](const auto* labels) {
     for (int k = 0; k < shape[2]; ++k) {
       for (int r = 0; r < height; ++r) {
-        std::uint8_t* px = image.ptr<std::uint8_t>(r);
+        std::uint8_t* px = image.row(r);
         const auto* in = labels + volume.linear_index(0, height - 1 - r, k);
         for (int c = 0; c < width; ++c, px += 4) {
           const auto l = in[c];
           const auto& rgb = colours[l];
-          px[0] = l ? rgb[2] : 0;
+          px[0] = l ? rgb[0] : 0;
           px[1] = l ? rgb[1] : 0;
-          px[2] = l ? rgb[0] : 0;
+          px[2] = l ? rgb[2] : 0;
           px[3] = l ? 255 : 0;
         }
       }
       const std::string path =
           (fs::path(folder) / (prefix + std::to_string(k) + "." + format)).string();
-      bool ok = false;
-      try {
-        ok = cv::imwrite(path, image);
-      } catch (const cv::Exception&) {
-      }
-      if (!ok) throw ConfigError(path, "cannot write the slice image");
+      write_image(path, image);
     }
   });
 }

@@ -60,6 +60,27 @@ constexpr std::size_t kDirtyHistory = 4096;
 
 std::size_t label_bytes(LabelType t) { return t == LabelType::kUInt8 ? 1 : 2; }
 
+// Throws unless box is a box of the grid: lo <= hi on every axis (ArgumentError) and inside
+// [0, shape] (OutOfRange). An empty box (lo == hi) is fine.
+void check_box(const char* what, const VoxelBox& box, const std::array<int, 3>& shape) {
+  auto text = [](const std::array<int, 3>& v) {
+    return "(" + std::to_string(v[0]) + ", " + std::to_string(v[1]) + ", " + std::to_string(v[2]) +
+           ")";
+  };
+  for (int a = 0; a < 3; ++a) {
+    if (box.lo[a] > box.hi[a]) {
+      throw ArgumentError(std::string(what) + ": lo " + text(box.lo) + " is above hi " +
+                          text(box.hi) + " on axis " + "ijk"[a] + " (expected lo <= hi)");
+    }
+  }
+  for (int a = 0; a < 3; ++a) {
+    if (box.lo[a] < 0 || box.hi[a] > shape[a]) {
+      throw OutOfRange(std::string(what) + ": box " + text(box.lo) + ".." + text(box.hi) +
+                       " reaches outside the grid (0, 0, 0).." + text(shape));
+    }
+  }
+}
+
 void check_table_fits(const LabelTable& table, LabelType type) {
   if (type == LabelType::kUInt8 && table.max_id() > 255) {
     throw ArgumentError("label id " + std::to_string(table.max_id()) +
@@ -87,7 +108,9 @@ VolumeData::VolumeData(const std::array<int, 3>& shape, const Eigen::Vector3d& d
 
 void VolumeData::set_dimensions(const Eigen::Vector3d& dimensions) {
   if (!(dimensions.minCoeff() > 0.0) || !dimensions.allFinite()) {
-    throw ArgumentError("volume dimensions must be positive metres");
+    throw ArgumentError("volume dimensions must be positive finite metres, got (" +
+                        std::to_string(dimensions.x()) + ", " + std::to_string(dimensions.y()) +
+                        ", " + std::to_string(dimensions.z()) + ")");
   }
   dimensions_ = dimensions;
 }
@@ -157,6 +180,11 @@ void VolumeData::set_intensity_type(IntensityType type) {
 }
 
 Eigen::Vector3d VolumeData::voxel_center(int i, int j, int k) const {
+  if (i < 0 || j < 0 || k < 0 || i >= shape_[0] || j >= shape_[1] || k >= shape_[2]) {
+    throw OutOfRange("voxel_center: voxel (" + std::to_string(i) + ", " + std::to_string(j) + ", " +
+                     std::to_string(k) + ") is outside the grid of " + std::to_string(shape_[0]) +
+                     "x" + std::to_string(shape_[1]) + "x" + std::to_string(shape_[2]));
+  }
   return from_voxel_units(Eigen::Vector3d(i + 0.5, j + 0.5, k + 0.5));
 }
 
@@ -205,17 +233,21 @@ void VolumeData::log_edit(VolumeEdit edit) {
 
 std::int64_t VolumeData::remove_sphere(const Eigen::Vector3d& center, double radius,
                                        bool only_removable) {
-  if (!(radius >= 0.0) || !center.allFinite()) {
-    throw ArgumentError("remove_sphere needs a finite centre and a radius >= 0");
+  if (!(radius >= 0.0) || !std::isfinite(radius) || !center.allFinite()) {
+    throw ArgumentError(
+        "remove_sphere needs a finite centre and a finite radius >= 0, got radius " +
+        std::to_string(radius));
   }
   const Eigen::Vector3d s = voxel_size();
   const Eigen::Vector3d u = to_voxel_units(center);
   VoxelBox box;
   for (int a = 0; a < 3; ++a) {
-    box.lo[a] = static_cast<int>(std::floor(u[a] - radius / s[a] - 0.5));
-    box.hi[a] = static_cast<int>(std::ceil(u[a] + radius / s[a] + 0.5)) + 1;
+    // Clamped before the conversion, so a far centre or a huge radius cannot overflow an int.
+    const double lo = std::floor(u[a] - radius / s[a] - 0.5);
+    const double hi = std::ceil(u[a] + radius / s[a] + 0.5) + 1;
+    box.lo[a] = static_cast<int>(std::clamp(lo, 0.0, double(shape_[a])));
+    box.hi[a] = static_cast<int>(std::clamp(hi, 0.0, double(shape_[a])));
   }
-  box = box.clipped(shape_);
   std::vector<bool> keep(label_type_ == LabelType::kUInt8 ? 256 : 65536, false);
   if (only_removable) {
     for (const Label& l : table_.labels()) keep[l.id] = !l.removable;
@@ -276,7 +308,8 @@ std::int64_t VolumeData::set_region(const VoxelBox& region, std::uint16_t label)
   if (label_type_ == LabelType::kUInt8 && label > 255) {
     throw ArgumentError("label " + std::to_string(label) + " does not fit a uint8 grid");
   }
-  const VoxelBox box = region.clipped(shape_);
+  check_box("set_region", region, shape_);
+  const VoxelBox box = region;
   std::int64_t changed = 0;
   visit_labels(label_type_, labels_.data(), [&](auto* p) {
     using T = std::remove_pointer_t<decltype(p)>;
@@ -300,9 +333,10 @@ std::int64_t VolumeData::set_region(const VoxelBox& region, std::uint16_t label)
 }
 
 void VolumeData::mark_dirty(const VoxelBox& box) {
+  check_box("mark_dirty", box, shape_);
   VolumeEdit edit;
   edit.kind = "mark_dirty";
-  edit.box = box.clipped(shape_);
+  edit.box = box;
   if (!edit.box.empty()) record(std::move(edit));
 }
 

@@ -298,8 +298,11 @@ struct AMBFPLUS_API DeviceRecord {
 /// Plays back logged readings: the reading logged for a step (held until the next logged one).
 class AMBFPLUS_API ReplayDevice final : public Device {
  public:
-  /// Records in increasing step order; throws ArgumentError otherwise.
-  explicit ReplayDevice(std::vector<DeviceRecord> records, DeviceSpec spec = {"replay"});
+  /// Records in increasing step order; throws ArgumentError otherwise. By default it limits no
+  /// force (it renders none): a replay reproduces the recorded session's limit through its
+  /// binding's max_force.
+  explicit ReplayDevice(std::vector<DeviceRecord> records,
+                        DeviceSpec spec = {"replay", std::numeric_limits<double>::infinity()});
   DeviceState read(std::int64_t step, double time) override;
   /// Steps read beyond the last record.
   std::int64_t steps_past_end() const { return past_end_; }

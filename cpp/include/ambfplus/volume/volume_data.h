@@ -114,7 +114,7 @@ class AMBFPLUS_API VolumeData {
   /// Allocates a zeroed intensity grid of this type (kNone removes it).
   void set_intensity_type(IntensityType type);
 
-  /// Centre of voxel (i, j, k) in the volume frame.
+  /// Centre of voxel (i, j, k) in the volume frame; throws OutOfRange outside the grid.
   Eigen::Vector3d voxel_center(int i, int j, int k) const;
   /// Volume-frame point to continuous voxel units.
   Eigen::Vector3d to_voxel_units(const Eigen::Vector3d& p) const;
@@ -134,17 +134,20 @@ class AMBFPLUS_API VolumeData {
 
   // --- Editing: every edit bumps revision() and records its box for renderers and the log.
 
-  /// Clears the voxels whose centres lie within radius of center (volume frame); with
-  /// only_removable, voxels whose label is not removable stay. Returns how many were cleared.
+  /// Clears the voxels whose centres lie within radius of center (volume frame; both finite, else
+  /// ArgumentError); with only_removable, voxels whose label is not removable stay. Returns how
+  /// many were cleared.
   std::int64_t remove_sphere(const Eigen::Vector3d& center, double radius,
                              bool only_removable = true);
   /// Clears the given voxels (one edit of `kind`, logging the voxels that were solid and their
   /// labels). Returns the labels they had, 0 for those already empty.
   std::vector<std::uint16_t> remove_voxels(const std::vector<std::array<int, 3>>& voxels,
                                            const std::string& kind = "drill");
-  /// Sets every voxel of the box to label (0 clears). Returns how many changed.
+  /// Sets every voxel of the box to label (0 clears). Returns how many changed. Throws
+  /// ArgumentError for an inverted box (lo > hi) and OutOfRange for one reaching outside the grid.
   std::int64_t set_region(const VoxelBox& box, std::uint16_t label);
-  /// Declares that the labels in box were changed directly (through the NumPy view).
+  /// Declares that the labels in box were changed directly (through the NumPy view). Throws as
+  /// set_region does for an inverted box or one outside the grid.
   void mark_dirty(const VoxelBox& box);
   /// Restores the labels the volume had when it was loaded or last committed.
   void reset();

@@ -263,6 +263,10 @@ class RigidBody(Object):
     def damping(self) -> tuple[float, float]: ...
     @damping.setter
     def damping(self, value: tuple[float, float]) -> None: ...
+    @property
+    def is_ghost(self) -> bool: ...
+    @property
+    def overlapping(self) -> list[RigidBody]: ...
 
 class Joint(Object):
     @property
@@ -313,6 +317,13 @@ class Joint(Object):
     def controller(self) -> dict[str, float | str]: ...
     @controller.setter
     def controller(self, value: dict[str, float | str]) -> None: ...
+    @property
+    def six_dof(self) -> dict[str, list[float | None]] | None: ...
+    @six_dof.setter
+    def six_dof(self, value: dict[str, Sequence[float | None]]) -> None: ...
+    @property
+    def six_dof_coordinates(self) -> list[float]: ...
+    def set_cone_twist_limits(self, twist: float, swing_y: float, swing_z: float) -> None: ...
 
 class Camera(Object):
     @property
@@ -729,6 +740,24 @@ def _benchmark_collision(drill: Drill, cursor: int = 0, iterations: int = 20) ->
 def _benchmark_removal(drill: Drill, count: int) -> dict[str, Any]: ...
 
 class _Adders:
+    def add_ghost(
+        self,
+        name: str,
+        shape: str = "",
+        *,
+        size: _Vec3 | None = None,
+        radius: float | None = None,
+        height: float | None = None,
+        mesh: str | None = None,
+        scale: float = 1.0,
+        pose: _Mat4 | None = None,
+        color: Sequence[float] | None = None,
+        visible: bool = True,
+        collision_mesh: str = "",
+        collision_type: str = "concave",
+        collision_shapes: Sequence[dict[str, Any]] = (),
+        margin: float = 0.001,
+    ) -> RigidBody: ...
     def add_body(
         self,
         name: str,

@@ -4,10 +4,12 @@
 
 #include <optional>
 
+#include "ambfplus/scene/ghost.h"
 #include "ambfplus/scene/joint.h"
 #include "ambfplus/scene/model.h"
 #include "ambfplus/scene/rigid_body.h"
 #include "ambfplus/scene/simulator.h"
+#include "ambfplus/scene/six_dof.h"
 #include "bindings.h"
 
 namespace py = pybind11;
@@ -236,7 +238,17 @@ void register_physics(py::module_& m,
             return py::make_tuple(b.dynamics().linear_damping, b.dynamics().angular_damping);
           },
           [](RigidBody& b, std::pair<double, double> d) { b.set_damping(d.first, d.second); },
-          "(linear, angular), 0..1");
+          "(linear, angular), 0..1")
+      .def_property_readonly("is_ghost", &is_ghost, "a ghost object (World.add_ghost)")
+      .def_property_readonly(
+          "overlapping",
+          [](RigidBody& b) {
+            py::list out;
+            for (RigidBody* o : ghost_overlaps(b)) out.append(handle(o, b.world()));
+            return out;
+          },
+          "a ghost's overlapping bodies after the last step (Bullet's narrow phase), in "
+          "creation order; ValueError for a body that is not a ghost");
 
   joint.def_property_readonly("type", [](Joint& j) { return joint_type_name(j.type()); })
       .def_property_readonly("parent",
@@ -289,7 +301,52 @@ void register_physics(py::module_& m,
           [](Joint& j, const py::dict& d) {
             j.set_controller(parse_controller(d, j.spec().controller));
           },
-          "{p, i, d, output}; output 'effort' or 'velocity'; assigning updates the keys given");
+          "{p, i, d, output}; output 'effort' or 'velocity'; assigning updates the keys given")
+      .def_property(
+          "six_dof",
+          [](Joint& j) -> py::object {
+            const std::optional<SixDofAxes> a = six_dof_axes(j);
+            if (!a) return py::none();
+            py::dict d;
+            d["lower"] = std::vector<std::optional<double>>(a->lower.begin(), a->lower.end());
+            d["upper"] = std::vector<std::optional<double>>(a->upper.begin(), a->upper.end());
+            d["stiffness"] = a->stiffness;
+            d["damping"] = a->damping;
+            d["equilibrium"] = a->equilibrium;
+            return std::move(d);
+          },
+          [](Joint& j, const py::dict& d) {
+            SixDofAxes a = six_dof_axes(j).value_or(SixDofAxes{});
+            for (auto item : d) {
+              const std::string key = py::str(item.first);
+              if (key == "lower" || key == "upper") {
+                const auto v = item.second.cast<std::vector<std::optional<double>>>();
+                if (v.size() != 6) throw py::value_error("six_dof: '" + key + "' needs 6 values");
+                auto& out = key == "lower" ? a.lower : a.upper;
+                std::copy(v.begin(), v.end(), out.begin());
+              } else if (key == "stiffness" || key == "damping" || key == "equilibrium") {
+                const auto v = item.second.cast<std::vector<double>>();
+                if (v.size() != 6) throw py::value_error("six_dof: '" + key + "' needs 6 values");
+                auto& out = key == "stiffness" ? a.stiffness
+                            : key == "damping" ? a.damping
+                                               : a.equilibrium;
+                std::copy(v.begin(), v.end(), out.begin());
+              } else {
+                throw py::value_error("six_dof: unknown key '" + key +
+                                      "' (lower, upper, stiffness, damping, equilibrium)");
+              }
+            }
+            set_six_dof_axes(j, a);
+          },
+          "a six dof (spring) joint's per-axis settings {lower, upper, stiffness, damping, "
+          "equilibrium}, 6 values each (x, y, z translation, then x, y, z rotation; a limit "
+          "None or lower > upper: free); None before any were set; assigning updates the keys "
+          "given")
+      .def_property_readonly(
+          "six_dof_coordinates", [](Joint& j) { return six_dof_coordinates(j); },
+          "a six dof (spring) joint's six coordinates now (m, rad)")
+      .def("set_cone_twist_limits", &set_cone_twist_limits, py::arg("twist"), py::arg("swing_y"),
+           py::arg("swing_z"), "a cone twist joint's twist (about its axis) and swing spans, rad");
 }
 
 }  // namespace ambfplus::bindings

@@ -9,6 +9,7 @@
 #include "ambfplus/adf/volume_adf.h"
 #include "ambfplus/haptics/device.h"
 #include "ambfplus/render/render_stats.h"
+#include "ambfplus/scene/ghost.h"
 #include "ambfplus/scene/simulator.h"
 #include "bindings.h"
 
@@ -84,12 +85,12 @@ void reject(bool given, const char* key, Shape::Kind kind) {
   }
 }
 
-RigidBody& add_body(Model& model, const std::string& name, const std::string& shape,
-                    std::optional<Vec3> size, std::optional<double> radius,
-                    std::optional<double> height, std::optional<std::string> mesh, double scale,
-                    std::optional<Mat4> pose, double mass, std::optional<std::vector<double>> color,
-                    std::optional<double> specular, std::optional<double> shininess,
-                    const py::kwargs& physics) {
+RigidBodySpec body_spec(const std::string& name, const std::string& shape, std::optional<Vec3> size,
+                        std::optional<double> radius, std::optional<double> height,
+                        std::optional<std::string> mesh, double scale, std::optional<Mat4> pose,
+                        double mass, std::optional<std::vector<double>> color,
+                        std::optional<double> specular, std::optional<double> shininess,
+                        const py::kwargs& physics) {
   RigidBodySpec spec;
   spec.name = name;
   spec.shape.kind = parse_shape_kind(shape.empty() ? (mesh ? "mesh" : "box") : shape);
@@ -149,12 +150,12 @@ RigidBody& add_body(Model& model, const std::string& name, const std::string& sh
   if (specular) spec.material.specular = static_cast<float>(*specular);
   if (shininess) spec.material.shininess = static_cast<float>(*shininess);
   apply_body_options(spec, physics);
-  RigidBody* body = nullptr;
-  {
-    py::gil_scoped_release release;  // mesh files can take a while to read
-    body = &model.add_body(spec);
-  }
-  return *body;
+  return spec;
+}
+
+RigidBody& add_body(Model& model, const RigidBodySpec& spec) {
+  py::gil_scoped_release release;  // mesh files can take a while to read
+  return model.add_body(spec);
 }
 
 Camera& add_camera(Model& model, const std::string& name, int width, int height, double fov_y,
@@ -201,9 +202,9 @@ void def_adders(Class& cls, GetModel get_model) {
                      std::optional<std::vector<double>> color, std::optional<double> specular,
                      std::optional<double> shininess, const py::kwargs& physics) {
            Model& model = get_model(self);
-           return handle(&add_body(model, name, shape, size, radius, height, mesh, scale, pose,
-                                   mass, color, specular, shininess, physics),
-                         model.world());
+           const RigidBodySpec spec = body_spec(name, shape, size, radius, height, mesh, scale,
+                                                pose, mass, color, specular, shininess, physics);
+           return handle(&add_body(model, spec), model.world());
          },
          py::arg("name"), py::arg("shape") = "", py::kw_only(), py::arg("size") = py::none(),
          py::arg("radius") = py::none(), py::arg("height") = py::none(),
@@ -218,6 +219,33 @@ void def_adders(Class& cls, GetModel get_model) {
          "linear_damping, angular_damping, kinematic, collision (False: none), collision_mesh, "
          "collision_type (concave, convex_mesh, convex_hull, point_cloud), collision_shapes "
          "([{shape, size/radius/height/axis, pose}]), margin, groups ([0..31]).")
+      .def(
+          "add_ghost",
+          [get_model](typename Class::type& self, const std::string& name, const std::string& shape,
+                      std::optional<Vec3> size, std::optional<double> radius,
+                      std::optional<double> height, std::optional<std::string> mesh, double scale,
+                      std::optional<Mat4> pose, std::optional<std::vector<double>> color,
+                      bool visible, const py::kwargs& collision) {
+            Model& model = get_model(self);
+            RigidBodySpec spec = body_spec(name, shape, size, radius, height, mesh, scale, pose,
+                                           0.0, color, std::nullopt, std::nullopt, collision);
+            spec.material.visible = visible;
+            RigidBody* ghost = nullptr;
+            {
+              py::gil_scoped_release release;
+              ghost = &add_ghost(model, spec);
+            }
+            return handle(ghost, model.world());
+          },
+          py::arg("name"), py::arg("shape") = "", py::kw_only(), py::arg("size") = py::none(),
+          py::arg("radius") = py::none(), py::arg("height") = py::none(),
+          py::arg("mesh") = py::none(), py::arg("scale") = 1.0, py::arg("pose") = py::none(),
+          py::arg("color") = py::none(), py::arg("visible") = true,
+          "Adds a ghost object (AMBF's ghost objects): a shape as add_body takes it that "
+          "touches nothing (no force, rays pass through) and reports, after every step, the "
+          "bodies overlapping it (body.overlapping, Bullet's narrow phase). It moves by its pose "
+          "or rides on a parent (attach_to). Collision keywords of add_body (collision_mesh, "
+          "collision_type, collision_shapes, margin) shape what it tests.")
       .def(
           "add_joint",
           [get_model](typename Class::type& self, const std::string& name, RigidBody& parent,

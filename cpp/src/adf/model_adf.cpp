@@ -14,11 +14,14 @@
 #include <Eigen/Geometry>
 
 #include "adf/adf_internal.h"
+#include "adf/joint_axes_adf.h"
 #include "ambfplus/adf/volume_adf.h"
 #include "ambfplus/errors.h"
 #include "ambfplus/plugin/registry.h"
 #include "ambfplus/scene/constraint_actuator.h"
+#include "ambfplus/scene/ghost.h"
 #include "ambfplus/scene/proximity_sensor.h"
+#include "ambfplus/scene/six_dof.h"
 #include "ambfplus/scene/soft_body.h"
 #include "ambfplus/scene/world.h"
 #include "util/strings.h"
@@ -364,6 +367,8 @@ struct JointPlan {
   YAML::Node block;
   JointSpec spec;  // without its bodies
   std::vector<AdfPlugin> plugins;
+  std::optional<SixDofAxes> six_dof;          // six dof (spring) per-axis settings
+  std::optional<std::array<double, 3>> cone;  // cone twist limits
 };
 
 JointPlan plan_joint(const Doc& doc, const std::string& model_ns, const std::string& id,
@@ -428,25 +433,31 @@ JointPlan plan_joint(const Doc& doc, const std::string& model_ns, const std::str
 
   const bool multi_axis = s.type == JointType::kConeTwist || s.type == JointType::kSixDof ||
                           s.type == JointType::kSixDofSpring;
-  if (multi_axis) {
-    for (const char* key : {"joint limits", "stiffness", "damping", "equilibrium point"}) {
-      if (j[key]) {
-        ctx.diag->warn(doc.path, at(j[key]) + id + ": '" + key + "' of a " +
-                                     joint_type_name(s.type) + " joint is not applied yet");
-      }
-    }
+  if (s.type == JointType::kConeTwist) {
+    plan.cone = read_cone_twist_limits(doc, j, id, ctx);
+  } else if (multi_axis) {
+    plan.six_dof = read_six_dof_axes(doc, j, id, s.type, ctx);
   } else {
+    double middle = 0.0;
     if (const YAML::Node limits = j["joint limits"]) {
       // AMBF turns limits on only when both are given.
       if (limits["low"] && limits["high"]) {
-        s.lower = number(doc, limits["low"], id, "joint limits.low");
-        s.upper = number(doc, limits["high"], id, "joint limits.high");
-        if (*s.lower > *s.upper) fail(doc, limits, id, "'joint limits' has low > high");
+        const double low = number(doc, limits["low"], id, "joint limits.low");
+        const double high = number(doc, limits["high"], id, "joint limits.high");
+        middle = (low + high) / 2;
+        if (low > high) {
+          // AMBF hands them to Bullet, which reads such a range as no limit.
+          ctx.diag->warn(doc.path, at(limits) + id +
+                                       ": 'joint limits' has low > high; Bullet (and so AMBF) "
+                                       "reads that as no limit: the joint moves freely");
+        } else {
+          s.lower = low;
+          s.upper = high;
+        }
       }
     }
     s.damping = number_or(doc, j, "damping", id, 0.0);
     s.stiffness = number_or(doc, j, "stiffness", id, 0.0);
-    const double middle = s.lower && s.upper ? (*s.lower + *s.upper) / 2 : 0.0;
     s.equilibrium = number_or(doc, j, "equilibrium point", id, middle);
   }
   s.max_motor_impulse = number_or(doc, j, "max motor impulse", id, s.max_motor_impulse);
@@ -721,7 +732,7 @@ std::optional<SensorPlan> plan_sensor(const Doc& doc, const std::string& model_n
     ctx.diag->unknown_keys(
         doc, id, n,
         {"name", "namespace", "type", "parent", "location", "range", "array", "parametric", "mesh",
-         "visible", "visible size", "publish frequency", "passive"});
+         "direction", "visible", "visible size", "publish frequency", "passive"});
   }
   if (!n["parent"]) fail(doc, n, id, std::string("a ") + what + " needs 'parent'");
   SensorPlan p;
@@ -770,8 +781,17 @@ std::optional<SensorPlan> plan_sensor(const Doc& doc, const std::string& model_n
     ctx.diag->warn(
         doc.path, at(n["mesh"]) + id + ": sensor rays from a mesh are not supported yet; left out");
     return std::nullopt;
+  } else if (const YAML::Node direction = n["direction"]) {
+    // AMBF's older form: one ray from the sensor's location along `direction`, `range` long.
+    SensorRay r;
+    r.offset = Eigen::Vector3d::Zero();
+    r.direction = xyz(doc, direction, id, "direction", Eigen::Vector3d::Zero());
+    if (!(r.direction.norm() > 1e-12)) fail(doc, direction, id, "'direction' must not be zero");
+    r.direction.normalize();
+    s.rays.push_back(r);
   } else {
-    fail(doc, n, id, "a proximity sensor needs 'array' or 'parametric' rays");
+    fail(doc, n, id,
+         "a proximity sensor needs 'array' or 'parametric' rays, or one ray's 'direction'");
   }
   return p;
 }
@@ -824,6 +844,41 @@ Eigen::Isometry3d parent_frame(const Object& parent) {
   return frame;
 }
 
+// Runs attempt now; if what it names is not in the world yet, keeps it to run again when a later
+// file brings it (AMBF resolves parents across files, in any order). `missing` is the warning
+// if that never happens.
+void now_or_later(Model& model, const Doc& doc, const std::function<std::string()>& missing,
+                  std::function<bool(World&)> attempt) {
+  if (attempt(model.world())) return;
+  model.world().defer_link({&model, doc.path, missing(), std::move(attempt)});
+}
+
+// Attaches child to the object parent names (looked up in own, then the world) at local in
+// that object's frame, now or once it appears.
+void attach_when_found(Model& model, const Doc& doc, Object& child, const std::string& id,
+                       const std::string& parent, const std::string& ns,
+                       const std::vector<std::pair<std::string, RigidBody*>>& own,
+                       const Eigen::Isometry3d& local) {
+  if (parent.empty()) return;
+  Object* target = &child;
+  auto attempt = [target, parent, ns, own, local](World& world) {
+    std::string why;
+    Object* found = find_object(world, parent, ns, own, std::nullopt, why);
+    if (found == nullptr) return false;
+    target->attach_to(found, parent_frame(*found) * local);
+    return true;
+  };
+  now_or_later(
+      model, doc,
+      [&] {
+        std::string why;
+        find_object(model.world(), parent, ns, own, std::nullopt, why);
+        return id + ": parent '" + parent + "' not found (" + why +
+               "); placed in the world frame instead (attached if a later load brings it)";
+      },
+      attempt);
+}
+
 }  // namespace
 
 std::string join_ns(const std::string& prefix, const std::string& base, const std::string& ns) {
@@ -861,18 +916,7 @@ void add_cameras_and_lights(Model& model, const Doc& doc, const std::string& bas
   for (const auto& [id, block] : listed(doc, "lights")) {
     lights.push_back(plan_light(doc, base_ns, id, block, ctx));
   }
-  // A parent that is not there leaves the object in the world frame, with a warning.
-  auto parent_of = [&](const std::string& id, const std::string& parent,
-                       const std::string& ns) -> Object* {
-    if (parent.empty()) return nullptr;
-    std::string why;
-    Object* found = find_object(world, parent, ns, own, std::nullopt, why);
-    if (found == nullptr) {
-      ctx.diag->warn(doc.path, id + ": parent '" + parent + "' not found (" + why +
-                                   "); placed in the world frame instead");
-    }
-    return found;
-  };
+  // A parent that is not there yet leaves the object in the world frame until it comes.
   for (CameraPlan& c : cameras) {
     c.spec.name = unique_name(world, c.spec.name);
     Camera& camera = model.add_camera(c.spec);
@@ -880,9 +924,7 @@ void add_cameras_and_lights(Model& model, const Doc& doc, const std::string& bas
     camera.set_name_space(c.ns);
     camera.set_preprocessing_shader(c.preprocessing);
     camera.look_at(c.eye, c.target, c.up);
-    if (Object* parent = parent_of(c.id, c.parent, c.ns)) {
-      camera.attach_to(parent, parent_frame(*parent) * camera.pose());
-    }
+    attach_when_found(model, doc, camera, c.id, c.parent, c.ns, own, camera.pose());
     if (c.eye_separation > 0) {
       // AMBF's passive stereo: two eyes half the separation either side, converging (off-axis)
       // at the focal length when one is given.
@@ -907,9 +949,7 @@ void add_cameras_and_lights(Model& model, const Doc& doc, const std::string& bas
     Light& light = model.add_light(l.spec);
     light.set_identifier(l.id);
     light.set_name_space(l.ns);
-    if (Object* parent = parent_of(l.id, l.parent, l.ns)) {
-      light.attach_to(parent, parent_frame(*parent) * light.pose());
-    }
+    attach_when_found(model, doc, light, l.id, l.parent, l.ns, own, light.pose());
     if (!l.plugins.empty()) plugins.push_back({&light, l.id, l.plugins});
   }
 }
@@ -963,7 +1003,27 @@ Model& load_model(World& world, const std::string& path, Context& ctx) {
   // Everything is read (and every mesh found) before anything is created.
   std::vector<BodyPlan> bodies;
   for (const auto& [id, block] : listed(doc, "bodies")) {
-    bodies.push_back(plan_body(doc, hr, lr, model_ns, id, block, ctx));
+    try {
+      bodies.push_back(plan_body(doc, hr, lr, model_ns, id, block, ctx));
+    } catch (const AssetNotFound& e) {
+      // A world's environment goes on without a body whose mesh is missing (AMBF's scope).
+      if (!ctx.skip_missing_meshes) throw;
+      ctx.diag->error(doc.path, at(block) + id + ": left out: " + e.what());
+    }
+  }
+  // Ghost objects: a body's keys (no mass) and a `parent` they ride on.
+  struct GhostPlan {
+    BodyPlan body;
+    std::string parent;
+  };
+  std::vector<GhostPlan> ghosts;
+  for (const auto& [id, block] : listed(doc, "ghost objects")) {
+    YAML::Node keys = YAML::Clone(block);
+    std::string parent;
+    if (block["parent"]) parent = text(doc, block["parent"], id, "parent");
+    keys.remove("parent");
+    if (!keys["mass"]) keys["mass"] = 0.0;  // a ghost has none; no warning about it
+    ghosts.push_back({plan_body(doc, hr, lr, model_ns, id, keys, ctx), parent});
   }
   std::vector<JointPlan> joints;
   for (const auto& [id, block] : listed(doc, "joints")) {
@@ -981,10 +1041,8 @@ Model& load_model(World& world, const std::string& path, Context& ctx) {
       if (auto p = plan_sensor(doc, model_ns, actuator, id, block, ctx)) sensors.push_back(*p);
     }
   }
-  for (const char* key : {"ghost objects", "vehicles"}) {
-    if (!listed(doc, key).empty()) {
-      ctx.diag->warn(doc.path, at(root[key]) + "'" + key + "' are not loaded yet");
-    }
+  if (!listed(doc, "vehicles").empty()) {
+    ctx.diag->warn(doc.path, at(root["vehicles"]) + "'vehicles' are not loaded yet");
   }
   const std::optional<ShaderSpec> model_shader =
       read_shader(doc, root["shaders"], where, "shaders", ctx);
@@ -1028,46 +1086,98 @@ Model& load_model(World& world, const std::string& path, Context& ctx) {
       soft.set_name_space(model_ns);
       if (!soft_plugins[i].empty()) object_plugins.push_back({&soft, id, soft_plugins[i]});
     }
+    // Joints, sensors and actuators whose bodies are not in the world yet are made when a
+    // later file brings them.
+    Model* target = &model;
     for (JointPlan& j : joints) {
       current = j.id;
-      std::string why_parent, why_child;
-      RigidBody* parent = find_body(world, j.parent, model_ns, own, why_parent);
-      RigidBody* child = find_body(world, j.child, model_ns, own, why_child);
-      if (parent == nullptr || child == nullptr) {
-        ctx.diag->warn(doc.path, at(j.block) + j.id + ": joint left out: " +
-                                     (parent == nullptr ? why_parent : why_child));
-        continue;
+      const bool now = [&] {
+        std::string why;
+        return find_body(world, j.parent, model_ns, own, why) != nullptr &&
+               find_body(world, j.child, model_ns, own, why) != nullptr;
+      }();
+      if (!now && !j.plugins.empty()) {
+        ctx.diag->warn(doc.path, at(j.block) + j.id +
+                                     ": its plugins are not loaded: its bodies come in a later "
+                                     "file");
       }
-      j.spec.parent = parent;
-      j.spec.child = child;
-      j.spec.parent_pivot *= parent->shape().scale;
-      j.spec.child_pivot *= child->shape().scale;
-      j.spec.name = unique_name(world, j.spec.name);
-      Joint& joint = model.add_joint(j.spec);
-      joint.set_identifier(j.id);
-      joint.set_name_space(j.ns);
-      if (!j.plugins.empty()) object_plugins.push_back({&joint, j.id, j.plugins});
+      // Plugins only for a joint made now (a later one's file has finished loading).
+      std::vector<ObjectPlugins>* sink = now ? &object_plugins : nullptr;
+      auto make = [target, plan = j, model_ns, own, sink](World& w) {
+        std::string why;
+        RigidBody* parent = find_body(w, plan.parent, model_ns, own, why);
+        RigidBody* child = find_body(w, plan.child, model_ns, own, why);
+        if (parent == nullptr || child == nullptr) return false;
+        JointSpec spec = plan.spec;
+        spec.parent = parent;
+        spec.child = child;
+        spec.parent_pivot *= parent->shape().scale;
+        spec.child_pivot *= child->shape().scale;
+        spec.name = unique_name(w, spec.name);
+        Joint& joint = target->add_joint(spec);
+        joint.set_identifier(plan.id);
+        joint.set_name_space(plan.ns);
+        if (plan.six_dof) set_six_dof_axes(joint, *plan.six_dof);
+        if (plan.cone)
+          set_cone_twist_limits(joint, (*plan.cone)[0], (*plan.cone)[1], (*plan.cone)[2]);
+        if (sink != nullptr && !plan.plugins.empty()) {
+          sink->push_back({&joint, plan.id, plan.plugins});
+        }
+        return true;
+      };
+      now_or_later(
+          model, doc,
+          [&] {
+            std::string why_parent, why_child;
+            const bool has_parent =
+                find_body(world, j.parent, model_ns, own, why_parent) != nullptr;
+            find_body(world, j.child, model_ns, own, why_child);
+            return at(j.block) + j.id +
+                   ": joint left out: " + (has_parent ? why_child : why_parent) +
+                   " (made if a later load brings it)";
+          },
+          make);
     }
     for (SensorPlan& p : sensors) {
       current = p.id;
-      std::string why;
-      RigidBody* parent = find_body(world, p.parent, model_ns, own, why);
-      if (parent == nullptr) {
-        ctx.diag->warn(doc.path, at(p.block) + p.id + ": left out: " + why);
-        continue;
-      }
-      Object* made = nullptr;
-      if (p.actuator) {
-        p.act.parent = parent;
-        p.act.name = unique_name(world, p.act.name);
-        made = &model.add_actuator(p.act);
-      } else {
-        p.sensor.parent = parent;
-        p.sensor.name = unique_name(world, p.sensor.name);
-        made = &model.add_sensor(p.sensor);
-      }
-      made->set_identifier(p.id);
-      made->set_name_space(p.ns);
+      auto make = [target, plan = p, model_ns, own](World& w) {
+        std::string why;
+        RigidBody* parent = find_body(w, plan.parent, model_ns, own, why);
+        if (parent == nullptr) return false;
+        Object* made = nullptr;
+        if (plan.actuator) {
+          ConstraintActuatorSpec spec = plan.act;
+          spec.parent = parent;
+          spec.name = unique_name(w, spec.name);
+          made = &target->add_actuator(spec);
+        } else {
+          ProximitySensorSpec spec = plan.sensor;
+          spec.parent = parent;
+          spec.name = unique_name(w, spec.name);
+          made = &target->add_sensor(spec);
+        }
+        made->set_identifier(plan.id);
+        made->set_name_space(plan.ns);
+        return true;
+      };
+      now_or_later(
+          model, doc,
+          [&] {
+            std::string why;
+            find_body(world, p.parent, model_ns, own, why);
+            return at(p.block) + p.id + ": left out: " + why + " (made if a later load brings it)";
+          },
+          make);
+    }
+    for (GhostPlan& g : ghosts) {
+      current = g.body.id;
+      g.body.spec.name = unique_name(world, g.body.spec.name);
+      RigidBody& ghost = add_ghost(model, g.body.spec);
+      ghost.set_identifier(g.body.id);
+      ghost.set_name_space(g.body.ns);
+      if (!g.body.plugins.empty()) object_plugins.push_back({&ghost, g.body.id, g.body.plugins});
+      attach_when_found(model, doc, ghost, g.body.id, g.parent, g.body.ns, own,
+                        Eigen::Isometry3d(g.body.spec.pose));
     }
     current = "cameras and lights";
     add_cameras_and_lights(model, doc, model_ns, ctx, own, object_plugins);

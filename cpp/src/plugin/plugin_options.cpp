@@ -6,6 +6,7 @@
 
 #include "ambfplus/errors.h"
 #include "ambfplus/haptics/drill.h"
+#include "ambfplus/scene/ghost.h"
 #include "ambfplus/scene/model.h"
 #include "ambfplus/scene/world.h"
 
@@ -70,7 +71,9 @@ Eigen::Matrix4d pose(const Option& o) {
 
 }  // namespace
 
-RigidBody& add_body(Model& model, const std::string& name, const std::vector<Option>& options) {
+namespace {
+
+RigidBodySpec body_spec(const std::string& name, const std::vector<Option>& options) {
   RigidBodySpec spec;
   spec.name = name;
   const Setters<RigidBodySpec> setters = {
@@ -101,7 +104,17 @@ RigidBody& add_body(Model& model, const std::string& name, const std::vector<Opt
       {"pose", [](auto& s, const Option& o) { s.pose = pose(o); }},
   };
   apply(spec, options, setters, "body '" + name + "'");
-  return model.add_body(spec);
+  return spec;
+}
+
+}  // namespace
+
+RigidBody& add_body(Model& model, const std::string& name, const std::vector<Option>& options) {
+  return model.add_body(body_spec(name, options));
+}
+
+RigidBody& add_ghost(Model& model, const std::string& name, const std::vector<Option>& options) {
+  return ambfplus::add_ghost(model, body_spec(name, options));
 }
 
 Drill& add_drill(Model& model, const std::string& name, const std::vector<Option>& options) {

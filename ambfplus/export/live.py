@@ -20,8 +20,9 @@ the ``mcap`` export), only on channels a client subscribed to, from two threads 
   ``/<camera>/depth/image_rect``, 32FC1 metres), at most ``image_rate`` times a second (``rate``
   by default) and otherwise as fast as the renderer makes them: one capture follows another, so
   where a frame takes longer than 1 / ``image_rate`` to render, rendering sets the image rate
-  (on llvmpipe, a 640x480 frame of the 256^3 ear phantom took 0.25-0.7 s, so 1.5-4 images a
-  second). ``stats.summary()["image_rate_hz"]`` is the rate achieved. Each image comes with a
+  (on llvmpipe with 2 cores, a 640x480 frame of the 128^3 phantom took 40-120 ms to capture
+  and send, so 8-25 images a second). ``stats.summary()["image_rate_hz"]`` is the rate
+  achieved. Each image comes with a
   ``/tf`` message placing its camera (and the posed objects) at the image's own time.
 
 Stamps are simulation time. The physics loop (``ambfplus.RealTimeLoop``) does not wait for the

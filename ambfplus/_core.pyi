@@ -476,6 +476,10 @@ class World:
           voxels_per_step (list[int]): per burr (compatible removal)
           pose (numpy.ndarray): 4x4 initial goal, world from drill
         """
+    def add_ghost(self, name: str, shape: ShapeKind | str | None = None, *, size: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] | None = None, radius: typing.SupportsFloat | typing.SupportsIndex | None = None, height: typing.SupportsFloat | typing.SupportsIndex | None = None, mesh: os.PathLike | str | bytes | None = None, scale: typing.SupportsFloat | typing.SupportsIndex = 1.0, pose: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"] | None = None, color: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex] | None = None, visible: bool = True, **kwargs) -> RigidBody:
+        """
+        Adds a ghost object (AMBF's ghost objects): a shape as add_body takes it that touches nothing (no force, rays pass through) and reports, after every step, the bodies overlapping it (body.overlapping, Bullet's narrow phase). It moves by its pose or rides on a parent (attach_to). Collision keywords of add_body (collision_mesh, collision_type, collision_shapes, margin) shape what it tests.
+        """
     def add_input_device(self, name: str, device: Device, drill: Drill, **kwargs) -> InputDevice:
         """
         Binds a device to a drill, as a surgeon holds it. Keywords:
@@ -766,6 +770,10 @@ class Model:
           cutting_rate (float): m^3 / (s N) at full speed
           voxels_per_step (list[int]): per burr (compatible removal)
           pose (numpy.ndarray): 4x4 initial goal, world from drill
+        """
+    def add_ghost(self, name: str, shape: ShapeKind | str | None = None, *, size: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] | None = None, radius: typing.SupportsFloat | typing.SupportsIndex | None = None, height: typing.SupportsFloat | typing.SupportsIndex | None = None, mesh: os.PathLike | str | bytes | None = None, scale: typing.SupportsFloat | typing.SupportsIndex = 1.0, pose: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"] | None = None, color: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex] | None = None, visible: bool = True, **kwargs) -> RigidBody:
+        """
+        Adds a ghost object (AMBF's ghost objects): a shape as add_body takes it that touches nothing (no force, rays pass through) and reports, after every step, the bodies overlapping it (body.overlapping, Bullet's narrow phase). It moves by its pose or rides on a parent (attach_to). Collision keywords of add_body (collision_mesh, collision_type, collision_shapes, margin) shape what it tests.
         """
     def add_input_device(self, name: str, device: Device, drill: Drill, **kwargs) -> InputDevice:
         """
@@ -1566,6 +1574,11 @@ class RigidBody(Object):
         the centre-of-mass frame in the body frame
         """
     @property
+    def is_ghost(self) -> bool:
+        """
+        a ghost object (World.add_ghost)
+        """
+    @property
     def joints(self) -> list:
         """
         The joints below this body in AMBF's order (every joint reachable from it, creation order, passive ones left out): the order of a root body's joint positions.
@@ -1592,6 +1605,11 @@ class RigidBody(Object):
     @property
     def mesh(self) -> str:
         ...
+    @property
+    def overlapping(self) -> list:
+        """
+        a ghost's overlapping bodies after the last step (Bullet's narrow phase), in creation order; ValueError for a body that is not a ghost
+        """
     @property
     def radius(self) -> float:
         ...
@@ -1636,6 +1654,10 @@ class Joint(Object):
     def release(self) -> None:
         """
         stop commanding the joint
+        """
+    def set_cone_twist_limits(self, twist: typing.SupportsFloat | typing.SupportsIndex, swing_y: typing.SupportsFloat | typing.SupportsIndex, swing_z: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        """
+        a cone twist joint's twist (about its axis) and swing spans, rad
         """
     def set_effort(self, effort: typing.SupportsFloat | typing.SupportsIndex) -> None:
         """
@@ -1722,6 +1744,19 @@ class Joint(Object):
     def position(self) -> float:
         """
         rad or m; 0 where the parent's and child's joint frames coincide
+        """
+    @property
+    def six_dof(self) -> typing.Any:
+        """
+        a six dof (spring) joint's per-axis settings {lower, upper, stiffness, damping, equilibrium}, 6 values each (x, y, z translation, then x, y, z rotation; a limit None or lower > upper: free); None before any were set; assigning updates the keys given
+        """
+    @six_dof.setter
+    def six_dof(self, arg1: dict) -> None:
+        ...
+    @property
+    def six_dof_coordinates(self) -> typing.Annotated[list[float], "FixedSize(6)"]:
+        """
+        a six dof (spring) joint's six coordinates now (m, rad)
         """
     @property
     def type(self) -> str:

@@ -269,6 +269,9 @@ def run_export(args: argparse.Namespace) -> int:
     options = {}
     if args.to in ("mcap", "rosbag2"):
         options["point_clouds"] = not args.no_points
+        options["image_topics"] = args.image_topics
+        options["rgb_codec"] = args.rgb_codec
+        options["jpeg_quality"] = args.jpeg_quality
     if args.to == "mcap":
         options["compression"] = None if args.compression == "none" else args.compression
     if args.to == "original-h5":
@@ -448,6 +451,13 @@ def main(argv: list[str] | None = None) -> int:
                           help="mcap/rosbag2: no point clouds")  # fmt: skip
     exporter.add_argument("--compression", default="zstd", choices=("zstd", "lz4", "none"),
                           help="mcap: chunk compression")  # fmt: skip
+    exporter.add_argument("--image-topics", default="raw", choices=("raw", "compressed", "both"),
+                          help="mcap/rosbag2: sensor_msgs/Image topics, CompressedImage topics "
+                          "(<topic>/compressed: PNG or TIFF, lossless) or both")  # fmt: skip
+    exporter.add_argument("--rgb-codec", default="png", choices=("png", "jpeg"),
+                          help="mcap/rosbag2: compressed rgb as png or jpeg (lossy)")  # fmt: skip
+    exporter.add_argument("--jpeg-quality", type=int, default=90,
+                          help="mcap/rosbag2: JPEG quality 1..100 (default 90)")  # fmt: skip
     exporter.add_argument("--chunk-size", type=int, default=500,
                           help="original-h5: samples per file (the original's 500)")  # fmt: skip
     exporter.add_argument("--no-images", action="store_true",

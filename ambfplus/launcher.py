@@ -34,9 +34,10 @@ adds a foot pedal's buttons (``--pedal-map drill=0,clutch=1,burr=2``: held spins
 clutches, pressed takes the next burr). The keyboard's Space and C keep working with any device.
 
 ``--foxglove [PORT]`` serves the session live over the Foxglove WebSocket protocol (port 8765 by
-default, loopback unless ``--foxglove-host`` says otherwise, ``--foxglove-rate`` messages per
-second, 10 by default): the camera, its calibration, TF, the drill's force and the nearest
-critical structure (``ambfplus.export.live``; needs ``ambfplus[foxglove]``).
+default, loopback unless ``--foxglove-host`` says otherwise): TF, the camera's calibration, the
+drill's force and the nearest critical structure at ``--foxglove-rate`` Hz (10 by default), and
+the camera's images at up to ``--foxglove-image-rate`` Hz (the same by default), as fast as the
+renderer makes them (``ambfplus.export.live``; needs ``ambfplus[foxglove]``).
 
 The status line shows the burr, whether it spins, the control mode, the distance to the nearest
 critical structure (a warning under 2 mm or when one is cut), and the graphics and physics
@@ -147,7 +148,13 @@ def parse_args(argv: list[str] | None) -> tuple[argparse.Namespace, list[str]]:
         "--foxglove-rate",
         type=float,
         default=10.0,
-        help="live view messages per second (default 10)",
+        help="live view: TF, calibration, force and critical structures per second (default 10)",
+    )
+    p.add_argument(
+        "--foxglove-image-rate",
+        type=float,
+        help="live view: the most images per second (default: --foxglove-rate); rendering may "
+        "make fewer",
     )
     p.add_argument("--seconds", type=float, help="quit after this many seconds")
     p.add_argument("--status", type=Path, help="write the status (JSON) here as it changes")
@@ -337,7 +344,8 @@ class Session:
         self.live_options = None
         if args.foxglove is not None:
             self.live_options = {"port": args.foxglove, "host": args.foxglove_host,
-                                 "rate": args.foxglove_rate}  # fmt: skip
+                                 "rate": args.foxglove_rate,
+                                 "image_rate": args.foxglove_image_rate}  # fmt: skip
 
     def start_live(self) -> None:
         """Starts the Foxglove live view (--foxglove), once the real-time loop runs."""
@@ -351,8 +359,10 @@ class Session:
                                        **self.live_options).start()  # fmt: skip
         except (MissingExtra, RuntimeError) as error:
             raise SystemExit(f"ambfplus-launch: --foxglove: {error}") from None
-        print(f"ambfplus-launch: live view on {self.live.url} at {self.live.rate:g} Hz "
-              "(Foxglove: open a WebSocket connection)", flush=True)  # fmt: skip
+        print(f"ambfplus-launch: live view on {self.live.url}: TF, force and critical "
+              f"structures at {self.live.rate:g} Hz, images at up to {self.live.image_rate:g} "
+              "Hz as rendering allows (Foxglove: open a WebSocket connection)",
+              flush=True)  # fmt: skip
 
     def stop_live(self) -> None:
         if self.live is not None:

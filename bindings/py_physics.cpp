@@ -12,11 +12,13 @@
 #include <vector>
 
 #include "ambfplus/scene/constraint_actuator.h"
+#include "ambfplus/scene/ghost.h"
 #include "ambfplus/scene/joint.h"
 #include "ambfplus/scene/model.h"
 #include "ambfplus/scene/proximity_sensor.h"
 #include "ambfplus/scene/rigid_body.h"
 #include "ambfplus/scene/simulator.h"
+#include "ambfplus/scene/six_dof.h"
 #include "ambfplus/scene/soft_body.h"
 #include "bindings.h"
 #include "enums.h"
@@ -217,7 +219,17 @@ void define_body(BodyClass& body) {
             }
             return out;
           },
-          "the primitive collision parts as (shape, 4x4 pose in the body frame)");
+          "the primitive collision parts as (shape, 4x4 pose in the body frame)")
+      .def_property_readonly("is_ghost", &is_ghost, "a ghost object (World.add_ghost)")
+      .def_property_readonly(
+          "overlapping",
+          [](RigidBody& b) {
+            py::list out;
+            for (RigidBody* o : ghost_overlaps(b)) out.append(handle(o, b.world()));
+            return out;
+          },
+          "a ghost's overlapping bodies after the last step (Bullet's narrow phase), in "
+          "creation order; ValueError for a body that is not a ghost");
 }
 
 void define_joint(JointClass& joint) {
@@ -267,6 +279,33 @@ void define_joint(JointClass& joint) {
             j.set_controller(c);
           },
           "{p, i, d, output}; output 'effort' or 'velocity'; assigning updates the keys given")
+      .def_property(
+          "six_dof",
+          [](Joint& j) -> py::object {
+            const std::optional<SixDofAxes> a = six_dof_axes(j);
+            if (!a) return py::none();
+            py::dict d;
+            d["lower"] = std::vector<std::optional<double>>(a->lower.begin(), a->lower.end());
+            d["upper"] = std::vector<std::optional<double>>(a->upper.begin(), a->upper.end());
+            d["stiffness"] = a->stiffness;
+            d["damping"] = a->damping;
+            d["equilibrium"] = a->equilibrium;
+            return std::move(d);
+          },
+          [](Joint& j, const py::dict& d) {
+            SixDofAxes a = six_dof_axes(j).value_or(SixDofAxes{});
+            six_dof_options().apply(a, to_options(d));
+            set_six_dof_axes(j, a);
+          },
+          "a six dof (spring) joint's per-axis settings {lower, upper, stiffness, damping, "
+          "equilibrium}, 6 values each (x, y, z translation, then x, y, z rotation; a limit "
+          "None or lower > upper: free); None before any were set; assigning updates the keys "
+          "given")
+      .def_property_readonly(
+          "six_dof_coordinates", [](Joint& j) { return six_dof_coordinates(j); },
+          "a six dof (spring) joint's six coordinates now (m, rad)")
+      .def("set_cone_twist_limits", &set_cone_twist_limits, py::arg("twist"), py::arg("swing_y"),
+           py::arg("swing_z"), "a cone twist joint's twist (about its axis) and swing spans, rad")
       .def_property_readonly(
           "parent_pivot", [](Joint& j) { return j.spec().parent_pivot; },
           "pivot in the parent body's frame, m")

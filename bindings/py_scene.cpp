@@ -21,6 +21,7 @@
 #include "ambfplus/haptics/input_device.h"
 #include "ambfplus/plugin/registry.h"
 #include "ambfplus/render/render_stats.h"
+#include "ambfplus/scene/ghost.h"
 #include "ambfplus/scene/realtime.h"
 #include "ambfplus/scene/simulator.h"
 #include "ambfplus/scene/step_log.h"
@@ -199,12 +200,13 @@ py::object get(World& w, const std::string& name, const std::optional<std::strin
 
 // ---- The add_* methods, shared by Model and World (which adds to its default model).
 
-RigidBody& add_body(Model& model, const std::string& name,
-                    const OptionalKindOrName<Shape::Kind>& shape, std::optional<Vec3> size,
-                    std::optional<double> radius, std::optional<double> height,
-                    std::optional<Path> mesh, double scale, std::optional<Mat4> pose, double mass,
-                    std::optional<std::vector<double>> color, std::optional<double> specular,
-                    std::optional<double> shininess, const py::kwargs& physics) {
+// A body's spec from add_body's (and add_ghost's) arguments.
+RigidBodySpec body_spec(const std::string& name, const OptionalKindOrName<Shape::Kind>& shape,
+                        std::optional<Vec3> size, std::optional<double> radius,
+                        std::optional<double> height, std::optional<Path> mesh, double scale,
+                        std::optional<Mat4> pose, std::optional<double> mass,
+                        std::optional<std::vector<double>> color, std::optional<double> specular,
+                        std::optional<double> shininess, const py::kwargs& physics) {
   OptionMap named;
   if (!shape.is_none()) named.push_back({"shape", to_option(shape)});
   if (size) named.push_back({"size", vec(*size)});
@@ -213,12 +215,14 @@ RigidBody& add_body(Model& model, const std::string& name,
   if (mesh) named.push_back({"mesh", mesh->string()});
   named.push_back({"scale", scale});
   if (pose) named.push_back({"pose", mat(*pose)});
-  named.push_back({"mass", mass});
+  if (mass) named.push_back({"mass", *mass});
   if (color) named.push_back({"color", OptionValue::from_numbers(*color)});
   if (specular) named.push_back({"specular", *specular});
   if (shininess) named.push_back({"shininess", *shininess});
-  const RigidBodySpec spec =
-      make_spec(name, rigid_body_options(), with_kwargs(std::move(named), physics));
+  return make_spec(name, rigid_body_options(), with_kwargs(std::move(named), physics));
+}
+
+RigidBody& add_body(Model& model, const RigidBodySpec& spec) {
   py::gil_scoped_release release;  // mesh files can take a while to read
   return model.add_body(spec);
 }
@@ -301,9 +305,9 @@ void def_adders(Class& cls, GetModel get_model) {
                      std::optional<std::vector<double>> color, std::optional<double> specular,
                      std::optional<double> shininess, const py::kwargs& physics) {
            Model& model = get_model(self);
-           return handle(&add_body(model, name, shape, size, radius, height, mesh, scale, pose,
-                                   mass, color, specular, shininess, physics),
-                         model.world());
+           const RigidBodySpec spec = body_spec(name, shape, size, radius, height, mesh, scale,
+                                                pose, mass, color, specular, shininess, physics);
+           return handle(&add_body(model, spec), model.world());
          },
          py::arg("name"), py::arg("shape") = py::none(), py::kw_only(),
          py::arg("size") = py::none(), py::arg("radius") = py::none(),
@@ -319,6 +323,34 @@ void def_adders(Class& cls, GetModel get_model) {
          "(False: none), collision_mesh, collision_type (concave, convex_mesh, convex_hull, "
          "point_cloud), collision_shapes ([{shape, size/radius/height/axis, pose}]), margin, "
          "groups ([0..31]), axis.")
+      .def(
+          "add_ghost",
+          [get_model](
+              Self& self, const std::string& name, const OptionalKindOrName<Shape::Kind>& shape,
+              std::optional<Vec3> size, std::optional<double> radius, std::optional<double> height,
+              std::optional<Path> mesh, double scale, std::optional<Mat4> pose,
+              std::optional<std::vector<double>> color, bool visible, const py::kwargs& collision) {
+            Model& model = get_model(self);
+            RigidBodySpec spec =
+                body_spec(name, shape, size, radius, height, mesh, scale, pose, std::nullopt, color,
+                          std::nullopt, std::nullopt, collision);
+            spec.material.visible = visible;
+            RigidBody* ghost = nullptr;
+            {
+              py::gil_scoped_release release;
+              ghost = &add_ghost(model, std::move(spec));
+            }
+            return handle(ghost, model.world());
+          },
+          py::arg("name"), py::arg("shape") = py::none(), py::kw_only(),
+          py::arg("size") = py::none(), py::arg("radius") = py::none(),
+          py::arg("height") = py::none(), py::arg("mesh") = py::none(), py::arg("scale") = 1.0,
+          py::arg("pose") = py::none(), py::arg("color") = py::none(), py::arg("visible") = true,
+          "Adds a ghost object (AMBF's ghost objects): a shape as add_body takes it that "
+          "touches nothing (no force, rays pass through) and reports, after every step, the "
+          "bodies overlapping it (body.overlapping, Bullet's narrow phase). It moves by its pose "
+          "or rides on a parent (attach_to). Collision keywords of add_body (collision_mesh, "
+          "collision_type, collision_shapes, margin) shape what it tests.")
       .def(
           "add_joint",
           [get_model](Self& self, const std::string& name, RigidBody& parent, RigidBody& child,

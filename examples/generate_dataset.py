@@ -4,8 +4,9 @@ torch extra is installed.
 
     python examples/generate_dataset.py OUT [--workers 2] [--ray auto]
 
-Running it again resumes (complete shards are kept). Workers are spawned processes, which is
-why everything runs under the `if __name__ == "__main__":` guard.
+Running it again resumes (complete shards are kept). Workers import this script again (as
+spawned processes do), which is why everything runs under the `if __name__ == "__main__":`
+guard.
 """
 
 from __future__ import annotations

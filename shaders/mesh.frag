@@ -12,10 +12,13 @@
 
 in vec4 v_position;
 in vec3 v_normal;
+in vec2 v_texcoord;
 
 uniform vec4 u_color;
 uniform int u_instance;  // the object's id
 uniform vec3 u_segmentation_color;  // flat, as AMBF's preprocessing shader draws it
+uniform bool u_textured;             // the diffuse colour is u_color x the texture's texel
+uniform sampler2D u_diffuse_map;     // unit 0
 
 layout(location = 0) out vec4 o_color;
 layout(location = 1) out float o_depth;
@@ -34,7 +37,9 @@ void main() {
 #if SHADE
   vec3 n = normalize(v_normal);
   if (!gl_FrontFacing) n = -n;
-  o_color = vec4(lit(u_color.rgb, n, p), u_color.a);
+  vec4 base = u_color;
+  if (u_textured) base *= texture(u_diffuse_map, v_texcoord);
+  o_color = vec4(lit(base.rgb, n, p), base.a);
 #else
   o_color = u_color;
 #endif

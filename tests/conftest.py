@@ -6,7 +6,6 @@ import os
 import re
 import shutil
 import subprocess
-import time
 from pathlib import Path
 
 import numpy as np
@@ -58,19 +57,22 @@ def display():
     if missing:
         pytest.skip(f"needs {', '.join(missing)} (Debian: xvfb xdotool x11-apps)")
     pytest.importorskip("glfw", reason="the launcher's window needs glfw (pip: ambfplus[gui])")
-    for number in range(90, 110):
-        if not Path(f"/tmp/.X11-unix/X{number}").exists():
-            break
-    name = f":{number}"
+    # Xvfb picks a free display itself and writes its number to the pipe once it listens, so
+    # test runs side by side never share (or lose) a display.
+    read, write = os.pipe()
     server = subprocess.Popen(
-        ["Xvfb", name, "-screen", "0", "1920x1080x24", "-nolisten", "tcp"],
+        ["Xvfb", "-displayfd", str(write), "-screen", "0", "1920x1080x24", "-nolisten", "tcp"],
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
+        pass_fds=(write,),
     )
-    for _ in range(100):
-        if Path(f"/tmp/.X11-unix/X{number}").exists():
-            break
-        time.sleep(0.05)
+    os.close(write)
+    with os.fdopen(read) as numbers:
+        number = numbers.readline().strip()
+    if not number:
+        server.kill()
+        pytest.fail(f"Xvfb did not start (exit status {server.wait(timeout=10)})")
+    name = f":{number}"
     yield name
     server.terminate()
     server.wait(timeout=10)

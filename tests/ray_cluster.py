@@ -1,7 +1,10 @@
 """A real two-node Ray cluster on this machine for the tests: a head and a second node, each
 started with `ray start` on its own loopback address (127.0.0.2, 127.0.0.3), with its own temp
-dir and ports, one CPU and a small object store each. Stopping it kills exactly the processes
-it started (found by their temp dirs) and their children, never anyone else's Ray."""
+dir and ports, one CPU and a small object store each, and as the README suggests for
+generating datasets: no dashboard and no log monitor. `ray start` runs in this Python (its
+workers import the ambfplus under test, not another one on PATH). Stopping it kills exactly
+the processes it started (found by their temp dirs) and their children, never anyone else's
+Ray."""
 
 from __future__ import annotations
 
@@ -12,7 +15,6 @@ import subprocess
 import sys
 import tempfile
 import time
-from pathlib import Path
 
 import psutil
 
@@ -52,9 +54,6 @@ class RayCluster:
     """`ray start` a head and a second node; ``address`` is the head's; ``stop()`` ends them."""
 
     def __init__(self, cpus_per_node: int = 1) -> None:
-        self.ray = str(Path(sys.executable).with_name("ray"))
-        if not Path(self.ray).exists():
-            self.ray = shutil.which("ray") or "ray"
         self.cpus = cpus_per_node
         self.dirs = [
             tempfile.mkdtemp(prefix="rayh", dir="/tmp"),
@@ -88,9 +87,19 @@ class RayCluster:
             f"--num-cpus={self.cpus}",
             f"--object-store-memory={OBJECT_STORE_BYTES}",
             "--disable-usage-stats",
+            "--include-log-monitor=false",
         ]
         done = subprocess.run(
-            [self.ray, "start", *args, *common, *self._node_ports()],
+            [
+                sys.executable,
+                "-m",
+                "ray.scripts.scripts",
+                "start",
+                *args,
+                *common,
+                *self._node_ports(),
+            ],
+            cwd="/",
             env=self.env,
             capture_output=True,
             text=True,

@@ -448,3 +448,31 @@ def test_ply_header_cut_before_end_header_is_an_error(tmp_path):
     path = tmp_path / "header_only.ply"
     path.write_text(PLY_HEAD.format(n=3, f=1))
     expect_mesh_error(path, "no 'end_header' line")
+
+
+# ADF files (the YAML layer every loader reads through).
+def adf_file(tmp_path: Path, data: bytes) -> Path:
+    path = tmp_path / "model.yaml"
+    path.write_bytes(data)
+    return path
+
+
+def test_adf_with_a_non_utf8_name_is_a_config_error_naming_file_and_line(tmp_path):
+    path = adf_file(tmp_path, b"bodies: [BODY a]\nBODY a:\n  name: ab\xff\n  mass: 1\n")
+    with pytest.raises(ambfplus.ConfigError) as caught:
+        ambfplus.World().load_adf(path)
+    message = str(caught.value)
+    assert str(path) in message and "line 3" in message and "0xff" in message
+
+
+def test_adf_with_two_yaml_documents_is_a_config_error(tmp_path):
+    text = b"bodies: [BODY a]\nBODY a:\n  name: a\n---\nbodies: [BODY b]\nBODY b:\n  name: b\n"
+    path = adf_file(tmp_path, text)
+    with pytest.raises(ambfplus.ConfigError, match="line 4: .*second YAML document"):
+        ambfplus.World().load_adf(path)
+
+
+def test_adf_of_a_lone_comma_is_a_config_error_not_endless_memory(tmp_path):
+    # A fuzzer's finding: yaml-cpp's LoadAll allocates without end on this input.
+    with pytest.raises(ambfplus.ConfigError):
+        ambfplus.World().load_adf(adf_file(tmp_path, b","))

@@ -220,21 +220,32 @@ def test_one_and_two_workers_make_identical_shards(dataset_spec, reference_datas
     assert (tmp_path / "two" / "spec.yaml").read_text() == dataset_spec.read_text()
 
 
-def _worker_pids(driver: int) -> list[int]:
-    """The generate driver's spawned worker processes (its children running Python)."""
-    children = Path(f"/proc/{driver}/task/{driver}/children")
+def _children(pid: int) -> list[int]:
     try:
-        pids = [int(p) for p in children.read_text().split()]
+        return [int(p) for p in Path(f"/proc/{pid}/task/{pid}/children").read_text().split()]
     except OSError:
         return []
-    out = []
-    for pid in pids:
+
+
+def _descendants(pid: int) -> list[int]:
+    found, todo = [], _children(pid)
+    while todo:
+        found.append(todo.pop())
+        todo += _children(found[-1])
+    return found
+
+
+def _worker_pids(driver: int) -> list[int]:
+    """The generate driver's worker processes (forked by its fork server, named
+    ambfplus-worker)."""
+    found = []
+    for pid in _descendants(driver):
         try:
-            if "spawn_main" in Path(f"/proc/{pid}/cmdline").read_text():
-                out.append(pid)
+            if Path(f"/proc/{pid}/comm").read_text().strip() == "ambfplus-worker":
+                found.append(pid)
         except OSError:
             pass
-    return out
+    return found
 
 
 def test_killed_workers_are_replaced_and_their_episodes_redone(
@@ -268,16 +279,20 @@ def test_a_killed_driver_resumes_to_the_same_dataset(dataset_spec, reference_dat
     while time.monotonic() < deadline and len(read_manifest(out)[0]) < 4:
         time.sleep(0.05)
     workers = _worker_pids(driver.pid)
+    assert len(workers) == 2
+    tree = _descendants(driver.pid)  # the workers, their fork server, multiprocessing's helper
     driver.kill()
     driver.wait(timeout=30)
     assert 4 <= len(read_manifest(out)[0]) < 12
-    for pid in workers:  # the workers die with their driver
+    for pid in tree:  # the workers and their fork server die with their driver
         for _ in range(100):
             if not Path(f"/proc/{pid}").exists() or "Z" in _state(pid):
                 break
             time.sleep(0.05)
         else:
-            pytest.fail(f"worker {pid} outlived its driver")
+            pytest.fail(
+                f"process {pid} ({'worker' if pid in workers else 'helper'}) outlived its driver"
+            )
     # what a killed driver may leave: a torn manifest line, unlisted shard files, partials
     with open(out / "manifest.jsonl", "a") as f:
         f.write('{"episode": 11, "seed"')

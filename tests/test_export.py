@@ -621,3 +621,223 @@ def test_copying_a_recording_keeps_its_parts_checkable(session, tmp_path):
     head = copy / session.name
     digests = shard_digests(head)
     assert hashlib.sha256(head.read_bytes()).hexdigest() in digests and len(digests) == 2
+
+
+# Compressed image topics ------------------------------------------------------------------------
+
+PASS_TOPICS = {"rgb": "image_rect_color", "depth": "depth/image_rect", "label": "label/image",
+               "instance": "instance/image", "voxel": "voxel/image",
+               "segmentation": "segmentation/image"}  # fmt: skip
+
+
+def decode_with_opencv(message) -> np.ndarray:
+    """A CompressedImage's pixels decoded by OpenCV (not the Pillow that wrote them), in the
+    raw encoding its format names (OpenCV hands colour images over as BGR)."""
+    cv2 = pytest.importorskip("cv2", reason="decoding with another library needs OpenCV")
+    image = cv2.imdecode(np.frombuffer(bytes(message.data), np.uint8), cv2.IMREAD_UNCHANGED)
+    assert image is not None, message.format
+    return image[..., ::-1] if image.ndim == 3 else image
+
+
+@pytest.mark.parametrize("which", ["mcap", "rosbag2"])
+def test_compressed_image_topics_round_trip(session, tmp_path, which):
+    """image_topics="both": every raw image topic has a CompressedImage twin on
+    <topic>/compressed; PNG and TIFF decode bit for bit to the recording's arrays, with both
+    readers; JPEG rgb is close; "compressed" alone leaves the raw topics out."""
+    from ambfplus.export.images import decode_image
+
+    out = tmp_path / ("both.mcap" if which == "mcap" else "both")
+    export(session, out, which, image_topics="both", point_clouds=False, progress=False)
+    formats = {"rgb": "rgb8; png compressed bgr8", "depth": "32FC1; tiff compressed",
+               "label": "16UC1; png compressed", "instance": "32SC1; tiff compressed",
+               "voxel": "32SC1; tiff compressed",
+               "segmentation": "rgb8; png compressed bgr8"}  # fmt: skip
+    with open_recording(session) as rec:
+        for reader in (read_with_mcap, read_with_rosbags):
+            by_topic: dict[str, list] = {}
+            for topic, msgtype, log_time, message in reader(out):
+                by_topic.setdefault(topic, []).append((msgtype, log_time, message))
+            for name, stream in rec.cameras.items():
+                for pass_name, suffix in PASS_TOPICS.items():
+                    raw = by_topic[f"/{name}/{suffix}"]
+                    compressed = by_topic[f"/{name}/{suffix}/compressed"]
+                    assert [t for _, t, _ in compressed] == [t for _, t, _ in raw]
+                    for index, (msgtype, log_time, message) in enumerate(compressed):
+                        assert msgtype == "sensor_msgs/msg/CompressedImage"
+                        assert message.format == formats[pass_name]
+                        assert stamp_ns(message) == log_time
+                        assert message.header.frame_id == f"{stream.camera}_optical_frame"
+                        expected = getattr(stream, pass_name)[index]
+                        for decoded in (decode_with_opencv(message),
+                                        decode_image(message.format, message.data)):  # fmt: skip
+                            assert decoded.dtype == expected.dtype, (name, pass_name)
+                            assert np.array_equal(decoded, expected), (name, pass_name)
+    # JPEG for rgb, compressed topics only; the rest stays lossless.
+    jpeg = tmp_path / ("jpeg.mcap" if which == "mcap" else "jpeg")
+    export(session, jpeg, which, image_topics="compressed", rgb_codec="jpeg", jpeg_quality=95,
+           point_clouds=False, progress=False)  # fmt: skip
+    topics = {}
+    for topic, _, _, message in read_with_rosbags(jpeg):
+        topics.setdefault(topic, []).append(message)
+    assert not any(t.endswith(("/image_rect_color", "/image_rect", "/image")) for t in topics)
+    with open_recording(session) as rec:
+        for name, stream in rec.cameras.items():
+            for index, message in enumerate(topics[f"/{name}/image_rect_color/compressed"]):
+                assert message.format == "rgb8; jpeg compressed bgr8"
+                assert bytes(message.data[:2]) == b"\xff\xd8"  # a JPEG stream
+                error = decode_with_opencv(message).astype(float) - stream.rgb[index]
+                psnr = 10 * np.log10(255.0**2 / np.mean(error**2))
+                assert 30 < psnr < 100, psnr  # lossy, and close
+            label = topics[f"/{name}/label/image/compressed"][0]
+            assert np.array_equal(decode_with_opencv(label), stream.label[0])
+        if which == "mcap":
+            with open(jpeg, "rb") as f:
+                metadata = {m.name: m.metadata for m in make_reader(f).iter_metadata()}
+            assert "JPEG, quality 95" in metadata["ambfplus"]["compressed_images"]
+
+
+def test_compressed_image_options_are_checked(session, tmp_path):
+    cases = [
+        ({"image_topics": "zipped"}, "image_topics is one of raw, compressed, both"),
+        ({"rgb_codec": "webp"}, "the rgb codec is one of png, jpeg"),
+        ({"jpeg_quality": 0}, "jpeg_quality is 1..100"),
+        ({"rgb_codec": "png", "chunk_size": 3}, "the mcap export takes no option chunk_size"),
+    ]
+    for options, message in cases:
+        with pytest.raises(ExportError, match=message):
+            export(session, tmp_path / "x.mcap", "mcap", progress=False, **options)
+        assert not (tmp_path / "x.mcap").exists()
+    completed = run_cli(tmp_path, str(session), "--to", "rosbag2", str(tmp_path / "bag"),
+                        "--image-topics", "compressed", "--rgb-codec", "jpeg", "--quiet",
+                        "--verbose")  # fmt: skip
+    assert completed.returncode == 0, completed.stderr
+    topics = json.loads(completed.stdout)["topics"]
+    assert topics["/rig_left/image_rect_color/compressed"] == "sensor_msgs/msg/CompressedImage"
+    assert "/rig_left/image_rect_color" not in topics
+
+
+# A dataset made by ambfplus generate -----------------------------------------------------------
+
+GENERATED_SPEC = """\
+version: 1
+name: export-tiny
+episodes: 3
+seed: 11
+capture: {every: 150, frames: 2, passes: [rgb, depth, label, instance, segmentation]}
+anatomies: [{phantom: {resolution: 40, seed: 1}}]
+scenarios: [{kind: drilling, frames: 3}, {kind: camera}]
+rigs: [{resolution: [160, 120], baseline: 0.065, working_distance: 0.25}]
+"""
+
+
+@pytest.fixture(scope="module")
+def generated(tmp_path_factory) -> Path:
+    """Three tiny episodes made by `ambfplus generate` with 2 local workers."""
+    folder = tmp_path_factory.mktemp("generated")
+    (folder / "spec.yaml").write_text(GENERATED_SPEC)
+    completed = subprocess.run(
+        [sys.executable, "-m", "ambfplus", "generate", "spec.yaml", "--out", "data",
+         "--workers", "2", "--quiet"],
+        cwd=folder, capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert completed.returncode == 0, completed.stderr
+    return folder / "data"
+
+
+def check_export_reads_back(to: str, output: Path, recording) -> None:
+    """Reads an export of a shard back with the format's own readers (not the writers) and
+    compares it with the shard."""
+    streams = recording.cameras
+    if to in ("mcap", "rosbag2"):
+        for reader in (read_with_mcap, read_with_rosbags):
+            by_topic: dict[str, list] = {}
+            for topic, _, log_time, message in reader(output):
+                by_topic.setdefault(topic, []).append((log_time, message))
+            for name, stream in streams.items():
+                times = [int(round(t * 1e9)) for t in stream.time[:]]
+                for pass_name in stream.passes:
+                    got = by_topic[f"/{name}/{PASS_TOPICS[pass_name]}"]
+                    assert [t for t, _ in got] == times, (name, pass_name)
+                    for index, (_, message) in enumerate(got):
+                        expected = getattr(stream, pass_name)[index]
+                        assert np.array_equal(image_array(message), expected), (name, pass_name)
+                assert len(by_topic[f"/{name}/camera_info"]) == len(stream)
+            assert len(by_topic["/drill/wrench"]) == len(recording.steps["step"])
+    elif to == "original-h5":
+        data = read_original(output)
+        rig = next(iter(recording.rigs.values()))
+        assert np.array_equal(data["l_img"][..., ::-1], rig.left.rgb[:])  # BGR
+        assert np.array_equal(data["r_img"][..., ::-1], rig.right.rgb[:])
+        assert np.array_equal(data["segm"][..., ::-1], rig.left.segmentation[:])
+        assert np.array_equal(data["time"], rig.left.time[:])
+        depth = rig.left.depth[:]
+        tolerance = np.abs(np.spacing(depth.astype(np.float16)).astype(np.float32)) / 2
+        assert (np.abs(data["depth"].astype(np.float32) - depth) <= tolerance + 1e-12).all()
+        assert data["baseline"] == pytest.approx(rig.baseline[0])
+        removed = len(recording.removed["step"])
+        assert len(data["voxels"]) == removed
+    else:
+        from pycocotools.coco import COCO
+
+        for name, stream in streams.items():
+            coco = COCO(str(output / f"{name}.json"))
+            assert len(coco.getImgIds()) == len(stream)
+            for index in range(len(stream)):
+                image = coco.loadImgs(index + 1)[0]
+                assert (output / image["file_name"]).is_file()
+                instance = np.zeros_like(stream.instance[index])
+                for annotation in coco.loadAnns(coco.getAnnIds(imgIds=image["id"])):
+                    instance[coco.annToMask(annotation).astype(bool)] = annotation["instance_id"]
+                assert np.array_equal(instance, stream.instance[index]), (name, index)
+
+
+@pytest.mark.parametrize("to", ["mcap", "rosbag2", "original-h5", "coco"])
+def test_a_generated_dataset_exports_whole_or_shard_by_shard(generated, tmp_path, to):
+    """A dataset folder made by `ambfplus generate` (shards with parts) exports to every
+    format, all shards at once or one shard at a time, and reads back equal to its shards."""
+    from ambfplus.dataset import read_manifest
+
+    records = read_manifest(generated)[0]
+    assert len(records) == 3 and all(r["parts"] for r in records)
+    results = export(generated, tmp_path / "all", to, progress=False)
+    assert len(results) == 3
+    index = [json.loads(x) for x in (tmp_path / "all" / "index.jsonl").read_text().splitlines()]
+    assert [(x["episode"], x["source_sha256"]) for x in index] == [
+        (r["episode"], r["sha256"]) for r in records
+    ]
+    for record, result in zip(records, results):
+        with open_recording(generated / record["file"]) as recording:
+            assert recording.metadata["dataset"]["episode"] == record["episode"]
+            check_export_reads_back(to, result.output, recording)
+    # One shard on its own, by its head file (its part is found beside it).
+    shard = generated / records[1]["file"]
+    single = tmp_path / ("one.mcap" if to == "mcap" else "one")
+    result = export(shard, single, to, progress=False)
+    with open_recording(shard) as recording:
+        check_export_reads_back(to, single, recording)
+    assert result.frames == results[1].frames
+
+
+def test_a_dataset_is_exported_by_its_folder_or_a_shards_head(generated, tmp_path):
+    """What is not a shard's head or a dataset folder is refused, saying what to pass."""
+    cases = [
+        (generated / "shards", "it is inside the dataset folder"),
+        (generated / "manifest.jsonl", "is a dataset's manifest: export its folder"),
+        (
+            next((generated / "shards").glob("*.part0001")),
+            "one part of a recording; open its head file",
+        ),  # fmt: skip
+    ]
+    for source, message in cases:
+        with pytest.raises(ValueError, match=message):
+            export(source, tmp_path / "out", "coco", progress=False)
+        completed = run_cli(tmp_path, str(source), "--to", "coco", str(tmp_path / "out"))
+        assert completed.returncode == 1 and message in completed.stderr, completed.stderr
+        assert list(tmp_path.iterdir()) == []
+    completed = run_cli(tmp_path, str(generated), "--to", "original-h5", str(tmp_path / "o"),
+                        "--quiet")  # fmt: skip
+    assert completed.returncode == 0, completed.stderr
+    assert len(completed.stdout.splitlines()) == 3
+    assert sorted(p.name for p in (tmp_path / "o" / "shards").iterdir()) == [
+        f"episode_{e:06d}" for e in range(3)
+    ]

@@ -3,7 +3,7 @@ resumable, exact and randomised.
 
     from ambfplus.dataset import generate, validate_dataset, dataset_info
 
-    if __name__ == "__main__":                      # workers are spawned
+    if __name__ == "__main__":                      # workers import this module again
         generate("spec.yaml", "out", workers=2)     # or ray="auto" (pip install "ambfplus[ray]")
         print(validate_dataset("out"))
 

@@ -72,7 +72,8 @@ def generate(
     """Generates the dataset of `spec` (a path, a dict or a DatasetSpec) into folder `out`, with
     `workers` local processes or on the Ray cluster at `ray` ("auto", "local" or an address;
     needs ``ambfplus[ray]``). Each episode is tried at most `retries` + 1 times, and at most
-    `timeout` seconds each. Call it under ``if __name__ == "__main__":`` (workers are spawned)."""
+    `timeout` seconds each. Call it under ``if __name__ == "__main__":`` (local workers import
+    the main module again)."""
     spec = spec if isinstance(spec, DatasetSpec) else load_spec(spec)
     check_anatomies(spec)
     executor = _executor(workers, ray, retries, timeout, ray_options or {})

@@ -1,6 +1,7 @@
 """Running one episode: its scene built from its plan, filmed and recorded into a shard, the
-shard checked and moved into the dataset. Runs in a worker (a spawned process or a Ray worker),
-which creates its EGL context on its first render."""
+shard checked and moved into the dataset. Runs in a worker (a local worker process or a Ray
+worker), which creates its EGL context on its first render and keeps it for its next
+episodes."""
 
 from __future__ import annotations
 

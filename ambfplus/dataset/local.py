@@ -1,9 +1,17 @@
-"""The default executor: spawned worker processes on this machine, each with its own EGL
-context (created on its first render), fed one episode at a time through a pipe.
+"""The default executor: worker processes on this machine, each with its own EGL context
+(created on its first render), fed one episode at a time through a pipe.
+
+Workers are forked from a fork server (``multiprocessing``'s "forkserver" start method): a
+fresh process, started once per driver, that has imported the engine and the episode code but
+never rendered, so each worker starts without importing them again and without inheriting a
+GL context. Like spawned processes, workers import the main module of a script again (it
+needs the ``if __name__ == "__main__":`` guard), and they take the driver's environment as it
+is when they start.
 
 A worker that dies (SIGKILL, a crash) is noticed through its process sentinel: its episode goes
-back to the queue and a new worker takes its place. Workers die with the driver (Linux's
-parent-death signal, and a check of their parent), so a killed driver leaves no orphans.
+back to the queue and a new worker takes its place. Workers die with the driver: a thread
+watches the driver's end of a pipe that closes when the driver exits however it exits, and
+Linux's parent-death signal covers the fork server.
 """
 
 from __future__ import annotations
@@ -12,6 +20,7 @@ import ctypes
 import multiprocessing
 import os
 import signal
+import threading
 import time
 import traceback
 from collections import deque
@@ -21,23 +30,50 @@ from multiprocessing.connection import wait
 
 from .executor import Done, Executor, Failed, Retry, WorkerStartError
 
-PR_SET_PDEATHSIG = 1
+PR_SET_PDEATHSIG, PR_SET_NAME = 1, 15
+# What `ps` and `top` show for a worker (at most 15 bytes).
+WORKER_NAME = b"ambfplus-worker"
+# Imported once by the fork server, so that its workers start with them.
+PRELOAD = ["ambfplus.dataset.local", "ambfplus.dataset.episode"]
 
 
-def _die_with_parent(parent: int) -> None:
-    """Asks Linux to SIGKILL this process when its parent exits (no-op elsewhere)."""
+def _worker_context():
+    """The fork server's context, preloading the engine (spawn where there is no fork)."""
+    if "forkserver" not in multiprocessing.get_all_start_methods():
+        return multiprocessing.get_context("spawn")
+    context = multiprocessing.get_context("forkserver")
+    context.set_forkserver_preload(PRELOAD)  # no effect once its server runs
+    return context
+
+
+def _die_with_driver() -> None:
+    """Ends this worker as soon as the driver exits (a thread waiting on the driver's pipe),
+    and asks Linux to SIGKILL it when its parent (the fork server) exits."""
     try:
         libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(PR_SET_NAME, WORKER_NAME, 0, 0, 0)
+        parent = os.getppid()
         libc.prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+        if os.getppid() != parent:  # the parent died before the request took effect
+            os._exit(1)
     except (OSError, AttributeError):
         pass
-    if os.getppid() != parent:  # the parent died before the request took effect
+    driver = multiprocessing.parent_process()
+    if driver is None or driver.sentinel is None:
+        return
+
+    def watch() -> None:
+        wait([driver.sentinel])
         os._exit(1)
 
+    threading.Thread(target=watch, name="driver-watch", daemon=True).start()
 
-def _worker_main(connection, spec_data: dict, out: str, name: str, parent: int) -> None:
+
+def _worker_main(connection, spec_data: dict, out: str, name: str, environ: dict) -> None:
     """A worker's loop: receive (episode, attempt), make the shard, send back its record."""
-    _die_with_parent(parent)
+    _die_with_driver()
+    os.environ.clear()  # the driver's environment now, not the fork server's
+    os.environ.update(environ)
     from .episode import run_episode
 
     connection.send(("ready", None, None, os.getpid()))
@@ -71,7 +107,7 @@ class _Slot:
 
 
 class LocalExecutor(Executor):
-    """Runs episodes in `workers` spawned processes on this machine."""
+    """Runs episodes in `workers` processes on this machine."""
 
     name = "local"
 
@@ -80,7 +116,7 @@ class LocalExecutor(Executor):
         if workers < 1:
             raise ValueError(f"workers must be >= 1, got {workers}")
         self.workers = int(workers)
-        self._context = multiprocessing.get_context("spawn")
+        self._context = _worker_context()
         self._started = 0
         self._start_failures = 0  # workers in a row that died before they were ready
 
@@ -93,7 +129,7 @@ class LocalExecutor(Executor):
         number = self._started
         process = self._context.Process(
             target=_worker_main,
-            args=(theirs, spec_data, out, f"local-{number}", os.getpid()),
+            args=(theirs, spec_data, out, f"local-{number}", dict(os.environ)),
             name=f"ambfplus-generate-{number}",
             daemon=True,
         )
@@ -164,7 +200,7 @@ class LocalExecutor(Executor):
         ):
             raise WorkerStartError(
                 f"a worker process could not start (exit code {code}; its error is above). "
-                "Workers are spawned: they import the main module again, so a script that "
+                "Workers import the main module again, so a script that "
                 "calls generate() must be a file and call it under "
                 '`if __name__ == "__main__":`'
             )

@@ -3,8 +3,9 @@
 Formats (``FORMATS``):
 
 - ``mcap``: one MCAP file of ROS 2 messages (CDR), which ROS 2 tools and Foxglove read: images
-  per camera and pass, CameraInfo, point clouds, TF, the drill's wrench, the removal log and
-  the critical-structure events (``ambfplus.export.ros`` lists the topics).
+  per camera and pass (raw, or as lossless PNG/TIFF CompressedImage with ``image_topics``,
+  ``ambfplus.export.images``), CameraInfo, point clouds, TF, the drill's wrench, the removal
+  log and the critical-structure events (``ambfplus.export.ros`` lists the topics).
 - ``rosbag2``: the same messages as a rosbag2 folder (``metadata.yaml`` and MCAP storage).
 - ``original-h5``: the original system's HDF5 layout (volumetric_drilling data_record v3,
   ``ambfplus.export.original_h5``).
@@ -39,6 +40,13 @@ SUFFIXES = {"mcap": ".mcap", "rosbag2": "", "original-h5": "", "coco": ""}
 MANIFEST = "manifest.jsonl"
 INDEX = "index.jsonl"
 MANIFEST_KEYS = ("episode", "file", "sha256")
+# The options each format takes (keyword arguments of export()).
+OPTIONS = {
+    "mcap": ("point_clouds", "compression", "image_topics", "rgb_codec", "jpeg_quality"),
+    "rosbag2": ("point_clouds", "image_topics", "rgb_codec", "jpeg_quality"),
+    "original-h5": ("chunk_size", "names"),
+    "coco": ("images",),
+}
 
 
 @dataclass
@@ -73,10 +81,15 @@ def _writer(to: str) -> Callable:
     }[to]
 
 
-def check_format(to: str) -> str:
-    """The format name, or an ExportError listing the known ones."""
+def check_format(to: str, options: dict | None = None) -> str:
+    """The format name, or an ExportError listing the known ones (or naming an option the
+    format does not take)."""
     if to not in FORMATS:
         raise ExportError(f"unknown export format {to!r}; known: {', '.join(FORMATS)}")
+    unknown = sorted(set(options or {}) - set(OPTIONS[to]))
+    if unknown:
+        raise ExportError(f"the {to} export takes no option {', '.join(unknown)} (its options: "
+                          f"{', '.join(OPTIONS[to])})")  # fmt: skip
     return to
 
 
@@ -90,13 +103,18 @@ def export(source, out, to: str, *, force: bool = False, progress: bool | None =
            **options) -> ExportResult | list[ExportResult]:  # fmt: skip
     """Exports a recording (or every shard of a dataset folder) to ``out`` in format ``to``
     (one of FORMATS). ``force`` replaces an existing output; ``progress`` shows a bar (None:
-    only on a terminal). Options go to the format: ``point_clouds``, ``compression`` (mcap,
-    rosbag2), ``chunk_size``, ``names`` (original-h5), ``images`` (coco). A dataset gives one
-    result per shard."""
-    check_format(to)
+    only on a terminal). Options go to the format (``OPTIONS``): ``point_clouds``,
+    ``image_topics`` ("raw", "compressed" or "both"), ``rgb_codec`` ("png" or "jpeg"),
+    ``jpeg_quality`` (mcap, rosbag2), ``compression`` (mcap), ``chunk_size``, ``names``
+    (original-h5), ``images`` (coco). A source is a recording's head file (a dataset's shard)
+    or a dataset folder, which gives one result per shard."""
+    check_format(to, options)
     source, out = Path(source), Path(out)
     if source.is_dir():
         return export_dataset(source, out, to, force=force, progress=progress, **options)
+    if source.name == MANIFEST:
+        raise ExportError(f"{source} is a dataset's manifest: export its folder "
+                          f"{source.parent} (every shard) or one shard's head file")  # fmt: skip
     check_output(out, force)
     _writer(to)  # the extra's modules are imported before anything is opened
     with open_recording(source) as recording, whole_output(out, force) as temporary:
@@ -125,7 +143,13 @@ def read_manifest(folder: Path) -> list[dict]:
     """The dataset's manifest lines, checked: JSON objects with episode, file and sha256."""
     path = folder / MANIFEST
     if not path.is_file():
-        raise ExportError(f"{folder}: not a recording and not a dataset folder (no {MANIFEST})")
+        hint = ""
+        if (folder.parent / MANIFEST).is_file():
+            hint = f"; it is inside the dataset folder {folder.parent}: export that folder"
+        elif any(folder.glob("*.h5")):
+            hint = "; export one of its recordings (name.h5) or a dataset folder"
+        raise ExportError(f"{folder}: not a recording and not a dataset folder (no "
+                          f"{MANIFEST}){hint}")  # fmt: skip
     entries = []
     for number, line in enumerate(path.read_text().splitlines(), start=1):
         if not line.strip():
@@ -184,7 +208,7 @@ def export_dataset(folder: Path, out: Path, to: str, *, force: bool = False,
     """Exports every shard of a dataset folder into the folder ``out``, mirroring the shards'
     names, with ``index.jsonl`` (one line per shard: its manifest fields, the output and
     counts). Checksums are verified first; a mismatch exports nothing."""
-    check_format(to)
+    check_format(to, options)
     check_output(out, force)
     entries = read_manifest(folder)
     verify_shards(folder, entries)

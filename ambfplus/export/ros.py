@@ -13,6 +13,12 @@ topic                           type                         content
 ``/S/instance/image``           sensor_msgs/Image            32SC1 object ids (0 = background)
 ``/S/voxel/image``              sensor_msgs/Image            32SC1 voxel index, -1 = none
 ``/S/segmentation/image``       sensor_msgs/Image            rgb8 flat segmentation colours
+``/S/.../compressed``           sensor_msgs/CompressedImage  ``image_topics="compressed"`` (in-
+                                                             stead of the raw ones) or "both":
+                                                             each image topic's PNG (rgb8,
+                                                             16UC1) or TIFF (32-bit) form,
+                                                             lossless; JPEG for rgb as an option
+                                                             (``ambfplus.export.images``)
 ``/S/camera_info``              sensor_msgs/CameraInfo       K, P in ROS's pixel convention
 ``/S/points``                   sensor_msgs/PointCloud2      organised, optical frame: x y z
                                                              (float32, NaN where no hit), rgb
@@ -59,6 +65,7 @@ from ._common import (
     quaternion_xyzw,
     require,
 )
+from .images import COMPRESSED_IMAGE, check_image_options, compressed_image_message
 
 WORLD = "world"
 TYPESTORE = "ROS2_JAZZY"  # the message definitions (ROS 2 Jazzy's; unchanged since Humble)
@@ -222,9 +229,14 @@ def _rays(shape: tuple[int, int], k: tuple) -> np.ndarray:
 class RosExport:
     """Turns a recording into time-ordered ROS 2 messages (see the module docstring)."""
 
-    def __init__(self, recording, *, point_clouds: bool = True) -> None:
+    def __init__(self, recording, *, point_clouds: bool = True, image_topics: str = "raw",
+                 rgb_codec: str = "png", jpeg_quality: int = 90) -> None:  # fmt: skip
+        check_image_options(image_topics, rgb_codec, jpeg_quality)
         self.rec = recording
         self.point_clouds = point_clouds
+        self.raw_images = image_topics in ("raw", "both")
+        self.compressed_images = image_topics in ("compressed", "both")
+        self.rgb_codec, self.jpeg_quality = rgb_codec, jpeg_quality
         self.clock = StepClock(recording)
         self.legend = recording.legend
         self.names = {entry.get("name"): entry for entry in self.legend.values()}
@@ -292,7 +304,11 @@ class RosExport:
         for name, stream in self.rec.cameras.items():
             for pass_name in stream.passes:
                 if pass_name in IMAGE_TOPICS:
-                    out[f"/{name}/{IMAGE_TOPICS[pass_name][0]}"] = IMAGE
+                    topic = f"/{name}/{IMAGE_TOPICS[pass_name][0]}"
+                    if self.raw_images:
+                        out[topic] = IMAGE
+                    if self.compressed_images:
+                        out[f"{topic}/compressed"] = COMPRESSED_IMAGE
             out[f"/{name}/camera_info"] = CAMERA_INFO
             if self.point_clouds and "depth" in stream.passes:
                 out[f"/{name}/points"] = POINT_CLOUD
@@ -352,6 +368,7 @@ class RosExport:
             "pixels",
             "encodings": "rgb8 colour and segmentation; 32FC1 depth in metres (0 = no hit); "
             "16UC1 label ids; 32SC1 instance ids and voxel indices (-1 = none)",
+            "compressed_images": self._compressed_description(),
             "point_clouds": "organised, optical frame, NaN where nothing was hit; rgb packed "
             "0x00RRGGBB as float32",
             "wrench": "the force the drill feeds back to the device (N), world axes; torque 0",
@@ -361,6 +378,18 @@ class RosExport:
             "recording_metadata": json.dumps(self.rec.metadata, sort_keys=True, default=str),
             "warnings": json.dumps(self.warnings),
         }
+
+    def _compressed_description(self) -> str:
+        if not self.compressed_images:
+            return "none (raw sensor_msgs/Image topics only)"
+        rgb = ("JPEG, quality " + str(self.jpeg_quality) + " (lossy)" if self.rgb_codec == "jpeg"
+               else "PNG (lossless)")  # fmt: skip
+        return (
+            "sensor_msgs/CompressedImage on <image topic>/compressed, format 'ORIG_PIXFMT; "
+            f"CODEC compressed [PIXFMT]' as image_transport's compressed plugin: rgb {rgb}; "
+            "segmentation PNG and 16UC1 labels 16-bit PNG (lossless); 32FC1 depth and 32SC1 "
+            "ids 32-bit TIFF with deflate (lossless)"
+        )
 
     def frames(self) -> int:
         return sum(len(s) for s in self.rec.cameras.values())
@@ -384,8 +413,14 @@ class RosExport:
                 if pass_name not in IMAGE_TOPICS:
                     continue
                 suffix, encoding = IMAGE_TOPICS[pass_name]
-                body = image_message(t, frame_id, getattr(frame, pass_name), encoding)
-                yield Message(t, 1, f"/{stream.name}/{suffix}", IMAGE, body)
+                topic, image = f"/{stream.name}/{suffix}", getattr(frame, pass_name)
+                if self.raw_images:
+                    yield Message(t, 1, topic, IMAGE, image_message(t, frame_id, image, encoding))
+                if self.compressed_images:
+                    codec = self.rgb_codec if pass_name == "rgb" else "png"
+                    body = compressed_image_message(header(t, frame_id), image, encoding, codec,
+                                                    self.jpeg_quality)  # fmt: skip
+                    yield Message(t, 1, f"{topic}/compressed", COMPRESSED_IMAGE, body)
             tx = 0.0
             if partner is not None:
                 baseline = partner[2][index]
@@ -659,10 +694,14 @@ class Rosbag2Sink:
 
 
 def write_ros(recording, out: Path, kind: str, bar, *, point_clouds: bool = True,
-              compression: str | None = "zstd") -> dict:  # fmt: skip
+              compression: str | None = "zstd", image_topics: str = "raw",
+              rgb_codec: str = "png", jpeg_quality: int = 90) -> dict:  # fmt: skip
     """Writes a recording as an MCAP file (kind "mcap") or a rosbag2 folder ("rosbag2") at
-    ``out`` (a path that does not exist yet); returns counts per topic."""
-    export = RosExport(recording, point_clouds=point_clouds)
+    ``out`` (a path that does not exist yet); returns counts per topic. ``image_topics``:
+    "raw" (sensor_msgs/Image), "compressed" (sensor_msgs/CompressedImage; ``rgb_codec`` "png"
+    or "jpeg" at ``jpeg_quality``) or "both"."""
+    export = RosExport(recording, point_clouds=point_clouds, image_topics=image_topics,
+                       rgb_codec=rgb_codec, jpeg_quality=jpeg_quality)  # fmt: skip
     topics = export.topics()
     if kind == "mcap":
         sink = McapSink(out, compression)

@@ -30,7 +30,20 @@ struct Context {
   /// A plugin that fails is an error of the load report (a non-strict launch) instead of a
   /// PluginError.
   bool report_plugin_errors = false;
+  /// A launch that is not strict: a world's environment that cannot load is an error of the
+  /// report and the rest of the world loads (AMBF's scope), instead of an exception.
+  bool report_environment_errors = false;
+  /// While loading a world's environment without strictness: a body whose mesh is missing is
+  /// left out (an error of the report) and the rest of the file loads, as in AMBF.
+  bool skip_missing_meshes = false;
 };
+
+/// Finishes the links waiting for objects that have now appeared; an error doing so is an
+/// error of the report (or thrown when ctx reports no errors).
+void resolve_deferred(World& world, Context& ctx);
+
+/// Warns of every link still waiting (once everything a load asked for is in the world).
+void warn_unresolved(const World& world, Context& ctx);
 
 /// The `plugins: [{name, filename, path}]` list under a block, `path` made absolute.
 std::vector<AdfPlugin> read_plugins(const Doc& doc, const YAML::Node& list,

@@ -1,13 +1,17 @@
 #include "adf/adf_yaml.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cstdlib>
+#include <fstream>
 #include <set>
+#include <sstream>
 #include <system_error>
 
 #include <Eigen/Geometry>
 
 #include "ambfplus/log.h"
+#include "util/strings.h"
 
 namespace ambfplus::adf {
 
@@ -15,8 +19,30 @@ Doc load(const std::string& path, const std::string& what) {
   std::error_code ec;
   if (!fs::is_regular_file(path, ec)) throw AssetNotFound(path, what);
   Doc doc{path, fs::absolute(fs::path(path)).parent_path().lexically_normal(), {}};
+  std::ifstream file(path, std::ios::binary);
+  std::stringstream text;
+  text << file.rdbuf();
+  if (!file) throw ConfigError(path, what + ": cannot be read");
+  // Names and messages made from the file must reach Python as text; a second document (a
+  // '---' line after content) would be ignored by YAML::Load, so it is refused. (YAML::LoadAll
+  // is not used: it loops without end on some malformed input, such as a lone ',').
+  std::istringstream lines(text.str());
+  std::string line;
+  bool content = false;
+  for (int number = 1; std::getline(lines, line); ++number) {
+    require_utf8(path, number, line);
+    const bool marker = line.rfind("---", 0) == 0 &&
+                        (line.size() == 3 || std::isspace(static_cast<unsigned char>(line[3])));
+    if (marker && content) {
+      throw ConfigError(path, "line " + std::to_string(number) + ": " + what +
+                                  ": a second YAML document ('---'); an ADF file holds one");
+    }
+    const std::size_t first = line.find_first_not_of(" \t\r");
+    content |=
+        !marker && first != std::string::npos && line[first] != '#' && line.rfind("%", 0) != 0;
+  }
   try {
-    doc.root = YAML::LoadFile(path);
+    doc.root = YAML::Load(text.str());
   } catch (const YAML::Exception& e) {
     throw ConfigError(path, "line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
   }

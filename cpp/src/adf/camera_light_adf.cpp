@@ -2,8 +2,10 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <functional>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -166,6 +168,36 @@ Eigen::Isometry3d parent_frame(const Object& parent) {
 
 }  // namespace
 
+void now_or_later(Model& model, const Doc& doc, const std::function<std::string()>& missing,
+                  std::function<bool(World&)> attempt) {
+  if (attempt(model.world())) return;
+  model.world().defer_link({&model, doc.path, missing(), std::move(attempt)});
+}
+
+void attach_when_found(Model& model, const Doc& doc, Object& child, const std::string& id,
+                       const std::string& parent, const std::string& ns,
+                       const std::vector<std::pair<std::string, RigidBody*>>& own,
+                       const Eigen::Isometry3d& local) {
+  if (parent.empty()) return;
+  Object* target = &child;
+  auto attempt = [target, parent, ns, own, local](World& world) {
+    std::string why;
+    Object* found = find_object(world, parent, ns, own, std::nullopt, why);
+    if (found == nullptr) return false;
+    target->attach_to(found, parent_frame(*found) * local);
+    return true;
+  };
+  now_or_later(
+      model, doc,
+      [&] {
+        std::string why;
+        find_object(model.world(), parent, ns, own, std::nullopt, why);
+        return id + ": parent '" + parent + "' not found (" + why +
+               "); placed in the world frame instead (attached if a later load brings it)";
+      },
+      attempt);
+}
+
 void add_cameras_and_lights(Model& model, const Doc& doc, const std::string& base_ns, Context& ctx,
                             const std::vector<std::pair<std::string, RigidBody*>>& own,
                             std::vector<ObjectPlugins>& plugins) {
@@ -178,18 +210,7 @@ void add_cameras_and_lights(Model& model, const Doc& doc, const std::string& bas
   for (const auto& [id, block] : listed(doc, "lights")) {
     lights.push_back(plan_light(doc, base_ns, id, block, ctx));
   }
-  // A parent that is not there leaves the object in the world frame, with a warning.
-  auto parent_of = [&](const std::string& id, const std::string& parent,
-                       const std::string& ns) -> Object* {
-    if (parent.empty()) return nullptr;
-    std::string why;
-    Object* found = find_object(world, parent, ns, own, std::nullopt, why);
-    if (found == nullptr) {
-      ctx.diag->warn(doc.path, id + ": parent '" + parent + "' not found (" + why +
-                                   "); placed in the world frame instead");
-    }
-    return found;
-  };
+  // A parent that is not there yet leaves the object in the world frame until it comes.
   for (CameraPlan& c : cameras) {
     c.spec.name = unique_name(world, c.spec.name);
     Camera& camera = model.add_camera(c.spec);
@@ -197,9 +218,7 @@ void add_cameras_and_lights(Model& model, const Doc& doc, const std::string& bas
     camera.set_name_space(c.ns);
     camera.set_preprocessing_shader(c.preprocessing);
     camera.look_at(c.eye, c.target, c.up);
-    if (Object* parent = parent_of(c.id, c.parent, c.ns)) {
-      camera.attach_to(parent, parent_frame(*parent) * camera.pose());
-    }
+    attach_when_found(model, doc, camera, c.id, c.parent, c.ns, own, camera.pose());
     if (c.eye_separation > 0) {
       // AMBF's passive stereo: two eyes half the separation either side, converging (off-axis)
       // at the focal length when one is given.
@@ -224,9 +243,7 @@ void add_cameras_and_lights(Model& model, const Doc& doc, const std::string& bas
     Light& light = model.add_light(l.spec);
     light.set_identifier(l.id);
     light.set_name_space(l.ns);
-    if (Object* parent = parent_of(l.id, l.parent, l.ns)) {
-      light.attach_to(parent, parent_frame(*parent) * light.pose());
-    }
+    attach_when_found(model, doc, light, l.id, l.parent, l.ns, own, light.pose());
     if (!l.plugins.empty()) plugins.push_back({&light, l.id, l.plugins});
   }
 }

@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "adf/joint_axes_adf.h"
 #include "adf/model_blocks.h"
 #include "util/strings.h"
 
@@ -71,24 +72,30 @@ JointPlan plan_joint(const Doc& doc, const std::string& model_ns, const std::str
 
   const bool multi_axis = s.type == JointType::kConeTwist || s.type == JointType::kSixDof ||
                           s.type == JointType::kSixDofSpring;
-  if (multi_axis) {
-    for (const char* key : {"joint limits", "stiffness", "damping", "equilibrium point"}) {
-      if (j[key]) {
-        ctx.diag->warn(doc.path, at(j[key]) + id + ": '" + key + "' of a " +
-                                     joint_type_name(s.type) + " joint is not applied yet");
-      }
-    }
+  if (s.type == JointType::kConeTwist) {
+    plan.cone = read_cone_twist_limits(doc, j, id, ctx);
+  } else if (multi_axis) {
+    plan.six_dof = read_six_dof_axes(doc, j, id, s.type, ctx);
   } else {
+    double middle = 0.0;
     if (const YAML::Node limits = j["joint limits"]) {
       // AMBF turns limits on only when both are given.
       if (limits["low"] && limits["high"]) {
-        s.lower = number(doc, limits["low"], id, "joint limits.low");
-        s.upper = number(doc, limits["high"], id, "joint limits.high");
-        if (*s.lower > *s.upper) fail(doc, limits, id, "'joint limits' has low > high");
+        const double low = number(doc, limits["low"], id, "joint limits.low");
+        const double high = number(doc, limits["high"], id, "joint limits.high");
+        middle = (low + high) / 2;
+        if (low > high) {
+          // AMBF hands them to Bullet, which reads such a range as no limit.
+          ctx.diag->warn(doc.path, at(limits) + id +
+                                       ": 'joint limits' has low > high; Bullet (and so AMBF) "
+                                       "reads that as no limit: the joint moves freely");
+        } else {
+          s.lower = low;
+          s.upper = high;
+        }
       }
     }
     set_options(doc, id, j, joint_options(), s, {"damping", "stiffness"});
-    const double middle = s.lower && s.upper ? (*s.lower + *s.upper) / 2 : 0.0;
     s.equilibrium = number_or(doc, j, "equilibrium point", id, middle);
   }
   s.erp = number_or(doc, j, "joint erp", id, s.erp);

@@ -83,6 +83,21 @@ void adf::load_plugins(const std::vector<ObjectPlugins>& objects, const std::str
   }
 }
 
+void adf::resolve_deferred(World& world, Context& ctx) {
+  try {
+    world.resolve_deferred_links();
+  } catch (const Error& e) {
+    if (!ctx.report_plugin_errors) throw;
+    ctx.diag->error("", std::string("attaching to a parent loaded later: ") + e.what());
+  }
+}
+
+void adf::warn_unresolved(const World& world, Context& ctx) {
+  for (const DeferredLink& link : world.deferred_links()) {
+    ctx.diag->warn(link.file, link.description);
+  }
+}
+
 namespace {
 
 // Static planes around the origin: AMBF's `enclosure` when a world has no environment.
@@ -154,12 +169,24 @@ void load_world(World& world, const std::string& path, adf::Context& ctx) {
   // Lights and cameras may ride on bodies of the environment, so it comes first.
   std::vector<std::pair<std::string, RigidBody*>> own;
   if (!environment.empty()) {
-    Model& env = adf::load_model(world, environment, ctx);
-    // AMBF builds the environment before it compiles the world's shader, which the
-    // environment therefore never gets.
-    if (shader && !env.shader()) env.set_shader(ShaderSpec{});
-    for (Object* o : env.objects()) {
-      if (auto* b = dynamic_cast<RigidBody*>(o)) own.emplace_back(b->identifier(), b);
+    Model* env = nullptr;
+    try {
+      ctx.skip_missing_meshes = ctx.report_environment_errors;
+      env = &adf::load_model(world, environment, ctx);
+      ctx.skip_missing_meshes = false;
+    } catch (const Error& e) {
+      ctx.skip_missing_meshes = false;
+      // AMBF reports an environment it cannot build and goes on with the world.
+      if (!ctx.report_environment_errors) throw;
+      ctx.diag->error(environment, std::string("world environment not loaded: ") + e.what());
+    }
+    if (env != nullptr) {
+      // AMBF builds the environment before it compiles the world's shader, which the
+      // environment therefore never gets.
+      if (shader && !env->shader()) env->set_shader(ShaderSpec{});
+      for (Object* o : env->objects()) {
+        if (auto* b = dynamic_cast<RigidBody*>(o)) own.emplace_back(b->identifier(), b);
+      }
     }
   } else if (root["enclosure"]) {
     add_enclosure(world, doc, root["enclosure"]);
@@ -291,6 +318,7 @@ void load_world_file(World& world, const std::string& path, const AdfColors& col
   adf::Diagnostics diag;
   adf::Context ctx{&colors, &diag, ""};
   load_world(world, path, ctx);
+  adf::resolve_deferred(world, ctx);
   if (warnings != nullptr) {
     warnings->insert(warnings->end(), diag.warnings().begin(), diag.warnings().end());
   }
@@ -301,6 +329,8 @@ Model& load_model_file(World& world, const std::string& path, const AdfColors& c
   adf::Diagnostics diag;
   adf::Context ctx{&colors, &diag, ""};
   Model& model = adf::load_model(world, path, ctx);
+  adf::resolve_deferred(world, ctx);
+  adf::warn_unresolved(world, ctx);
   if (warnings != nullptr) {
     warnings->insert(warnings->end(), diag.warnings().begin(), diag.warnings().end());
   }
@@ -322,17 +352,21 @@ AdfReport load_launch(World& world, const std::string& path, const AdfLoadOption
   }
   adf::Context ctx{&colors, &diag, options.namespace_prefix};
   ctx.report_plugin_errors = !options.strict;
+  ctx.report_environment_errors = !options.strict;
   const std::size_t models_before = world.models().size();
   if (options.load_world) load_world(world, launch.world, ctx);
 
-  // One model failing is reported (or thrown, when strict) and leaves nothing behind.
+  // One model failing is reported (or thrown, when strict) and leaves nothing behind. Objects
+  // of earlier files waiting for a parent it declares are attached as soon as it is in.
   auto load_one = [&](const std::string& file, const std::string& what) {
     try {
       adf::load_model(world, file, ctx);
     } catch (const Error& e) {
       if (options.strict) throw;
       diag.error(file, what + " not loaded: " + e.what());
+      return;
     }
+    adf::resolve_deferred(world, ctx);
   };
   std::vector<int> indices;
   if (options.indices) {
@@ -375,6 +409,9 @@ AdfReport load_launch(World& world, const std::string& path, const AdfLoadOption
   } else {
     diag.warn(launch.file, "input devices file " + launch.input_devices + " not found");
   }
+
+  // Parents still missing now are missing for good (unless a later load brings them).
+  adf::warn_unresolved(world, ctx);
 
   // Simulator plugins last, when the scene they see is complete: the launch file's, then those
   // given with the load (AMBF's --plugins).

@@ -12,7 +12,9 @@
 #include "ambfplus/adf/volume_adf.h"
 #include "ambfplus/errors.h"
 #include "ambfplus/plugin/registry.h"
+#include "ambfplus/scene/ghost.h"
 #include "ambfplus/scene/model.h"
+#include "ambfplus/scene/six_dof.h"
 #include "ambfplus/scene/world.h"
 
 namespace ambfplus::adf {
@@ -122,7 +124,27 @@ Model& load_model(World& world, const std::string& path, Context& ctx) {
   // Everything is read (and every mesh found) before anything is created.
   std::vector<BodyPlan> bodies;
   for (const auto& [id, block] : listed(doc, "bodies")) {
-    bodies.push_back(plan_body(doc, hr, lr, model_ns, id, block, ctx));
+    try {
+      bodies.push_back(plan_body(doc, hr, lr, model_ns, id, block, ctx));
+    } catch (const AssetNotFound& e) {
+      // A world's environment goes on without a body whose mesh is missing (AMBF's scope).
+      if (!ctx.skip_missing_meshes) throw;
+      ctx.diag->error(doc.path, at(block) + id + ": left out: " + e.what());
+    }
+  }
+  // Ghost objects: a body's keys (no mass) and a `parent` they ride on.
+  struct GhostPlan {
+    BodyPlan body;
+    std::string parent;
+  };
+  std::vector<GhostPlan> ghosts;
+  for (const auto& [id, block] : listed(doc, "ghost objects")) {
+    YAML::Node keys = YAML::Clone(block);
+    std::string parent;
+    if (block["parent"]) parent = text(doc, block["parent"], id, "parent");
+    keys.remove("parent");
+    if (!keys["mass"]) keys["mass"] = 0.0;  // a ghost has none; no warning about it
+    ghosts.push_back({plan_body(doc, hr, lr, model_ns, id, keys, ctx), parent});
   }
   std::vector<JointPlan> joints;
   for (const auto& [id, block] : listed(doc, "joints")) {
@@ -140,10 +162,8 @@ Model& load_model(World& world, const std::string& path, Context& ctx) {
       if (auto p = plan_sensor(doc, model_ns, actuator, id, block, ctx)) sensors.push_back(*p);
     }
   }
-  for (const char* key : {"ghost objects", "vehicles"}) {
-    if (!listed(doc, key).empty()) {
-      ctx.diag->warn(doc.path, at(root[key]) + "'" + key + "' are not loaded yet");
-    }
+  if (!listed(doc, "vehicles").empty()) {
+    ctx.diag->warn(doc.path, at(root["vehicles"]) + "'vehicles' are not loaded yet");
   }
   const std::optional<ShaderSpec> model_shader =
       read_shader(doc, root["shaders"], where, "shaders", ctx);
@@ -187,46 +207,98 @@ Model& load_model(World& world, const std::string& path, Context& ctx) {
       soft.set_name_space(model_ns);
       if (!soft_plugins[i].empty()) object_plugins.push_back({&soft, id, soft_plugins[i]});
     }
+    // Joints, sensors and actuators whose bodies are not in the world yet are made when a
+    // later file brings them.
+    Model* target = &model;
     for (JointPlan& j : joints) {
       current = j.id;
-      std::string why_parent, why_child;
-      RigidBody* parent = find_body(world, j.parent, model_ns, own, why_parent);
-      RigidBody* child = find_body(world, j.child, model_ns, own, why_child);
-      if (parent == nullptr || child == nullptr) {
-        ctx.diag->warn(doc.path, at(j.block) + j.id + ": joint left out: " +
-                                     (parent == nullptr ? why_parent : why_child));
-        continue;
+      const bool now = [&] {
+        std::string why;
+        return find_body(world, j.parent, model_ns, own, why) != nullptr &&
+               find_body(world, j.child, model_ns, own, why) != nullptr;
+      }();
+      if (!now && !j.plugins.empty()) {
+        ctx.diag->warn(doc.path, at(j.block) + j.id +
+                                     ": its plugins are not loaded: its bodies come in a later "
+                                     "file");
       }
-      j.spec.parent = parent;
-      j.spec.child = child;
-      j.spec.parent_pivot *= parent->shape().scale;
-      j.spec.child_pivot *= child->shape().scale;
-      j.spec.name = unique_name(world, j.spec.name);
-      Joint& joint = model.add_joint(j.spec);
-      joint.set_identifier(j.id);
-      joint.set_name_space(j.ns);
-      if (!j.plugins.empty()) object_plugins.push_back({&joint, j.id, j.plugins});
+      // Plugins only for a joint made now (a later one's file has finished loading).
+      std::vector<ObjectPlugins>* sink = now ? &object_plugins : nullptr;
+      auto make = [target, plan = j, model_ns, own, sink](World& w) {
+        std::string why;
+        RigidBody* parent = find_body(w, plan.parent, model_ns, own, why);
+        RigidBody* child = find_body(w, plan.child, model_ns, own, why);
+        if (parent == nullptr || child == nullptr) return false;
+        JointSpec spec = plan.spec;
+        spec.parent = parent;
+        spec.child = child;
+        spec.parent_pivot *= parent->shape().scale;
+        spec.child_pivot *= child->shape().scale;
+        spec.name = unique_name(w, spec.name);
+        Joint& joint = target->add_joint(spec);
+        joint.set_identifier(plan.id);
+        joint.set_name_space(plan.ns);
+        if (plan.six_dof) set_six_dof_axes(joint, *plan.six_dof);
+        if (plan.cone)
+          set_cone_twist_limits(joint, (*plan.cone)[0], (*plan.cone)[1], (*plan.cone)[2]);
+        if (sink != nullptr && !plan.plugins.empty()) {
+          sink->push_back({&joint, plan.id, plan.plugins});
+        }
+        return true;
+      };
+      now_or_later(
+          model, doc,
+          [&] {
+            std::string why_parent, why_child;
+            const bool has_parent =
+                find_body(world, j.parent, model_ns, own, why_parent) != nullptr;
+            find_body(world, j.child, model_ns, own, why_child);
+            return at(j.block) + j.id +
+                   ": joint left out: " + (has_parent ? why_child : why_parent) +
+                   " (made if a later load brings it)";
+          },
+          make);
     }
     for (SensorPlan& p : sensors) {
       current = p.id;
-      std::string why;
-      RigidBody* parent = find_body(world, p.parent, model_ns, own, why);
-      if (parent == nullptr) {
-        ctx.diag->warn(doc.path, at(p.block) + p.id + ": left out: " + why);
-        continue;
-      }
-      Object* made = nullptr;
-      if (p.actuator) {
-        p.act.parent = parent;
-        p.act.name = unique_name(world, p.act.name);
-        made = &model.add_actuator(p.act);
-      } else {
-        p.sensor.parent = parent;
-        p.sensor.name = unique_name(world, p.sensor.name);
-        made = &model.add_sensor(p.sensor);
-      }
-      made->set_identifier(p.id);
-      made->set_name_space(p.ns);
+      auto make = [target, plan = p, model_ns, own](World& w) {
+        std::string why;
+        RigidBody* parent = find_body(w, plan.parent, model_ns, own, why);
+        if (parent == nullptr) return false;
+        Object* made = nullptr;
+        if (plan.actuator) {
+          ConstraintActuatorSpec spec = plan.act;
+          spec.parent = parent;
+          spec.name = unique_name(w, spec.name);
+          made = &target->add_actuator(spec);
+        } else {
+          ProximitySensorSpec spec = plan.sensor;
+          spec.parent = parent;
+          spec.name = unique_name(w, spec.name);
+          made = &target->add_sensor(spec);
+        }
+        made->set_identifier(plan.id);
+        made->set_name_space(plan.ns);
+        return true;
+      };
+      now_or_later(
+          model, doc,
+          [&] {
+            std::string why;
+            find_body(world, p.parent, model_ns, own, why);
+            return at(p.block) + p.id + ": left out: " + why + " (made if a later load brings it)";
+          },
+          make);
+    }
+    for (GhostPlan& g : ghosts) {
+      current = g.body.id;
+      g.body.spec.name = unique_name(world, g.body.spec.name);
+      RigidBody& ghost = add_ghost(model, g.body.spec);
+      ghost.set_identifier(g.body.id);
+      ghost.set_name_space(g.body.ns);
+      if (!g.body.plugins.empty()) object_plugins.push_back({&ghost, g.body.id, g.body.plugins});
+      attach_when_found(model, doc, ghost, g.body.id, g.parent, g.body.ns, own,
+                        Eigen::Isometry3d(g.body.spec.pose));
     }
     current = "cameras and lights";
     add_cameras_and_lights(model, doc, model_ns, ctx, own, object_plugins);

@@ -8,6 +8,8 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <array>
+#include <functional>
 #include <initializer_list>
 #include <optional>
 #include <string>
@@ -15,6 +17,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "adf/adf_internal.h"
 #include "ambfplus/errors.h"
@@ -23,6 +26,7 @@
 #include "ambfplus/scene/options.h"
 #include "ambfplus/scene/proximity_sensor.h"
 #include "ambfplus/scene/rigid_body.h"
+#include "ambfplus/scene/six_dof.h"
 #include "ambfplus/scene/soft_body.h"
 
 namespace ambfplus::adf {
@@ -69,6 +73,8 @@ struct JointPlan {
   YAML::Node block;
   JointSpec spec;  // without its bodies
   std::vector<AdfPlugin> plugins;
+  std::optional<SixDofAxes> six_dof;          // six dof (spring) per-axis settings
+  std::optional<std::array<double, 3>> cone;  // cone twist limits
 };
 /// A `joints` block (joint_adf.cpp).
 JointPlan plan_joint(const Doc& doc, const std::string& model_ns, const std::string& id,
@@ -101,5 +107,20 @@ Object* find_object(World& world, const std::string& ref, const std::string& ns,
                     std::optional<ObjectKind> kind, std::string& why);
 RigidBody* find_body(World& world, const std::string& ref, const std::string& ns,
                      const std::vector<std::pair<std::string, RigidBody*>>& own, std::string& why);
+
+// ---- Parents across files (camera_light_adf.cpp).
+
+/// Runs attempt now; if what it names is not in the world yet, keeps it to run again when a later
+/// file brings it (AMBF resolves parents across files, in any order). `missing` is the warning
+/// if that never happens.
+void now_or_later(Model& model, const Doc& doc, const std::function<std::string()>& missing,
+                  std::function<bool(World&)> attempt);
+
+/// Attaches child to the object parent names (looked up in own, then the world) at local in
+/// that object's frame, now or once it appears.
+void attach_when_found(Model& model, const Doc& doc, Object& child, const std::string& id,
+                       const std::string& parent, const std::string& ns,
+                       const std::vector<std::pair<std::string, RigidBody*>>& own,
+                       const Eigen::Isometry3d& local);
 
 }  // namespace ambfplus::adf

@@ -31,7 +31,7 @@ std::optional<SensorPlan> plan_sensor(const Doc& doc, const std::string& model_n
     ctx.diag->unknown_keys(
         doc, id, n,
         {"name", "namespace", "type", "parent", "location", "range", "array", "parametric", "mesh",
-         "visible", "visible size", "publish frequency", "passive"});
+         "direction", "visible", "visible size", "publish frequency", "passive"});
   }
   if (!n["parent"]) fail(doc, n, id, std::string("a ") + what + " needs 'parent'");
   SensorPlan p;
@@ -69,8 +69,17 @@ std::optional<SensorPlan> plan_sensor(const Doc& doc, const std::string& model_n
     ctx.diag->warn(
         doc.path, at(n["mesh"]) + id + ": sensor rays from a mesh are not supported yet; left out");
     return std::nullopt;
+  } else if (const YAML::Node direction = n["direction"]) {
+    // AMBF's older form: one ray from the sensor's location along `direction`, `range` long.
+    SensorRay r;
+    r.offset = Eigen::Vector3d::Zero();
+    r.direction = xyz(doc, direction, id, "direction", Eigen::Vector3d::Zero());
+    if (!(r.direction.norm() > 1e-12)) fail(doc, direction, id, "'direction' must not be zero");
+    r.direction.normalize();
+    s.rays.push_back(r);
   } else {
-    fail(doc, n, id, "a proximity sensor needs 'array' or 'parametric' rays");
+    fail(doc, n, id,
+         "a proximity sensor needs 'array' or 'parametric' rays, or one ray's 'direction'");
   }
   return p;
 }

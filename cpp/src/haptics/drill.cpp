@@ -9,6 +9,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "ambfplus/scene/ghost.h"
 #include "ambfplus/scene/rigid_body.h"
 #include "ambfplus/scene/volume.h"
 #include "ambfplus/scene/world.h"
@@ -134,7 +135,11 @@ void Drill::sync_meshes() {
     mesh_bodies_.clear();
     for (Object* o : objects) {
       auto* body = dynamic_cast<RigidBody*>(o);
-      if (body == nullptr || !body->visual_mesh() || !body->collision().enabled) continue;
+      // Ghosts touch nothing, the drill's cursors included.
+      if (body == nullptr || !body->visual_mesh() || !body->collision().enabled ||
+          is_ghost(*body)) {
+        continue;
+      }
       const bool carried = std::any_of(attached_.begin(), attached_.end(),
                                        [&](const auto& a) { return a.first == body; });
       if (carried) continue;

@@ -2,6 +2,7 @@
 #include <assimp/scene.h>
 #include <assimp/Importer.hpp>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -19,6 +20,23 @@
 namespace ambfplus {
 
 namespace {
+
+// The diffuse texture a material names, relative to the mesh file; "" for none or an embedded
+// one ("*0"), which is not read.
+std::string diffuse_texture(const aiMaterial& material, const std::string& mesh_path) {
+  aiString name;
+  if (material.GetTextureCount(aiTextureType_DIFFUSE) == 0 ||
+      material.GetTexture(aiTextureType_DIFFUSE, 0, &name) != AI_SUCCESS || name.length == 0 ||
+      name.C_Str()[0] == '*') {
+    return "";
+  }
+  std::string file = name.C_Str();
+  std::replace(file.begin(), file.end(), '\\', '/');
+  const std::filesystem::path p(file);
+  return (p.is_absolute() ? p : std::filesystem::path(mesh_path).parent_path() / p)
+      .lexically_normal()
+      .string();
+}
 
 // The file's bytes, for the checks assimp cannot be trusted to make itself.
 std::string read_bytes(const std::string& path) {
@@ -38,7 +56,9 @@ bool starts_with_ply(const std::string& path) {
 
 // Our own checks of what assimp produced: faces name vertices of their mesh, and every position
 // is finite (normals of degenerate triangles are replaced, not trusted).
-void append_mesh(const std::string& path, const aiMesh& in, double scale, MeshData& mesh) {
+// With textured, texture coordinates too ((0, 0) for a mesh without them).
+void append_mesh(const std::string& path, const aiMesh& in, double scale, bool textured,
+                 MeshData& mesh) {
   const auto base = static_cast<std::uint32_t>(mesh.vertex_count());
   for (unsigned v = 0; v < in.mNumVertices; ++v) {
     const aiVector3D& p = in.mVertices[v];
@@ -59,6 +79,10 @@ void append_mesh(const std::string& path, const aiMesh& in, double scale, MeshDa
       n = aiVector3D(0, 0, 1);
     }
     mesh.normals.insert(mesh.normals.end(), {n.x, n.y, n.z});
+    if (textured) {
+      const aiVector3D t = in.HasTextureCoords(0) ? in.mTextureCoords[0][v] : aiVector3D();
+      mesh.texcoords.insert(mesh.texcoords.end(), {t.x, t.y});
+    }
   }
   for (unsigned f = 0; f < in.mNumFaces; ++f) {
     const aiFace& face = in.mFaces[f];
@@ -104,10 +128,19 @@ MeshData load_mesh(const std::string& path, double scale) {
     throw ConfigError(path, std::string("cannot read mesh: ") + importer.GetErrorString());
   }
   MeshData mesh;
+  // Texture coordinates when any mesh has them (0, 0 for those that do not, to stay aligned).
+  bool textured = false;
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+    textured = textured || scene->mMeshes[m]->HasTextureCoords(0);
+  }
   for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
     const aiMesh* in = scene->mMeshes[m];
     if (!(in->mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) continue;
-    append_mesh(path, *in, scale, mesh);
+    append_mesh(path, *in, scale, textured, mesh);
+    if (mesh.texture.empty() && in->HasTextureCoords(0) && scene->mMaterials != nullptr &&
+        in->mMaterialIndex < scene->mNumMaterials) {
+      mesh.texture = diffuse_texture(*scene->mMaterials[in->mMaterialIndex], path);
+    }
   }
   if (mesh.indices.empty()) {
     throw ConfigError(path, "mesh file holds no triangles");

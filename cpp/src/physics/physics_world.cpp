@@ -190,6 +190,8 @@ void PhysicsWorld::run(StepStage stage, const StepContext& context) {
       for (ConstraintActuator* a : actuators_) a->update();
       break;
     case StepStage::kSensors:
+      // Ghosts first, at their poses after the attachments stage, so they are current.
+      for (RigidBody* g : ghosts_) update_ghost(*g);
       for (ProximitySensor* p : sensors_) p->update();
       break;
     default:
@@ -229,6 +231,7 @@ void PhysicsWorld::detach_all() {
   }
   joints_.clear();
   bodies_.clear();
+  ghosts_.clear();
   actuators_.clear();
   sensors_.clear();
 }
@@ -243,6 +246,12 @@ Eigen::Vector3d PhysicsWorld::gravity() const { return to_eigen(world_->getGravi
 
 void PhysicsWorld::remove(RigidBody& rb) {
   bodies_.erase(std::remove(bodies_.begin(), bodies_.end(), &rb), bodies_.end());
+  ghosts_.erase(std::remove(ghosts_.begin(), ghosts_.end(), &rb), ghosts_.end());
+  // Ghosts forget a body that goes away.
+  for (RigidBody* g : ghosts_) {
+    std::vector<RigidBody*>& o = body_of(*g)->overlaps;
+    o.erase(std::remove(o.begin(), o.end(), &rb), o.end());
+  }
   // Actuators let go of it (or of the body their parent holds) while it still exists.
   const btRigidBody* bullet_body = body_of(rb) ? body_of(rb)->body.get() : nullptr;
   for (int i = world_->getNumConstraints() - 1; i >= 0; --i) {
@@ -348,6 +357,7 @@ void PhysicsWorld::add(RigidBody& rb) {
 
 void PhysicsWorld::refresh(RigidBody& rb) {
   Body& b = *body_of(rb);
+  if (b.ghost) return;  // never in the dynamics world
   btRigidBody& body = *b.body;
   world_->removeRigidBody(&body);
   int flags = body.getCollisionFlags() & ~btCollisionObject::CF_KINEMATIC_OBJECT;
@@ -435,6 +445,14 @@ void PhysicsWorld::add(Joint& joint) {
   }
   world_->addConstraint(c->constraint.get(), s.ignore_inter_collision);
   c->world = world_.get();
+  // A spring keeps its energy: Bullet must not put its bodies to sleep while they swing slowly
+  // (a damped spring would freeze short of its equilibrium).
+  if (s.type == JointType::kLinearSpring || s.type == JointType::kTorsionSpring ||
+      s.type == JointType::kSixDofSpring) {
+    for (btRigidBody* body : {&a, &b}) {
+      if (!body->isStaticOrKinematicObject()) body->forceActivationState(DISABLE_DEACTIVATION);
+    }
+  }
   joint.set_physics_state(std::move(c));
   joint.set_limits(s.lower, s.upper);
   a.activate(true);

@@ -3,6 +3,7 @@
 // Bullet behind the engine's own interfaces: no public header names a Bullet type.
 
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include <BulletSoftBody/btSoftBodyRigidBodyCollisionConfiguration.h>
@@ -12,6 +13,7 @@
 
 #include "ambfplus/physics/physics.h"
 #include "ambfplus/scene/rigid_body.h"
+#include "ambfplus/scene/six_dof.h"
 #include "ambfplus/scene/soft_body.h"
 
 namespace ambfplus {
@@ -43,6 +45,10 @@ struct Body : ObjectState {
   std::uint32_t groups = 0;
   btDynamicsWorld* world = nullptr;  // while in one
   RigidBody* owner = nullptr;        // the scene body (ray hits name it)
+  /// A ghost's collision object (its body then stays out of Bullet's world) and the bodies
+  /// overlapping it after the last step.
+  std::unique_ptr<btCollisionObject> ghost;
+  std::vector<RigidBody*> overlaps;
 };
 
 /// A soft body's Bullet side (its user pointer is the scene SoftBody).
@@ -73,6 +79,7 @@ struct Constraint : ObjectState {
   btDynamicsWorld* world = nullptr;
   double last_position = 0.0;
   ConstraintActuator* actuator = nullptr;  // an actuator's hold (its user pointer is this)
+  std::optional<SixDofAxes> six_dof;       // a six dof joint's per-axis settings, once given
 };
 
 /// The Bullet side of objects, as their physics state (Object::physics_state); nullptr for
@@ -119,6 +126,10 @@ class PhysicsWorld : public Physics {
   /// Forgets a body or joint about to be deleted (its own destructor takes it out of Bullet).
   void remove(RigidBody& body);
   void remove(Joint& joint);
+  /// Turns an added body into a ghost: out of the dynamics world, tested for overlaps instead.
+  void make_ghost(RigidBody& body);
+  /// Moves a ghost's collision object to its body's pose and finds what overlaps it.
+  void update_ghost(RigidBody& body);
 
   /// Controllers and commands, one Bullet step of dt, then poses back into the scene.
   void step(double dt);
@@ -149,6 +160,7 @@ class PhysicsWorld : public Physics {
   std::vector<Joint*> joints_;
   std::vector<ConstraintActuator*> actuators_;
   std::vector<ProximitySensor*> sensors_;
+  std::vector<RigidBody*> ghosts_;
 };
 
 /// The physics of an object's world.

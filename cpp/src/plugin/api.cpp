@@ -13,6 +13,7 @@
 #include "ambfplus/errors.h"
 #include "ambfplus/haptics/drill.h"
 #include "ambfplus/log.h"
+#include "ambfplus/scene/ghost.h"
 #include "ambfplus/scene/simulator.h"
 #include "ambfplus/scene/world.h"
 #include "plugin/plugin_options.h"
@@ -408,6 +409,19 @@ AmbfplusId ambfplus_world_add(AmbfplusWorld* world, const char* model, const cha
     return ambfplus::plugin::add_object(*target, what, called,
                                         ambfplus::plugin::to_options(options, count))
         .id();
+  });
+}
+
+int ambfplus_ghost_overlaps(const AmbfplusWorld* world, AmbfplusId ghost, AmbfplusId* ids,
+                            int capacity) {
+  return guarded(-1, [&] {
+    const auto& body =
+        ambfplus::object_as<ambfplus::RigidBody>(world, ghost, ambfplus::ObjectKind::kRigidBody);
+    const std::vector<ambfplus::RigidBody*> found = ambfplus::ghost_overlaps(body);
+    for (int i = 0; i < capacity && i < static_cast<int>(found.size()); ++i) {
+      ids[i] = found[static_cast<std::size_t>(i)]->id();
+    }
+    return static_cast<int>(found.size());
   });
 }
 

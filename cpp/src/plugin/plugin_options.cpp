@@ -1,10 +1,12 @@
 #include "plugin/plugin_options.h"
 
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "ambfplus/errors.h"
 #include "ambfplus/haptics/drill.h"
+#include "ambfplus/scene/ghost.h"
 #include "ambfplus/scene/model.h"
 #include "ambfplus/scene/world.h"
 
@@ -40,11 +42,11 @@ OptionMap to_options(const AmbfplusOption* options, int count) {
 
 Object& add_object(Model& model, const std::string& kind, const std::string& name,
                    const OptionMap& options) {
-  if (kind == "body") {
+  if (kind == "body" || kind == "ghost") {
     RigidBodySpec spec;
     spec.name = name;
     rigid_body_options().apply(spec, options);
-    return model.add_body(spec);
+    return kind == "body" ? model.add_body(spec) : add_ghost(model, std::move(spec));
   }
   if (kind == "drill") {
     DrillSpec spec;
@@ -68,7 +70,8 @@ Object& add_object(Model& model, const std::string& kind, const std::string& nam
     drill_options().apply(spec, rest);
     return model.add_drill(spec);
   }
-  throw ArgumentError("ambfplus_world_add makes a 'body' or a 'drill', not '" + kind + "'");
+  throw ArgumentError("ambfplus_world_add makes a 'body', a 'ghost' or a 'drill', not '" + kind +
+                      "'");
 }
 
 }  // namespace ambfplus::plugin

@@ -19,7 +19,8 @@ namespace plugin {
 /// whole numbers are integers (so 0 and 1 also stand for False and True).
 OptionMap to_options(const AmbfplusOption* options, int count);
 
-/// A "body" (add_body's keywords) or a "drill" (add_drill's, plus `volume`: a volume's name).
+/// A "body" (add_body's keywords), a "ghost" (a body's keywords; mass and kinematic are ignored)
+/// or a "drill" (add_drill's, plus `volume`: a volume's name).
 Object& add_object(Model& model, const std::string& kind, const std::string& name,
                    const OptionMap& options);
 

@@ -160,6 +160,14 @@ void bind_legacy_vao(GpuMesh& mesh) {
     glEnableClientState(GL_NORMAL_ARRAY);
     glVertexAttribPointer(kNormal, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
     glEnableVertexAttribArray(kNormal);
+    if (mesh.texcoords != 0) {
+      glBindBuffer(GL_ARRAY_BUFFER, mesh.texcoords);
+      glClientActiveTexture(GL_TEXTURE0);
+      glTexCoordPointer(2, GL_FLOAT, 0, nullptr);
+      glEnableClientState(GL_TEXTURE_COORD_ARRAY);
+      glVertexAttribPointer(kTexCoord, 2, GL_FLOAT, GL_FALSE, 0, nullptr);
+      glEnableVertexAttribArray(kTexCoord);
+    }
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, mesh.buffers[2]);
   }
   glBindVertexArray(mesh.legacy_vao);
@@ -363,7 +371,8 @@ void ShaderOverlay::begin(const UserShader& shader) {
 }
 
 void ShaderOverlay::draw(const UserShader& shader, GpuMesh& mesh,
-                         const Eigen::Isometry3d& model_view, const Material& material, int id) {
+                         const Eigen::Isometry3d& model_view, const Material& material, int id,
+                         GLuint texture) {
   if (mesh.index_count == 0) return;
   if (current_ != &shader) begin(shader);
   Program& program = *shader.program;
@@ -379,6 +388,11 @@ void ShaderOverlay::draw(const UserShader& shader, GpuMesh& mesh,
     glUniform1f(program.uniform("u_specular"), material.specular);
     glUniform1f(program.uniform("u_shininess"), material.shininess);
     glUniform1i(program.uniform("u_instance"), id);
+    const GLint textured = program.uniform("u_textured");
+    if (textured >= 0) glUniform1i(textured, texture != 0 && mesh.texcoords != 0 ? 1 : 0);
+    glActiveTexture(GL_TEXTURE0 + kDiffuseUnit);
+    glBindTexture(GL_TEXTURE_2D, texture != 0 ? texture : legacy_textures().white);
+    set_sampler(program, "u_diffuse_map", kDiffuseUnit);
     glBindVertexArray(mesh.vao);
   } else {
     glMatrixMode(GL_MODELVIEW);
@@ -393,6 +407,13 @@ void ShaderOverlay::draw(const UserShader& shader, GpuMesh& mesh,
     glMaterialfv(GL_FRONT_AND_BACK, GL_EMISSION, black);
     glMaterialf(GL_FRONT_AND_BACK, GL_SHININESS, std::clamp(material.shininess, 0.0f, 128.0f));
     bind_legacy_vao(mesh);
+    // The body's texture on the diffuse unit (white without one, which leaves colours as they
+    // are), and whether the shader should sample it.
+    const bool textured = texture != 0 && mesh.texcoords != 0;
+    glActiveTexture(GL_TEXTURE0 + kDiffuseUnit);
+    glBindTexture(GL_TEXTURE_2D, textured ? texture : legacy_textures().white);
+    const GLint enabled = program.uniform("uTextureEnabled");
+    if (enabled >= 0) glUniform1i(enabled, textured ? 1 : 0);
     // Attributes without arrays read these constants.
     glVertexAttrib4f(kTexCoord, 0, 0, 0, 1);
     glVertexAttrib4f(kColor, c[0], c[1], c[2], c[3]);

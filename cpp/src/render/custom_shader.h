@@ -60,9 +60,10 @@ class ShaderOverlay {
   ShaderOverlay(const ShaderOverlay&) = delete;
   ShaderOverlay& operator=(const ShaderOverlay&) = delete;
 
-  /// Draws mesh with shader; model_view is camera (OpenCV frame) from object.
+  /// Draws mesh with shader; model_view is camera (OpenCV frame) from object; texture (0 for
+  /// none) is the diffuse map (unit 0, `diffuseMap`, with `uTextureEnabled` set).
   void draw(const UserShader& shader, GpuMesh& mesh, const Eigen::Isometry3d& model_view,
-            const Material& material, int id);
+            const Material& material, int id, GLuint texture = 0);
 
  private:
   void begin(const UserShader& shader);

@@ -1,12 +1,17 @@
 #include "render/scene_renderer.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "ambfplus/errors.h"
+#include "ambfplus/io/image.h"
+#include "ambfplus/io/mesh.h"
+#include "ambfplus/log.h"
 #include "ambfplus/scene/world.h"
 #include "render/custom_shader.h"
 #include "render/egl_context.h"
@@ -42,6 +47,7 @@ void release_mesh(GpuMesh& m) {
   glDeleteVertexArrays(1, &m.vao);
   if (m.legacy_vao != 0) glDeleteVertexArrays(1, &m.legacy_vao);
   glDeleteBuffers(3, m.buffers);
+  if (m.texcoords != 0) glDeleteBuffers(1, &m.texcoords);
 }
 
 void release_target(RenderTarget& t) {
@@ -62,6 +68,9 @@ void SceneRenderer::release_all() {
     for (auto& entry : meshes_) release_mesh(entry.second);
     for (auto& entry : soft_meshes_) release_mesh(entry.second);
     for (auto& entry : targets_) release_target(entry.second);
+    for (auto& entry : textures_) {
+      if (entry.second != 0) glDeleteTextures(1, &entry.second);
+    }
   } catch (const Error&) {
     // The context is gone (e.g. after a fork); its objects went with it.
     for (auto& v : volumes_) v.second.release();
@@ -70,6 +79,7 @@ void SceneRenderer::release_all() {
   meshes_.clear();
   soft_meshes_.clear();
   targets_.clear();
+  textures_.clear();
 }
 
 void SceneRenderer::object_removed(Object& object) {
@@ -196,7 +206,7 @@ void SceneRenderer::take(const Camera& camera, unsigned passes, Snapshot& s) {
     if (body->visual_mesh()->indices.empty() || !body->material().visible) continue;
     s.bodies.push_back({body->visual_mesh(), body->pose(), body->material(),
                         copy_of(effective_shader(body->material(), body->model(), world_)),
-                        body->id()});
+                        body->id(), body->visual_mesh()->texture});
   }
   for (const SoftBody* body : world_.objects_of_kind<SoftBody>()) {
     if (!body->material().visible) continue;
@@ -243,6 +253,14 @@ GpuMesh& SceneRenderer::mesh_for(const std::shared_ptr<const MeshData>& source) 
                GL_STATIC_DRAW);
   glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
   glEnableVertexAttribArray(1);
+  if (!mesh->texcoords.empty()) {
+    glGenBuffers(1, &g.texcoords);
+    glBindBuffer(GL_ARRAY_BUFFER, g.texcoords);
+    glBufferData(GL_ARRAY_BUFFER, mesh->texcoords.size() * sizeof(float), mesh->texcoords.data(),
+                 GL_STATIC_DRAW);
+    glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, 0, nullptr);
+    glEnableVertexAttribArray(2);
+  }
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g.buffers[2]);
   glBufferData(GL_ELEMENT_ARRAY_BUFFER, mesh->indices.size() * sizeof(std::uint32_t),
                mesh->indices.data(), GL_STATIC_DRAW);
@@ -250,6 +268,56 @@ GpuMesh& SceneRenderer::mesh_for(const std::shared_ptr<const MeshData>& source) 
   g.index_count = static_cast<GLsizei>(mesh->indices.size());
   check_gl("uploading a mesh");
   return meshes_.emplace(mesh, g).first->second;
+}
+
+GLuint SceneRenderer::texture_for(const std::string& path) {
+  if (path.empty()) return 0;
+  auto it = textures_.find(path);
+  if (it != textures_.end()) return it->second;
+  GLuint texture = 0;
+  try {
+    const Image image = read_image(path);
+    // 8-bit RGBA, rows bottom first: texture coordinate v = 0 is the image's bottom row (OBJ's,
+    // AMBF's).
+    std::vector<std::uint8_t> rows(std::size_t(image.width) * image.height * 4);
+    for (int r = 0; r < image.height; ++r) {
+      const std::uint8_t* in = image.row(image.height - 1 - r);
+      std::uint8_t* out = rows.data() + std::size_t(r) * image.width * 4;
+      for (int c = 0; c < image.width; ++c, out += 4) {
+        // The most significant byte of a 16-bit sample (machine order).
+        auto sample = [&](int k) -> std::uint8_t {
+          const std::size_t i = (std::size_t(c) * image.channels + k) * image.sample_bytes();
+          if (image.sample_bytes() == 1) return in[i];
+          std::uint16_t v = 0;
+          std::memcpy(&v, in + i, 2);
+          return static_cast<std::uint8_t>(v >> 8);
+        };
+        const bool colour = image.channels >= 3;
+        const bool alpha = image.channels == 2 || image.channels == 4;
+        out[0] = sample(0);
+        out[1] = colour ? sample(1) : out[0];
+        out[2] = colour ? sample(2) : out[0];
+        out[3] = alpha ? sample(image.channels - 1) : 255;
+      }
+    }
+    glGenTextures(1, &texture);
+    glBindTexture(GL_TEXTURE_2D, texture);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, image.width, image.height, 0, GL_RGBA,
+                 GL_UNSIGNED_BYTE, rows.data());
+    glGenerateMipmap(GL_TEXTURE_2D);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    check_gl("uploading a texture");
+  } catch (const Error& e) {
+    log(LogLevel::kWarning, std::string("texture not applied: ") + e.what());
+    texture = 0;
+  }
+  textures_.emplace(path, texture);
+  return texture;
 }
 
 GpuMesh& SceneRenderer::soft_mesh_for(const Snapshot::Soft& soft) {
@@ -391,10 +459,18 @@ void SceneRenderer::draw(const Snapshot& s) {
   const GLint u_instance = program.uniform("u_instance");
   const GLint u_segmentation_color = program.uniform("u_segmentation_color");
 
+  const GLint u_textured = program.uniform("u_textured");
   auto draw = [&](const GpuMesh& mesh, const Eigen::Isometry3d& model_view, const Material& m,
-                  int id) {
+                  int id, GLuint texture) {
     if (mesh.index_count == 0) return;  // an anchor without geometry
     glUniform1i(u_instance, id);
+    // The texture colours the shaded pass only; ground truth is the geometry's.
+    const bool textured = texture != 0 && mesh.texcoords != 0;
+    if (u_textured >= 0) glUniform1i(u_textured, textured ? 1 : 0);
+    if (textured) {
+      glActiveTexture(GL_TEXTURE0);
+      glBindTexture(GL_TEXTURE_2D, texture);
+    }
     const Eigen::Matrix4f mv = to_float(model_view.matrix());
     const Eigen::Matrix3f normal = model_view.linear().cast<float>();
     glUniformMatrix4fv(u_model_view, 1, GL_FALSE, mv.data());
@@ -411,12 +487,14 @@ void SceneRenderer::draw(const Snapshot& s) {
   };
   for (const Snapshot::Body& body : s.bodies) {
     // Composed in double, then rounded once, to keep depth exact far from the origin.
-    draw(mesh_for(body.mesh), camera_from_world * body.pose, body.material, body.id);
+    draw(mesh_for(body.mesh), camera_from_world * body.pose, body.material, body.id,
+         (passes & kPassRgb) ? texture_for(body.texture) : 0);
   }
   // Soft bodies: their nodes are in the world frame.
   for (const Snapshot::Soft& soft : s.softs) {
-    draw(soft_mesh_for(soft), camera_from_world, soft.material, soft.id);
+    draw(soft_mesh_for(soft), camera_from_world, soft.material, soft.id, 0);
   }
+  glBindTexture(GL_TEXTURE_2D, 0);
   glBindVertexArray(0);
   // Volumes after the meshes: their rays write depth, so each pixel keeps the nearer surface.
   for (const Snapshot::Volume& v : s.volumes) v.gpu->draw(v, s);
@@ -438,19 +516,21 @@ void SceneRenderer::overlay(const Snapshot& s, GLenum attachment, ShaderOf shade
   const Eigen::Isometry3d camera_from_world = s.camera_pose.inverse();
   std::optional<ShaderOverlay> pass;  // begun at the first mesh whose shader runs
   auto draw = [&](const Material& m, const std::optional<ShaderSpec>& own, GpuMesh& mesh,
-                  const Eigen::Isometry3d& mv, int id) {
+                  const Eigen::Isometry3d& mv, int id, GLuint texture) {
     const ShaderSpec* spec = shader_of(m, own);
     const UserShader* shader = spec != nullptr ? user_shader(*spec, *s.lights) : nullptr;
     if (shader == nullptr) return;
     if (!pass) pass.emplace(s.projection, s.width, s.height, *s.lights, s.time, attachment);
-    pass->draw(*shader, mesh, mv, m, id);
+    pass->draw(*shader, mesh, mv, m, id, texture);
   };
   for (const Snapshot::Body& body : s.bodies) {
-    draw(body.material, body.shader, mesh_for(body.mesh), camera_from_world * body.pose, body.id);
+    // Textures colour the RGB image only, not the segmentation.
+    draw(body.material, body.shader, mesh_for(body.mesh), camera_from_world * body.pose, body.id,
+         attachment == GL_COLOR_ATTACHMENT0 ? texture_for(body.texture) : 0);
   }
   for (const Snapshot::Soft& soft : s.softs) {
     // Its nodes were uploaded by the main pass of this draw.
-    draw(soft.material, soft.shader, soft_meshes_.at(soft.id), camera_from_world, soft.id);
+    draw(soft.material, soft.shader, soft_meshes_.at(soft.id), camera_from_world, soft.id, 0);
   }
 }
 

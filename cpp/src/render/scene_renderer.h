@@ -33,6 +33,7 @@ struct GpuMesh {
   GLuint vao = 0;
   GLuint legacy_vao = 0;  // AMBF's attribute layout, made when a legacy shader first draws it
   GLuint buffers[3] = {0, 0, 0};  // positions, normals, indices
+  GLuint texcoords = 0;           // u, v per vertex; 0 when the mesh has none
   GLsizei index_count = 0;
   int position_size = 3;
   std::shared_ptr<const MeshData> source;  // kept alive, so its address is never reused
@@ -59,6 +60,7 @@ struct Snapshot {
     Material material;
     std::optional<ShaderSpec> shader;  // the effective user shader, if any
     int id = 0;
+    std::string texture;  // the diffuse texture's file, "" for none
   };
   struct Soft {
     int id = 0;
@@ -143,6 +145,9 @@ class SceneRenderer : public Renderer {
   /// The soft body's GPU mesh, its vertices refreshed from the snapshot (normals recomputed).
   GpuMesh& soft_mesh_for(const Snapshot::Soft& soft);
   RenderTarget& target_for(const Snapshot& snapshot);
+  /// The GL texture of an image file (read on first use, kept for the renderer's life); 0 when
+  /// the body has none or the file cannot be read (logged once).
+  GLuint texture_for(const std::string& path);
   /// Colours, into one attachment over the main pass, the meshes shader_of gives a user's
   /// shader for (nullptr: keep the engine's colours).
   template <typename ShaderOf>
@@ -153,6 +158,7 @@ class SceneRenderer : public Renderer {
   std::map<int, GpuMesh> soft_meshes_;         // by soft body id; vertices change every frame
   std::vector<float> soft_scratch_;            // positions then normals of one soft body
   std::map<int, RenderTarget> targets_;        // by camera id
+  std::map<std::string, GLuint> textures_;     // by image file
   mutable std::mutex volumes_mutex_;  // volumes_ grows during takes, which may overlap draws
   std::map<int, std::unique_ptr<GpuVolume>> volumes_;  // by volume id
   // Ids of objects that left the world, and whether a mesh may have lost its last body;

@@ -1,10 +1,14 @@
 // JointSpec: the names of its kinds, its checks and its keyword options.
 
 #include <cmath>
+#include <optional>
 #include <string>
+#include <type_traits>
+#include <vector>
 
 #include "ambfplus/errors.h"
 #include "ambfplus/scene/joint.h"
+#include "ambfplus/scene/six_dof.h"
 #include "util/strings.h"
 
 namespace ambfplus {
@@ -118,6 +122,55 @@ const OptionTable<JointController>& joint_controller_options() {
           O{"output", "ControlOutput | str", "effort or velocity",
             [](C& c, V v, K k) { c.output = parse_control_output(v.text(k)); }},
       });
+  return table;
+}
+
+namespace {
+
+// Six values, one per axis of a six dof joint.
+std::vector<OptionValue> six_values(const OptionValue& v, const std::string& key) {
+  const std::vector<OptionValue>& values = v.list(key);
+  if (values.size() != 6) {
+    throw ArgumentError("'" + key + "' needs 6 values (x, y, z translation, then x, y, z " +
+                        "rotation), not " + std::to_string(values.size()));
+  }
+  return values;
+}
+
+template <typename Array>
+auto six_numbers(Array SixDofAxes::*field) {
+  return [field](SixDofAxes& a, const OptionValue& v, const std::string& key) {
+    const std::vector<OptionValue> values = six_values(v, key);
+    for (std::size_t i = 0; i < 6; ++i) {
+      if constexpr (std::is_same_v<Array, std::array<double, 6>>) {
+        (a.*field)[i] = values[i].number(key);
+      } else {
+        (a.*field)[i] =
+            values[i].is_none() ? std::nullopt : std::optional<double>(values[i].number(key));
+      }
+    }
+  };
+}
+
+}  // namespace
+
+const OptionTable<SixDofAxes>& six_dof_options() {
+  using O = OptionTable<SixDofAxes>::Option;
+  using Limits = std::array<std::optional<double>, 6>;
+  using Values = std::array<double, 6>;
+  static const OptionTable<SixDofAxes> table(
+      "six_dof", {
+                     O{"lower", "list[float | None]", "lower limits, m or rad (None: free)",
+                       six_numbers<Limits>(&SixDofAxes::lower)},
+                     O{"upper", "list[float | None]", "upper limits, m or rad (None: free)",
+                       six_numbers<Limits>(&SixDofAxes::upper)},
+                     O{"stiffness", "list[float]", "springs' stiffness, N/m or N m/rad",
+                       six_numbers<Values>(&SixDofAxes::stiffness)},
+                     O{"damping", "list[float]", "springs' damping, N s/m or N m s/rad",
+                       six_numbers<Values>(&SixDofAxes::damping)},
+                     O{"equilibrium", "list[float]", "springs' rest positions, m or rad",
+                       six_numbers<Values>(&SixDofAxes::equilibrium)},
+                 });
   return table;
 }
 

@@ -169,6 +169,9 @@ void World::remove_model(Model& model) {
                                [&](const auto& m) { return m.get() == &model; });
   if (it == models_.end()) throw ArgumentError("the model is not in this world");
   plugins_->close_model(model);
+  deferred_.erase(std::remove_if(deferred_.begin(), deferred_.end(),
+                                 [&](const DeferredLink& l) { return l.model == &model; }),
+                  deferred_.end());
   // Newest first (joints go before the bodies they hold), each heard of by the systems in the
   // reverse of the order they took it in, while it is whole.
   for (auto o = model.owned_.rbegin(); o != model.owned_.rend(); ++o) {
@@ -181,6 +184,39 @@ void World::remove_model(Model& model) {
   }
   while (!model.owned_.empty()) model.owned_.pop_back();
   models_.erase(it);
+}
+
+void World::defer_link(DeferredLink link) {
+  if (!link.resolve) throw ArgumentError("a deferred link needs a resolve function");
+  deferred_.push_back(std::move(link));
+}
+
+int World::resolve_deferred_links() {
+  int resolved = 0;
+  std::exception_ptr first_error;
+  // A link resolved may be the parent another one waits for: go round until nothing changes.
+  for (bool progress = true; progress && !deferred_.empty();) {
+    progress = false;
+    std::vector<DeferredLink> waiting;
+    waiting.swap(deferred_);
+    for (DeferredLink& link : waiting) {
+      bool done = false;
+      try {
+        done = link.resolve(*this);
+      } catch (...) {
+        if (!first_error) first_error = std::current_exception();
+        done = true;
+      }
+      if (done) {
+        ++resolved;
+        progress = true;
+      } else {
+        deferred_.push_back(std::move(link));
+      }
+    }
+  }
+  if (first_error) std::rethrow_exception(first_error);
+  return resolved;
 }
 
 int World::claim_name(const std::string& name, const char* what) {

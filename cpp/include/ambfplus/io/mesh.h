@@ -18,6 +18,12 @@ struct AMBFPLUS_API MeshData {
   /// 3 indices per triangle.
   std::vector<std::uint32_t> indices;
   int position_size = 3;
+  /// 2 floats per vertex (u, v; v = 0 at the image's bottom row, as OBJ writes them), or empty
+  /// when the file has none.
+  std::vector<float> texcoords;
+  /// The diffuse texture its material names (an MTL's map_Kd), an absolute path; "" for none.
+  /// A file whose meshes name several keeps the first.
+  std::string texture;
 
   std::size_t vertex_count() const { return positions.size() / position_size; }
   std::size_t triangle_count() const { return indices.size() / 3; }

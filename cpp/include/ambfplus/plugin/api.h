@@ -95,7 +95,8 @@ AMBFPLUS_API AmbfplusId ambfplus_world_find(const AmbfplusWorld* world, const ch
  * of a name): writes up to capacity ids and returns how many match. */
 AMBFPLUS_API int ambfplus_world_lookup(const AmbfplusWorld* world, const char* query, int kind,
                                        AmbfplusId* ids, int capacity);
-/** Creates an object of kind "body" or "drill" named name in the model named model (NULL: the
+/** Creates an object of kind "body", "ghost" (a ghost object: a body's options, no collision
+ * response, overlaps reported) or "drill" named name in the model named model (NULL: the
  * world's own; a new model of that name when there is none), from options with the keyword
  * names of ambfplus's Python add_body / add_drill (a drill's "volume" is a volume's name).
  * Returns its id. */
@@ -129,6 +130,15 @@ AMBFPLUS_API int ambfplus_object_set(AmbfplusWorld* world, AmbfplusId object, co
  * anything else rides on its parent after every step. Parent 0 detaches. */
 AMBFPLUS_API int ambfplus_object_attach(AmbfplusWorld* world, AmbfplusId object, AmbfplusId parent,
                                         const double local[16]);
+
+/* ---- Ghost objects ------------------------------------------------------------------------ */
+
+/** The bodies overlapping a ghost object after the last step (Bullet's narrow phase), in
+ * creation order: writes up to capacity ids and returns how many there are (-1 when ghost is
+ * not a ghost object). Added in ABI 2 without changing it: a plugin that calls it needs an
+ * engine that has it. */
+AMBFPLUS_API int ambfplus_ghost_overlaps(const AmbfplusWorld* world, AmbfplusId ghost,
+                                         AmbfplusId* ids, int capacity);
 
 /* ---- Volumes ------------------------------------------------------------------------------ */
 

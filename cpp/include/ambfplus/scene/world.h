@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include <functional>
+
 #include <Eigen/Core>
 
 #include "ambfplus/export.h"
@@ -31,6 +33,17 @@ namespace scene {
 class Attachments;
 class StepLogger;
 }  // namespace scene
+
+/// Something a loader could not finish because an object it names is not in the world yet:
+/// AMBF attaches a child to a parent declared in any file, loaded before or after it.
+struct AMBFPLUS_API DeferredLink {
+  Model* model = nullptr;   ///< the model the link belongs to; dropped if it is removed
+  std::string file;         ///< the file that declared it
+  std::string description;  ///< the warning if it never resolves: what waits for what
+  /// Tries again: true once done (the link is then forgotten); false while what it names is
+  /// still missing. It may throw (the link is then forgotten and the error passed on).
+  std::function<bool(World&)> resolve;
+};
 
 /// The scene: models and their objects, the simulation clock, and the systems that step them.
 ///
@@ -72,6 +85,15 @@ class AMBFPLUS_API World {
   void remove_model(Model& model);
   /// All objects in creation order.
   std::vector<Object*> objects() const;
+
+  /// Keeps a link to finish when what it names appears (resolve_deferred_links).
+  void defer_link(DeferredLink link);
+  /// Tries every waiting link, in the order they were deferred, until a pass resolves none;
+  /// returns how many were resolved. A link that throws is dropped and the first error
+  /// rethrown after the others were tried.
+  int resolve_deferred_links();
+  /// The links still waiting.
+  const std::vector<DeferredLink>& deferred_links() const { return deferred_; }
   template <typename T>
   std::vector<T*> objects_of_kind() const;
 
@@ -170,6 +192,7 @@ class AMBFPLUS_API World {
   std::vector<std::unique_ptr<Model>> models_;
   std::map<std::string, Object*> by_name_;
   std::vector<Object*> objects_;
+  std::vector<DeferredLink> deferred_;
   std::int64_t graphics_step_ = -1;  // the step of the last graphics update
   std::optional<ShaderSpec> shader_;
   mutable StateMutex state_mutex_;

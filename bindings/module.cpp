@@ -29,14 +29,26 @@ PYBIND11_MODULE(_core, m) {
   m.doc() = "ambfplus engine bindings (use the ambfplus package, not this module)";
   m.attr("__version__") = ambfplus::version();
 
-  ambfplus::bindings::register_errors(m);
-  ambfplus::bindings::register_io(m);
-  ambfplus::bindings::register_render(m);
-  ambfplus::bindings::register_capture(m);
-  ambfplus::bindings::register_volume(m);
-  ambfplus::bindings::register_scene(m);
-  ambfplus::bindings::register_adf(m);
-  ambfplus::bindings::register_plugin(m);
+  namespace b = ambfplus::bindings;
+  b::register_errors(m);
+  // Every class and enum first, so that every signature below names Python types.
+  b::declare_io(m);
+  b::declare_render(m);
+  b::declare_capture(m);
+  b::declare_volume(m);
+  b::declare_scene(m);
+  b::declare_physics(m);
+  b::declare_haptics(m);
+  b::declare_adf(m);
+  b::define_io(m);
+  b::define_render(m);
+  b::define_capture(m);
+  b::define_volume(m);
+  b::define_scene(m);
+  b::define_physics(m);
+  b::define_haptics(m);
+  b::define_adf(m);
+  b::register_plugin(m);
 
   // Info and above go to Python, whose logging decides what to show (debug only on request, by
   // AMBFPLUS_LOG_LEVEL=debug, since every message takes the GIL).

@@ -1,3 +1,6 @@
+// ambfplus/capture: Frame (its images as views with the frame as owner), the pass table and
+// Camera.capture.
+
 #include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -5,13 +8,13 @@
 #include <time.h>
 
 #include <chrono>
-#include <filesystem>
 #include <sstream>
 #include <vector>
 
 #include "ambfplus/capture/capture.h"
 #include "ambfplus/capture/frame.h"
 #include "ambfplus/capture/points.h"
+#include "ambfplus/errors.h"
 #include "ambfplus/scene/camera.h"
 #include "ambfplus/scene/world.h"
 #include "bindings.h"
@@ -41,7 +44,7 @@ template <typename T>
 T* checked_output(const py::handle& value, const char* key,
                   std::initializer_list<py::ssize_t> shape) {
   if (!py::isinstance<py::array>(value)) {
-    throw py::type_error(std::string("out['") + key + "'] must be a NumPy array");
+    throw ArgumentTypeError(std::string("out['") + key + "'] must be a NumPy array");
   }
   auto array = py::reinterpret_borrow<py::array>(value);
   std::ostringstream want;
@@ -59,12 +62,12 @@ T* checked_output(const py::handle& value, const char* key,
   }
   const bool contiguous = (array.flags() & py::array::c_style) != 0;
   if (!dtype_ok || !shape_ok || !contiguous || !array.writeable()) {
-    throw py::value_error(std::string("out['") + key + "'] must be a writable C-contiguous " +
-                          py::str(py::dtype::of<T>()).cast<std::string>() + " array of shape " +
-                          want.str() + ", got " + py::str(array.dtype()).cast<std::string>() + " " +
-                          py::str(array.attr("shape")).cast<std::string>() +
-                          (contiguous ? "" : " (not C-contiguous)") +
-                          (array.writeable() ? "" : " (read-only)"));
+    throw ArgumentError(std::string("out['") + key + "'] must be a writable C-contiguous " +
+                        py::str(py::dtype::of<T>()).cast<std::string>() + " array of shape " +
+                        want.str() + ", got " + py::str(array.dtype()).cast<std::string>() + " " +
+                        py::str(array.attr("shape")).cast<std::string>() +
+                        (contiguous ? "" : " (not C-contiguous)") +
+                        (array.writeable() ? "" : " (read-only)"));
   }
   return static_cast<T*>(array.mutable_data());
 }
@@ -80,11 +83,11 @@ double process_cpu_seconds() {
 
 unsigned parse_passes(const py::handle& names) {
   if (py::isinstance<py::str>(names)) {
-    throw py::type_error("passes must be a list of names, e.g. ['rgb', 'depth']");
+    throw ArgumentTypeError("passes must be a list of names, e.g. ['rgb', 'depth']");
   }
   unsigned passes = 0;
   for (const py::handle& n : names) passes |= parse_pass(py::str(n));
-  if (passes == 0) throw py::value_error("passes must name at least one image");
+  if (passes == 0) throw ArgumentError("passes must name at least one image");
   return passes;
 }
 
@@ -94,33 +97,6 @@ py::list pass_names(unsigned passes) {
     if (passes & p.bit) out.append(p.name);
   }
   return out;
-}
-
-std::optional<ShaderSpec> to_shader(const py::handle& value, const char* what) {
-  if (value.is_none()) return std::nullopt;
-  if (py::isinstance<py::str>(value) && value.cast<std::string>() == "builtin") {
-    return ShaderSpec{};
-  }
-  const std::string expected = std::string(what) +
-                               " must be None, 'builtin' or a pair of file paths (vertex, "
-                               "fragment)";
-  if (py::isinstance<py::str>(value) || !py::isinstance<py::sequence>(value) ||
-      py::len(value) != 2) {
-    throw py::type_error(expected);
-  }
-  auto path = [&](const py::handle& p) {
-    const std::string s = py::str(py::module_::import("os").attr("fspath")(p));
-    if (s.empty()) throw py::value_error(expected);
-    return std::filesystem::absolute(s).lexically_normal().string();
-  };
-  auto pair = py::reinterpret_borrow<py::sequence>(value);
-  return ShaderSpec{path(pair[0]), path(pair[1])};
-}
-
-py::object from_shader(const std::optional<ShaderSpec>& shader) {
-  if (!shader) return py::none();
-  if (shader->builtin()) return py::str("builtin");
-  return py::make_tuple(shader->vertex, shader->fragment);
 }
 
 namespace {
@@ -134,11 +110,11 @@ PoseRequest pose_request(const py::object& poses) {
     return request;
   }
   if (py::isinstance<py::str>(poses)) {
-    throw py::type_error("poses must be True, None or a list of object names, e.g. ['drill']");
+    throw ArgumentTypeError("poses must be True, None or a list of object names, e.g. ['drill']");
   }
   for (const py::handle& n : poses) request.names.push_back(py::str(n));
   if (request.names.empty()) {
-    throw py::value_error("poses names no object: give True for every object, or None");
+    throw ArgumentError("poses names no object: give True for every object, or None");
   }
   return request;
 }
@@ -158,7 +134,7 @@ py::object capture(Camera& camera, py::object out, py::object passes, py::object
     return py::cast(frame);
   }
   if (!passes.is_none()) {
-    throw py::value_error("passes goes with a new frame; out's buffers already decide them");
+    throw ArgumentError("passes goes with a new frame; out's buffers already decide them");
   }
   if (py::isinstance<Frame>(out)) {
     Frame& frame = out.cast<Frame&>();
@@ -198,8 +174,8 @@ py::object capture(Camera& camera, py::object out, py::object passes, py::object
         targets.points = checked_output<float>(item.second, "points", {h, w, 3});
         frame->points.attach(targets.points, hi, wi, 3);
       } else {
-        throw py::value_error("out has an unknown key '" + key + "': expected one of " +
-                              ambfplus::pass_names(kAllPasses));
+        throw ArgumentError("out has an unknown key '" + key + "': expected one of " +
+                            ambfplus::pass_names(kAllPasses));
       }
     }
     py::object result = py::cast(frame);
@@ -211,13 +187,17 @@ py::object capture(Camera& camera, py::object out, py::object passes, py::object
     }
     return result;
   }
-  throw py::type_error(
+  throw ArgumentTypeError(
       "out must be None, a Frame, or a dict of arrays {'rgb': ..., 'depth': ..., 'label': ...}");
 }
 
-void register_capture(py::module_& m) {
+void declare_capture(py::module_& m) {
   py::class_<Frame, std::shared_ptr<Frame>>(m, "Frame", py::dynamic_attr(),
-                                            "One capture of a camera: images, time and geometry.")
+                                            "One capture of a camera: images, time and geometry.");
+}
+
+void define_capture(py::module_& m) {
+  bound<Frame, std::shared_ptr<Frame>>(m, "Frame")
       .def_property_readonly(
           "rgb", [](py::object self) { return view(self, self.cast<Frame&>().rgb, false); },
           "uint8 (H, W, 3) RGB view of the frame's colour image (row 0 at the top), or None")

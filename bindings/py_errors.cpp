@@ -5,6 +5,9 @@
 //   ambfplus.RenderError    (Error, RuntimeError)
 //   ambfplus.PluginError    (Error, RuntimeError)
 //   ambfplus.ArgumentError  (Error, ValueError)        a value a caller gave cannot be used
+//   ambfplus.ArgumentTypeError (ArgumentError, TypeError) a value of the wrong type, or a keyword
+//                                                      option that does not exist
+//   ambfplus.NotFound       (Error, KeyError)          a name or key that names nothing
 //   ambfplus.OutOfRange     (Error, IndexError)        an index outside what it indexes
 //   ambfplus.StateError     (Error, RuntimeError)      a call that does not fit the state
 //   ambfplus.ResourceError  (Error, OSError)           a socket, port or device file
@@ -21,9 +24,9 @@
 namespace ambfplus::bindings {
 namespace {
 
-PyObject* make_exception(pybind11::module_& m, const char* name, PyObject* bases) {
+PyObject* make_exception(pybind11::module_& m, const char* name, PyObject* bases, const char* doc) {
   const std::string qualified = std::string("ambfplus.") + name;
-  PyObject* type = PyErr_NewException(qualified.c_str(), bases, nullptr);
+  PyObject* type = PyErr_NewExceptionWithDoc(qualified.c_str(), doc, bases, nullptr);
   if (type == nullptr) throw pybind11::error_already_set();
   m.add_object(name, pybind11::handle(type));
   return type;
@@ -35,6 +38,8 @@ PyObject* g_asset_not_found = nullptr;
 PyObject* g_render_error = nullptr;
 PyObject* g_plugin_error = nullptr;
 PyObject* g_argument_error = nullptr;
+PyObject* g_argument_type_error = nullptr;
+PyObject* g_not_found = nullptr;
 PyObject* g_out_of_range = nullptr;
 PyObject* g_state_error = nullptr;
 PyObject* g_resource_error = nullptr;
@@ -62,19 +67,32 @@ void raise_with(PyObject* type, const std::string& message, const char* filename
 PyObject* plugin_error_type() { return g_plugin_error; }
 
 void register_errors(pybind11::module_& m) {
-  g_error = make_exception(m, "Error", PyExc_Exception);
+  g_error = make_exception(m, "Error", PyExc_Exception, "Every error the engine raises.");
   auto pair = [](PyObject* a, PyObject* b) {
     return pybind11::make_tuple(pybind11::handle(a), pybind11::handle(b));
   };
-  g_config_error = make_exception(m, "ConfigError", pair(g_error, PyExc_ValueError).ptr());
+  g_config_error = make_exception(m, "ConfigError", pair(g_error, PyExc_ValueError).ptr(),
+                                  "A bad scene or data file; .filename names it.");
   g_asset_not_found =
-      make_exception(m, "AssetNotFound", pair(g_error, PyExc_FileNotFoundError).ptr());
-  g_render_error = make_exception(m, "RenderError", pair(g_error, PyExc_RuntimeError).ptr());
-  g_plugin_error = make_exception(m, "PluginError", pair(g_error, PyExc_RuntimeError).ptr());
-  g_argument_error = make_exception(m, "ArgumentError", pair(g_error, PyExc_ValueError).ptr());
-  g_out_of_range = make_exception(m, "OutOfRange", pair(g_error, PyExc_IndexError).ptr());
-  g_state_error = make_exception(m, "StateError", pair(g_error, PyExc_RuntimeError).ptr());
-  g_resource_error = make_exception(m, "ResourceError", pair(g_error, PyExc_OSError).ptr());
+      make_exception(m, "AssetNotFound", pair(g_error, PyExc_FileNotFoundError).ptr(),
+                     "A missing file; .filename names it, .tried lists every place looked.");
+  g_render_error = make_exception(m, "RenderError", pair(g_error, PyExc_RuntimeError).ptr(),
+                                  "Rendering failed or cannot start (what is missing is named).");
+  g_plugin_error = make_exception(m, "PluginError", pair(g_error, PyExc_RuntimeError).ptr(),
+                                  "A plugin failed to load or to run.");
+  g_argument_error = make_exception(m, "ArgumentError", pair(g_error, PyExc_ValueError).ptr(),
+                                    "A value a caller gave cannot be used.");
+  g_argument_type_error =
+      make_exception(m, "ArgumentTypeError", pair(g_argument_error, PyExc_TypeError).ptr(),
+                     "A value of the wrong type, or a keyword option that does not exist.");
+  g_not_found = make_exception(m, "NotFound", pair(g_error, PyExc_KeyError).ptr(),
+                               "A name or key that names nothing where it was looked up.");
+  g_out_of_range = make_exception(m, "OutOfRange", pair(g_error, PyExc_IndexError).ptr(),
+                                  "An index outside what it indexes.");
+  g_state_error = make_exception(m, "StateError", pair(g_error, PyExc_RuntimeError).ptr(),
+                                 "A call that does not fit the object's state.");
+  g_resource_error = make_exception(m, "ResourceError", pair(g_error, PyExc_OSError).ptr(),
+                                    "A socket, port or device file that cannot be used.");
 
   pybind11::register_exception_translator([](std::exception_ptr p) {
     try {
@@ -89,8 +107,12 @@ void register_errors(pybind11::module_& m) {
       raise_with(g_render_error, e.what());
     } catch (const PluginError& e) {
       raise_with(g_plugin_error, e.what());
+    } catch (const ArgumentTypeError& e) {
+      raise_with(g_argument_type_error, e.what());
     } catch (const ArgumentError& e) {
       raise_with(g_argument_error, e.what());
+    } catch (const NotFound& e) {
+      raise_with(g_not_found, e.what());
     } catch (const OutOfRange& e) {
       raise_with(g_out_of_range, e.what());
     } catch (const StateError& e) {

@@ -1,6 +1,9 @@
+// ambfplus/io: images.
+
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include "ambfplus/errors.h"
 #include "ambfplus/io/image.h"
 #include "bindings.h"
 
@@ -12,8 +15,8 @@ namespace {
 template <typename T>
 void write(const std::string& path, py::array_t<T, py::array::c_style> a, PixelType type) {
   if (a.ndim() != 2 && a.ndim() != 3) {
-    throw py::value_error("write_image: expected an (H, W) or (H, W, C) array, got " +
-                          std::to_string(a.ndim()) + " dimensions");
+    throw ArgumentError("write_image: expected an (H, W) or (H, W, C) array, got " +
+                        std::to_string(a.ndim()) + " dimensions");
   }
   const int h = static_cast<int>(a.shape(0)), w = static_cast<int>(a.shape(1));
   const int c = a.ndim() == 3 ? static_cast<int>(a.shape(2)) : 1;
@@ -24,7 +27,9 @@ void write(const std::string& path, py::array_t<T, py::array::c_style> a, PixelT
 
 }  // namespace
 
-void register_io(py::module_& m) {
+void declare_io(py::module_&) {}
+
+void define_io(py::module_& m) {
   m.def(
       "write_image",
       [](const std::string& path, py::array array) {
@@ -33,8 +38,8 @@ void register_io(py::module_& m) {
         } else if (array.dtype().is(py::dtype::of<std::uint16_t>())) {
           write<std::uint16_t>(path, array, PixelType::kUInt16);
         } else {
-          throw py::type_error("write_image: expected a uint8 or uint16 array, got " +
-                               py::str(array.dtype()).cast<std::string>());
+          throw ArgumentTypeError("write_image: expected a uint8 or uint16 array, got " +
+                                  py::str(array.dtype()).cast<std::string>());
         }
       },
       py::arg("path"), py::arg("image"),

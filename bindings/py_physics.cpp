@@ -1,16 +1,27 @@
+// The physical objects of ambfplus/scene: RigidBody, Joint, SoftBody, ProximitySensor and
+// ConstraintActuator, with the kinds they take (ShapeKind, Axis, MeshCollision, JointType,
+// ControlOutput, ActuatorHold). Every method of these classes is here.
+
 #include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
 #include <optional>
+#include <string>
+#include <vector>
 
+#include "ambfplus/scene/constraint_actuator.h"
 #include "ambfplus/scene/ghost.h"
 #include "ambfplus/scene/joint.h"
 #include "ambfplus/scene/model.h"
+#include "ambfplus/scene/proximity_sensor.h"
 #include "ambfplus/scene/rigid_body.h"
 #include "ambfplus/scene/simulator.h"
 #include "ambfplus/scene/six_dof.h"
+#include "ambfplus/scene/soft_body.h"
 #include "bindings.h"
+#include "enums.h"
 
 namespace py = pybind11;
 
@@ -20,189 +31,137 @@ namespace {
 using Vec3 = Eigen::Vector3d;
 using Mat4 = Eigen::Matrix4d;
 
-int parse_axis(const py::handle& v) {
-  if (py::isinstance<py::str>(v)) {
-    const std::string a = v.cast<std::string>();
-    if (a == "x") return 0;
-    if (a == "y") return 1;
-    if (a == "z") return 2;
-    throw py::value_error("axis must be 'x', 'y' or 'z', got '" + a + "'");
-  }
-  return v.cast<int>();
-}
-
-ControlOutput parse_output(const std::string& s) {
-  if (s == "effort" || s == "force") return ControlOutput::kEffort;
-  if (s == "velocity") return ControlOutput::kVelocity;
-  throw py::value_error("controller output must be 'effort' or 'velocity', got '" + s + "'");
-}
-
-// Updates `c` with the keys given.
-JointController parse_controller(const py::dict& d, JointController c) {
-  for (auto item : d) {
-    const std::string key = py::str(item.first);
-    if (key == "p") {
-      c.p = item.second.cast<double>();
-    } else if (key == "i") {
-      c.i = item.second.cast<double>();
-    } else if (key == "d") {
-      c.d = item.second.cast<double>();
-    } else if (key == "output") {
-      c.output = parse_output(item.second.cast<std::string>());
-    } else {
-      throw py::value_error("controller keys are p, i, d and output, got '" + key + "'");
-    }
-  }
-  return c;
-}
+using BodyClass = py::class_<RigidBody, Object, std::shared_ptr<RigidBody>>;
+using JointClass = py::class_<Joint, Object, std::shared_ptr<Joint>>;
+using SoftClass = py::class_<SoftBody, Object, std::shared_ptr<SoftBody>>;
+using SensorClass = py::class_<ProximitySensor, Object, std::shared_ptr<ProximitySensor>>;
+using ActuatorClass = py::class_<ConstraintActuator, Object, std::shared_ptr<ConstraintActuator>>;
 
 py::dict controller_dict(const JointController& c) {
   py::dict d;
   d["p"] = c.p;
   d["i"] = c.i;
   d["d"] = c.d;
-  d["output"] = c.output == ControlOutput::kEffort ? "effort" : "velocity";
+  d["output"] = control_output_name(c.output);
   return d;
 }
 
-// A compound part: {"shape": "box", "size": ..., "radius": ..., "height": ..., "axis": ...,
-// "pose": 4x4}.
-std::pair<Shape, Mat4> parse_part(const py::dict& d) {
-  Shape s;
-  Mat4 pose = Mat4::Identity();
-  for (auto item : d) {
-    const std::string key = py::str(item.first);
-    if (key == "shape") {
-      s.kind = parse_shape_kind(item.second.cast<std::string>());
-    } else if (key == "size") {
-      s.size = item.second.cast<Vec3>();
-    } else if (key == "radius") {
-      s.radius = item.second.cast<double>();
-    } else if (key == "height") {
-      s.height = item.second.cast<double>();
-    } else if (key == "axis") {
-      s.axis = parse_axis(item.second);
-    } else if (key == "pose") {
-      pose = item.second.cast<Mat4>();
-    } else {
-      throw py::value_error(
-          "compound parts take shape, size, radius, height, axis and pose, got '" + key + "'");
-    }
-  }
-  return {s, pose};
+// A read-only (rows, 3) NumPy view of `data`, kept alive by `owner`.
+template <typename T>
+py::array rows_view(py::object owner, const T* data, std::size_t rows) {
+  const auto s = static_cast<py::ssize_t>(sizeof(T));
+  return readonly(py::array(py::dtype::of<T>(), {static_cast<py::ssize_t>(rows), py::ssize_t(3)},
+                            {3 * s, s}, data, owner));
 }
 
-}  // namespace
-
-void apply_body_options(RigidBodySpec& spec, const py::kwargs& kw) {
-  Dynamics& d = spec.dynamics;
-  Collision& c = spec.collision;
-  for (auto item : kw) {
-    const std::string key = py::str(item.first);
-    const py::handle v = item.second;
-    if (key == "inertia") {
-      d.inertia = v.cast<Vec3>();
-    } else if (key == "inertial_offset") {
-      d.inertial_offset = v.cast<Mat4>();
-    } else if (key == "friction") {
-      d.static_friction = v.cast<double>();
-    } else if (key == "rolling_friction") {
-      d.rolling_friction = v.cast<double>();
-    } else if (key == "restitution") {
-      d.restitution = v.cast<double>();
-    } else if (key == "linear_damping") {
-      d.linear_damping = v.cast<double>();
-    } else if (key == "angular_damping") {
-      d.angular_damping = v.cast<double>();
-    } else if (key == "kinematic") {
-      d.kinematic = v.cast<bool>();
-    } else if (key == "collision") {
-      c.enabled = v.cast<bool>();
-    } else if (key == "collision_mesh") {
-      c.mesh = v.cast<std::string>();
-    } else if (key == "collision_type") {
-      c.mesh_type = parse_mesh_collision(v.cast<std::string>());
-    } else if (key == "collision_shapes") {
-      for (const py::handle part : v) c.shapes.push_back(parse_part(part.cast<py::dict>()));
-    } else if (key == "margin") {
-      c.margin = v.cast<double>();
-    } else if (key == "groups") {
-      for (int g : v.cast<std::vector<int>>()) {
-        if (g < 0 || g > 31) throw py::value_error("collision groups are 0..31");
-        c.groups |= 1u << g;
-      }
-    } else if (key == "axis") {
-      spec.shape.axis = parse_axis(v);
-    } else {
-      throw py::type_error("add_body() got an unexpected keyword argument '" + key + "'");
-    }
-  }
+py::array_t<double> rows_copy(const std::vector<double>& xyz) {
+  py::array_t<double> out({static_cast<py::ssize_t>(xyz.size() / 3), py::ssize_t(3)});
+  std::copy(xyz.begin(), xyz.end(), out.mutable_data());
+  return out;
 }
 
-Joint& add_joint(Model& model, const std::string& name, RigidBody& parent, RigidBody& child,
-                 const std::string& type, const py::kwargs& kw) {
-  JointSpec spec;
-  spec.name = name;
-  spec.parent = &parent;
-  spec.child = &child;
-  spec.type = parse_joint_type(type);
-  bool continuous = type == "continuous";
-  for (auto item : kw) {
-    const std::string key = py::str(item.first);
-    const py::handle v = item.second;
-    if (key == "parent_pivot") {
-      spec.parent_pivot = v.cast<Vec3>();
-    } else if (key == "parent_axis") {
-      spec.parent_axis = v.cast<Vec3>();
-    } else if (key == "child_pivot") {
-      spec.child_pivot = v.cast<Vec3>();
-    } else if (key == "child_axis") {
-      spec.child_axis = v.cast<Vec3>();
-    } else if (key == "offset") {
-      spec.offset = v.cast<double>();
-    } else if (key == "child_offset") {
-      spec.child_offset = v.cast<double>();
-    } else if (key == "lower") {
-      if (!v.is_none()) spec.lower = v.cast<double>();
-    } else if (key == "upper") {
-      if (!v.is_none()) spec.upper = v.cast<double>();
-    } else if (key == "damping") {
-      spec.damping = v.cast<double>();
-    } else if (key == "stiffness") {
-      spec.stiffness = v.cast<double>();
-    } else if (key == "equilibrium") {
-      spec.equilibrium = v.cast<double>();
-    } else if (key == "max_motor_impulse") {
-      spec.max_motor_impulse = v.cast<double>();
-    } else if (key == "erp") {
-      spec.erp = v.cast<double>();
-    } else if (key == "cfm") {
-      spec.cfm = v.cast<double>();
-    } else if (key == "controller") {
-      if (!v.is_none()) {
-        // A declared controller drives efforts unless told otherwise, as in AMBF.
-        JointController declared;
-        declared.output = ControlOutput::kEffort;
-        spec.controller = parse_controller(v.cast<py::dict>(), declared);
-      }
-    } else if (key == "passive") {
-      spec.passive = v.cast<bool>();
-    } else if (key == "ignore_inter_collision") {
-      spec.ignore_inter_collision = v.cast<bool>();
-    } else {
-      throw py::type_error("add_joint() got an unexpected keyword argument '" + key + "'");
+// A node index list: ints in range (OutOfRange otherwise).
+std::vector<int> node_list(const SoftBody& s, const std::vector<int>& nodes) {
+  const int count = static_cast<int>(s.node_count());
+  for (int n : nodes) {
+    if (n < 0 || n >= count) {
+      throw OutOfRange("soft body '" + s.name() + "' has nodes 0.." + std::to_string(count - 1) +
+                       ", not " + std::to_string(n));
     }
   }
-  if (continuous && (spec.lower || spec.upper)) {
-    throw py::value_error("joint '" + name + "': a continuous joint has no limits");
-  }
-  return model.add_joint(spec);
+  return nodes;
 }
 
-void register_physics(py::module_& m,
-                      py::class_<RigidBody, Object, std::shared_ptr<RigidBody>>& body,
-                      py::class_<Joint, Object, std::shared_ptr<Joint>>& joint) {
-  body.def_property_readonly("dynamic", &RigidBody::is_dynamic,
+// Each ray's start or end, (N, 3), world frame.
+py::array_t<double> ray_points(const ProximitySensor& s,
+                               Vec3 (ProximitySensor::*point)(int) const) {
+  std::vector<double> xyz;
+  for (int i = 0; i < static_cast<int>(s.ray_count()); ++i) {
+    const Vec3 p = (s.*point)(i);
+    xyz.insert(xyz.end(), {p.x(), p.y(), p.z()});
+  }
+  return rows_copy(xyz);
+}
+
+py::dict config_dict(const SoftBodyConfig& c) {
+  py::dict d;
+  d["kLST"] = c.linear_stiffness;
+  d["kAST"] = c.area_stiffness;
+  d["kVST"] = c.volume_stiffness;
+  d["kVCF"] = c.velocity_correction;
+  d["kDP"] = c.damping;
+  d["kDG"] = c.drag;
+  d["kLF"] = c.lift;
+  d["kPR"] = c.pressure;
+  d["kVC"] = c.volume_conservation;
+  d["kDF"] = c.dynamic_friction;
+  d["kMT"] = c.pose_matching ? py::cast(*c.pose_matching) : py::none();
+  d["kCHR"] = c.rigid_hardness;
+  d["kKHR"] = c.kinetic_hardness;
+  d["kSHR"] = c.soft_hardness;
+  d["kAHR"] = c.anchor_hardness;
+  d["kSRHR_CL"] = c.cluster_rigid_hardness;
+  d["kSKHR_CL"] = c.cluster_kinetic_hardness;
+  d["kSSHR_CL"] = c.cluster_soft_hardness;
+  d["kSR_SPLT_CL"] = c.cluster_rigid_impulse_split;
+  d["kSK_SPLT_CL"] = c.cluster_kinetic_impulse_split;
+  d["kSS_SPLT_CL"] = c.cluster_soft_impulse_split;
+  d["maxvolume"] = c.max_volume;
+  d["timescale"] = c.time_scale;
+  d["viterations"] = c.velocity_iterations;
+  d["piterations"] = c.position_iterations;
+  d["diterations"] = c.drift_iterations;
+  d["citerations"] = c.cluster_iterations;
+  d["flags"] = c.collision_flags;
+  d["bending constraint"] = c.bending_constraint ? py::cast(*c.bending_constraint) : py::none();
+  d["clusters"] = c.clusters ? py::cast(*c.clusters) : py::none();
+  d["fixed nodes"] = c.fixed_nodes;
+  return d;
+}
+
+py::object hit_object(const SensorHit& h) {
+  if (h.body != nullptr) return py::cast(handle(h.body));
+  if (h.soft_body != nullptr) return py::cast(handle(h.soft_body));
+  return py::none();
+}
+
+py::dict hit_to_dict(const SensorHit& h) {
+  py::dict d;
+  d["triggered"] = h.triggered;
+  d["distance"] = h.distance;
+  d["fraction"] = h.fraction;
+  d["point"] = Vec3(h.point);
+  d["normal"] = Vec3(h.normal);
+  d["body"] = hit_object(h);
+  d["node"] = h.soft_body_node >= 0 ? py::cast(h.soft_body_node) : py::none();
+  return d;
+}
+
+void define_body(BodyClass& body) {
+  body.def_property_readonly("shape", [](RigidBody& b) { return shape_kind_name(b.shape().kind); })
+      .def_property_readonly("mass", &RigidBody::mass)
+      .def_property_readonly("size", [](RigidBody& b) { return Vec3(b.shape().size); })
+      .def_property_readonly("radius", [](RigidBody& b) { return b.shape().radius; })
+      .def_property_readonly("height", [](RigidBody& b) { return b.shape().height; })
+      .def_property_readonly("mesh", [](RigidBody& b) { return b.shape().mesh; })
+      .def_property(
+          "color", [](RigidBody& b) { return b.material().color; },
+          [](RigidBody& b, const py::object& c) {
+            Material m = b.material();
+            m.color = to_option(c).rgba("color");
+            b.set_material(m);
+          },
+          "RGBA in 0..1")
+      .def_property(
+          "shader", [](RigidBody& b) { return from_shader(b.material().shader); },
+          [](RigidBody& b, const py::object& v) {
+            Material m = b.material();
+            m.shader = to_shader(v, "shader");
+            b.set_material(m);
+          },
+          "the body's own shader (AMBF's body `shaders`): None (its model's), 'builtin' (the "
+          "engine's own), or (vertex_path, fragment_path); it colours the rgb image only")
+      .def_property_readonly("dynamic", &RigidBody::is_dynamic,
                              "moved by physics (mass > 0 and not kinematic)")
       .def_property(
           "kinematic", [](RigidBody& b) { return b.dynamics().kinematic; },
@@ -239,6 +198,28 @@ void register_physics(py::module_& m,
           },
           [](RigidBody& b, std::pair<double, double> d) { b.set_damping(d.first, d.second); },
           "(linear, angular), 0..1")
+      .def_property_readonly(
+          "joints",
+          [](RigidBody& b) {
+            py::list out;
+            for (Joint* j : b.world().descendant_joints(b)) out.append(to_python(j));
+            return out;
+          },
+          "The joints below this body in AMBF's order (every joint reachable from it, creation "
+          "order, passive ones left out): the order of a root body's joint positions.")
+      .def_property_readonly(
+          "collision_mesh", [](RigidBody& b) { return b.collision().mesh; },
+          "the separate collision mesh file, or '' (the visual mesh collides)")
+      .def_property_readonly(
+          "collision_shapes",
+          [](RigidBody& b) {
+            py::list out;
+            for (const auto& [shape, pose] : b.collision().shapes) {
+              out.append(py::make_tuple(shape_kind_name(shape.kind), Mat4(pose)));
+            }
+            return out;
+          },
+          "the primitive collision parts as (shape, 4x4 pose in the body frame)")
       .def_property_readonly("is_ghost", &is_ghost, "a ghost object (World.add_ghost)")
       .def_property_readonly(
           "overlapping",
@@ -249,18 +230,12 @@ void register_physics(py::module_& m,
           },
           "a ghost's overlapping bodies after the last step (Bullet's narrow phase), in "
           "creation order; ValueError for a body that is not a ghost");
+}
 
+void define_joint(JointClass& joint) {
   joint.def_property_readonly("type", [](Joint& j) { return joint_type_name(j.type()); })
-      .def_property_readonly("parent",
-                             [](Joint& j) {
-                               return std::shared_ptr<RigidBody>(
-                                   j.world().simulator().shared_from_this(), &j.parent());
-                             })
-      .def_property_readonly("child",
-                             [](Joint& j) {
-                               return std::shared_ptr<RigidBody>(
-                                   j.world().simulator().shared_from_this(), &j.child());
-                             })
+      .def_property_readonly("parent", [](Joint& j) { return handle(&j.parent(), j.world()); })
+      .def_property_readonly("child", [](Joint& j) { return handle(&j.child(), j.world()); })
       .def_property_readonly("position", &Joint::position,
                              "rad or m; 0 where the parent's and child's joint frames coincide")
       .def_property_readonly("velocity", &Joint::velocity, "rad/s or m/s")
@@ -299,7 +274,9 @@ void register_physics(py::module_& m,
       .def_property(
           "controller", [](Joint& j) { return controller_dict(j.spec().controller); },
           [](Joint& j, const py::dict& d) {
-            j.set_controller(parse_controller(d, j.spec().controller));
+            JointController c = j.spec().controller;
+            joint_controller_options().apply(c, to_options(d));
+            j.set_controller(c);
           },
           "{p, i, d, output}; output 'effort' or 'velocity'; assigning updates the keys given")
       .def_property(
@@ -317,25 +294,7 @@ void register_physics(py::module_& m,
           },
           [](Joint& j, const py::dict& d) {
             SixDofAxes a = six_dof_axes(j).value_or(SixDofAxes{});
-            for (auto item : d) {
-              const std::string key = py::str(item.first);
-              if (key == "lower" || key == "upper") {
-                const auto v = item.second.cast<std::vector<std::optional<double>>>();
-                if (v.size() != 6) throw py::value_error("six_dof: '" + key + "' needs 6 values");
-                auto& out = key == "lower" ? a.lower : a.upper;
-                std::copy(v.begin(), v.end(), out.begin());
-              } else if (key == "stiffness" || key == "damping" || key == "equilibrium") {
-                const auto v = item.second.cast<std::vector<double>>();
-                if (v.size() != 6) throw py::value_error("six_dof: '" + key + "' needs 6 values");
-                auto& out = key == "stiffness" ? a.stiffness
-                            : key == "damping" ? a.damping
-                                               : a.equilibrium;
-                std::copy(v.begin(), v.end(), out.begin());
-              } else {
-                throw py::value_error("six_dof: unknown key '" + key +
-                                      "' (lower, upper, stiffness, damping, equilibrium)");
-              }
-            }
+            six_dof_options().apply(a, to_options(d));
             set_six_dof_axes(j, a);
           },
           "a six dof (spring) joint's per-axis settings {lower, upper, stiffness, damping, "
@@ -346,7 +305,251 @@ void register_physics(py::module_& m,
           "six_dof_coordinates", [](Joint& j) { return six_dof_coordinates(j); },
           "a six dof (spring) joint's six coordinates now (m, rad)")
       .def("set_cone_twist_limits", &set_cone_twist_limits, py::arg("twist"), py::arg("swing_y"),
-           py::arg("swing_z"), "a cone twist joint's twist (about its axis) and swing spans, rad");
+           py::arg("swing_z"), "a cone twist joint's twist (about its axis) and swing spans, rad")
+      .def_property_readonly(
+          "parent_pivot", [](Joint& j) { return j.spec().parent_pivot; },
+          "pivot in the parent body's frame, m")
+      .def_property_readonly(
+          "child_pivot", [](Joint& j) { return j.spec().child_pivot; },
+          "pivot in the child body's frame, m")
+      .def_property_readonly("parent_axis", [](Joint& j) { return j.spec().parent_axis; })
+      .def_property_readonly("child_axis", [](Joint& j) { return j.spec().child_axis; })
+      .def_property_readonly("offset", [](Joint& j) { return j.spec().offset; })
+      .def_property_readonly("child_offset", [](Joint& j) { return j.spec().child_offset; })
+      .def_property_readonly(
+          "anchors",
+          [](Joint& j) {
+            const Vec3 a = j.parent().pose() * j.spec().parent_pivot;
+            const Vec3 b = j.child().pose() * j.spec().child_pivot;
+            return py::make_tuple(a, b);
+          },
+          "the pivot on the parent and on the child, world frame: the joint holds them "
+          "together");
+}
+
+void define_soft_body(SoftClass& soft) {
+  soft.def_property_readonly("mesh", [](SoftBody& s) { return s.spec().mesh; })
+      .def_property_readonly("mass", &SoftBody::mass, "kg, shared evenly by the nodes")
+      .def_property_readonly(
+          "margin", [](SoftBody& s) { return s.spec().margin; }, "collision margin, m")
+      .def_property_readonly(
+          "config", [](SoftBody& s) { return config_dict(s.spec().config); },
+          "the AMBF config coefficients it was created with (a copy)")
+      .def_property_readonly("node_count", &SoftBody::node_count)
+      .def_property_readonly(
+          "nodes",
+          [](py::object self) {
+            const SoftBody& s = self.cast<const SoftBody&>();
+            return rows_view(self, s.node_positions().data(), s.node_count());
+          },
+          "(N, 3) float64 node positions, world frame: a read-only view refreshed by every step "
+          "(node i is the mesh's i-th distinct vertex)")
+      .def_property_readonly(
+          "triangles",
+          [](py::object self) {
+            const SoftBody& s = self.cast<const SoftBody&>();
+            return rows_view(self, s.triangles().data(), s.triangles().size() / 3);
+          },
+          "(M, 3) uint32 node indices of the faces (read-only view)")
+      .def_property_readonly(
+          "node_velocities", [](SoftBody& s) { return rows_copy(s.node_velocities()); },
+          "(N, 3) float64 node velocities, world frame, m/s (a copy)")
+      .def(
+          "set_node_positions",
+          [](SoftBody& s, const std::vector<int>& nodes, const Eigen::MatrixX3d& positions) {
+            const std::vector<int> list = node_list(s, nodes);
+            if (static_cast<Eigen::Index>(list.size()) != positions.rows()) {
+              throw ArgumentError("set_node_positions: " + std::to_string(list.size()) +
+                                  " nodes but " + std::to_string(positions.rows()) + " positions");
+            }
+            for (std::size_t i = 0; i < list.size(); ++i) {
+              s.set_node_position(list[i], positions.row(static_cast<Eigen::Index>(i)));
+            }
+          },
+          py::arg("nodes"), py::arg("positions"),
+          "Moves nodes (indices) to positions ((K, 3), world frame) at once.")
+      .def(
+          "fix_nodes",
+          [](SoftBody& s, const std::vector<int>& nodes) {
+            for (int n : node_list(s, nodes)) s.set_node_fixed(n, true);
+          },
+          py::arg("nodes"), "Pins nodes (indices) where they are.")
+      .def(
+          "release_nodes",
+          [](SoftBody& s, const std::vector<int>& nodes) {
+            for (int n : node_list(s, nodes)) s.set_node_fixed(n, false);
+          },
+          py::arg("nodes"), "Lets pinned nodes move again.")
+      .def_property_readonly("fixed_nodes", &SoftBody::fixed_nodes, "pinned node indices")
+      .def_property(
+          "color", [](SoftBody& s) { return s.material().color; },
+          [](SoftBody& s, const py::object& c) {
+            Material mat = s.material();
+            mat.color = to_option(c).rgba("color");
+            s.set_material(mat);
+          },
+          "RGBA in 0..1")
+      .def_property(
+          "shader", [](SoftBody& s) { return from_shader(s.material().shader); },
+          [](SoftBody& s, const py::object& v) {
+            Material mat = s.material();
+            mat.shader = to_shader(v, "shader");
+            s.set_material(mat);
+          },
+          "its own shader: None (its model's), 'builtin', or (vertex_path, fragment_path)");
+}
+
+void define_sensor(SensorClass& sensor) {
+  sensor.def_property_readonly("parent", [](ProximitySensor& s) { return handle(&s.parent()); })
+      .def_property_readonly(
+          "location", [](ProximitySensor& s) { return Mat4(s.spec().location); },
+          "4x4 sensor frame in the parent's frame")
+      .def_property("range", &ProximitySensor::range, &ProximitySensor::set_range,
+                    "m each ray reaches (per unit of its direction)")
+      .def_property_readonly("ray_count", &ProximitySensor::ray_count)
+      .def_property_readonly("triggered", &ProximitySensor::triggered, "whether any ray hits")
+      .def_property_readonly(
+          "hits",
+          [](ProximitySensor& s) {
+            py::list out;
+            for (const SensorHit& h : s.hits()) out.append(hit_to_dict(h));
+            return out;
+          },
+          "per ray: dict(triggered, distance (m from the ray's start; its length on a miss), "
+          "fraction, point, normal (world), body (RigidBody, SoftBody or None), node (soft "
+          "body's nearest node or None))")
+      .def_property_readonly(
+          "distances",
+          [](ProximitySensor& s) {
+            py::array_t<double> out(static_cast<py::ssize_t>(s.ray_count()));
+            for (std::size_t i = 0; i < s.ray_count(); ++i) {
+              out.mutable_at(i) = s.hits()[i].distance;
+            }
+            return out;
+          },
+          "(N,) m from each ray's start to its hit (its length on a miss)")
+      .def_property_readonly(
+          "triggered_rays",
+          [](ProximitySensor& s) {
+            py::array_t<bool> out(static_cast<py::ssize_t>(s.ray_count()));
+            for (std::size_t i = 0; i < s.ray_count(); ++i) {
+              out.mutable_at(i) = s.hits()[i].triggered;
+            }
+            return out;
+          },
+          "(N,) bool, whether each ray hits")
+      .def_property_readonly(
+          "ray_starts",
+          [](ProximitySensor& s) { return ray_points(s, &ProximitySensor::ray_start); },
+          "(N, 3) world frame")
+      .def_property_readonly(
+          "ray_ends", [](ProximitySensor& s) { return ray_points(s, &ProximitySensor::ray_end); },
+          "(N, 3) world frame")
+      .def("update", &ProximitySensor::update,
+           "Casts the rays now (the world does it after every physics step).");
+}
+
+void define_actuator(ActuatorClass& actuator) {
+  actuator
+      .def_property_readonly("parent", [](ConstraintActuator& a) { return handle(&a.parent()); })
+      .def_property_readonly(
+          "location", [](ConstraintActuator& a) { return Mat4(a.location().matrix()); },
+          "4x4 actuator frame in the parent's frame")
+      .def_property_readonly("max_impulse",
+                             [](ConstraintActuator& a) { return a.spec().max_impulse; })
+      .def_property_readonly("tau", [](ConstraintActuator& a) { return a.spec().tau; })
+      .def_property_readonly(
+          "hold", [](ConstraintActuator& a) { return actuator_hold_name(a.spec().hold); })
+      .def(
+          "actuate",
+          [](ConstraintActuator& a, RigidBody& body, const py::object& offset) {
+            if (offset.is_none()) {
+              a.actuate(body);
+              return;
+            }
+            const py::array arr = py::array::ensure(offset);
+            if (arr && arr.ndim() == 2) {
+              a.actuate(body, checked_pose(offset.cast<Mat4>()));
+            } else {
+              Eigen::Isometry3d o = Eigen::Isometry3d::Identity();
+              o.translation() = to_option(offset).vector3("offset");
+              a.actuate(body, o);
+            }
+          },
+          py::arg("body"), py::arg("offset") = py::none(),
+          "Holds body: where it is now, or with the actuator at offset in the body's frame (a "
+          "point, or a 4x4 frame), pulling it there. A body already held stays held.")
+      .def("deactuate", &ConstraintActuator::deactuate, "Releases the body held.")
+      .def("is_actuated", &ConstraintActuator::is_actuated, "Whether a body is held.")
+      .def_property_readonly(
+          "actuated_body",
+          [](ConstraintActuator& a) -> py::object {
+            return a.actuated_body() ? py::cast(handle(a.actuated_body())) : py::none();
+          },
+          "the body held, or None");
+}
+
+}  // namespace
+
+void declare_physics(py::module_& m) {
+  declare_enum<Shape::Kind>(m, "ShapeKind", "A rigid body's geometry.",
+                            {{"box", Shape::Kind::kBox},
+                             {"sphere", Shape::Kind::kSphere},
+                             {"cylinder", Shape::Kind::kCylinder},
+                             {"capsule", Shape::Kind::kCapsule},
+                             {"cone", Shape::Kind::kCone},
+                             {"plane", Shape::Kind::kPlane},
+                             {"mesh", Shape::Kind::kMesh},
+                             {"none", Shape::Kind::kNone}},
+                            &parse_shape_kind);
+  declare_enum<Axis>(m, "Axis", "A body axis (cylinders, capsules and cones run along one).",
+                     {{"x", Axis::kX}, {"y", Axis::kY}, {"z", Axis::kZ}}, &parse_axis);
+  declare_enum<MeshCollision>(m, "MeshCollision",
+                              "How a body's collision shape is made from a mesh.",
+                              {{"concave", MeshCollision::kConcave},
+                               {"convex_mesh", MeshCollision::kConvexMesh},
+                               {"convex_hull", MeshCollision::kConvexHull},
+                               {"point_cloud", MeshCollision::kPointCloud}},
+                              &parse_mesh_collision);
+  declare_enum<JointType>(m, "JointType", "How a joint lets its child move.",
+                          {{"revolute", JointType::kRevolute},
+                           {"prismatic", JointType::kPrismatic},
+                           {"fixed", JointType::kFixed},
+                           {"linear_spring", JointType::kLinearSpring},
+                           {"torsion_spring", JointType::kTorsionSpring},
+                           {"p2p", JointType::kP2P},
+                           {"cone_twist", JointType::kConeTwist},
+                           {"six_dof", JointType::kSixDof},
+                           {"six_dof_spring", JointType::kSixDofSpring}},
+                          &parse_joint_type);
+  declare_enum<ControlOutput>(
+      m, "ControlOutput", "What a joint controller drives.",
+      {{"effort", ControlOutput::kEffort}, {"velocity", ControlOutput::kVelocity}},
+      &parse_control_output);
+  declare_enum<ActuatorHold>(m, "ActuatorHold", "How a constraint actuator holds a body.",
+                             {{"fixed", ActuatorHold::kFixed}, {"point", ActuatorHold::kPoint}},
+                             &parse_actuator_hold);
+  BodyClass(m, "RigidBody", "A rigid body: a shape with mass and a material.");
+  JointClass(m, "Joint", "A joint between two bodies, with a controller and limits.");
+  SoftClass(m, "SoftBody",
+            "A deformable body: Bullet nodes at a mesh's vertices, links along its edges.");
+  SensorClass(m, "ProximitySensor", "Rays fixed to a body reporting the nearest body along each.");
+  ActuatorClass(m, "ConstraintActuator", "Holds a body to its parent body on request (a grasp).");
+}
+
+void define_physics(py::module_& m) {
+  auto body = bound<RigidBody, Object, std::shared_ptr<RigidBody>>(m, "RigidBody");
+  define_body(body);
+  auto joint = bound<Joint, Object, std::shared_ptr<Joint>>(m, "Joint");
+  define_joint(joint);
+  auto soft = bound<SoftBody, Object, std::shared_ptr<SoftBody>>(m, "SoftBody");
+  define_soft_body(soft);
+  auto sensor =
+      bound<ProximitySensor, Object, std::shared_ptr<ProximitySensor>>(m, "ProximitySensor");
+  define_sensor(sensor);
+  auto actuator = bound<ConstraintActuator, Object, std::shared_ptr<ConstraintActuator>>(
+      m, "ConstraintActuator");
+  define_actuator(actuator);
 }
 
 }  // namespace ambfplus::bindings

@@ -1,12 +1,16 @@
+// ambfplus/render: the GL context, windows, OpenXR sessions, and shader settings.
+
 #include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
 #include <Eigen/Core>
+#include <filesystem>
 #include <memory>
 #include <vector>
 
+#include "ambfplus/errors.h"
 #include "ambfplus/render/gl_info.h"
 #include "ambfplus/render/openxr.h"
 #include "ambfplus/render/window.h"
@@ -33,7 +37,45 @@ py::list shown(const std::vector<Frame>& frames) {
 
 }  // namespace
 
-void register_render(py::module_& m) {
+std::optional<ShaderSpec> to_shader(const py::handle& value, const char* what) {
+  if (value.is_none()) return std::nullopt;
+  if (py::isinstance<py::str>(value) && value.cast<std::string>() == "builtin") {
+    return ShaderSpec{};
+  }
+  const std::string expected = std::string(what) +
+                               " must be None, 'builtin' or a pair of file paths (vertex, "
+                               "fragment)";
+  if (py::isinstance<py::str>(value) || !py::isinstance<py::sequence>(value) ||
+      py::len(value) != 2) {
+    throw ArgumentTypeError(expected);
+  }
+  auto path = [&](const py::handle& p) {
+    const std::string s = py::str(py::module_::import("os").attr("fspath")(p));
+    if (s.empty()) throw ArgumentError(expected);
+    return std::filesystem::absolute(s).lexically_normal().string();
+  };
+  auto pair = py::reinterpret_borrow<py::sequence>(value);
+  return ShaderSpec{path(pair[0]), path(pair[1])};
+}
+
+py::object from_shader(const std::optional<ShaderSpec>& shader) {
+  if (!shader) return py::none();
+  if (shader->builtin()) return py::str("builtin");
+  return py::make_tuple(shader->vertex, shader->fragment);
+}
+
+void declare_render(py::module_& m) {
+  py::class_<Window>(m, "Window",
+                     "An X11 window (GLFW's, made without a client API) showing cameras.");
+  py::class_<OpenXrSession>(
+      m, "OpenXrSession",
+      "A session with the OpenXR runtime's head-mounted display, given the engine's EGL context "
+      "(XR_MNDX_egl_enable). Per frame: poll_events(); while running: eyes = wait_frame(), "
+      "place a camera per eye, end_frame(cameras). Raises RenderError naming the call and the "
+      "runtime's result when the loader, a runtime or a headset is missing.");
+}
+
+void define_render(py::module_& m) {
   m.def(
       "gl_info",
       []() {
@@ -60,16 +102,16 @@ void register_render(py::module_& m) {
   m.def(
       "use_x11_display",
       [](std::uintptr_t display) {
-        if (display == 0) throw py::value_error("use_x11_display: the display pointer is null");
+        if (display == 0) throw ArgumentError("use_x11_display: the display pointer is null");
         use_x11_display(reinterpret_cast<void*>(display));
       },
       py::arg("display"),
       "Puts the engine's OpenGL context on this X11 display (the address of a Display*, e.g. "
       "GLFW's glfwGetX11Display()), so windows can show cameras. Call before anything renders.");
 
-  py::class_<Window>(m, "Window",
-                     "An X11 window (GLFW's, made without a client API) showing cameras.")
-      .def(py::init<unsigned long>(), py::arg("x11_window"))
+  bound<Window>(m, "Window")
+      .def(py::init<unsigned long>(), py::arg("x11_window"),
+           "Wraps the X11 window with this id (GLFW's glfwGetX11Window()).")
       .def(
           "present",
           [](Window& w, const std::vector<std::shared_ptr<Camera>>& cameras, int width, int height,
@@ -82,7 +124,7 @@ void register_render(py::module_& m) {
               image = py::array_t<std::uint8_t, py::array::c_style>::ensure(overlay);
               if (!image || image.ndim() != 3 || image.shape(0) != height ||
                   image.shape(1) != width || image.shape(2) != 4) {
-                throw py::value_error(
+                throw ArgumentError(
                     "overlay must be a uint8 (height, width, 4) RGBA array of "
                     "the window's size");
               }
@@ -129,12 +171,7 @@ void register_render(py::module_& m) {
 
   m.def("openxr_built", &openxr_built,
         "True when this build has OpenXR sessions (OpenXR's headers were there at build time).");
-  py::class_<OpenXrSession>(
-      m, "OpenXrSession",
-      "A session with the OpenXR runtime's head-mounted display, given the engine's EGL context "
-      "(XR_MNDX_egl_enable). Per frame: poll_events(); while running: eyes = wait_frame(), "
-      "place a camera per eye, end_frame(cameras). Raises RenderError naming the call and the "
-      "runtime's result when the loader, a runtime or a headset is missing.")
+  bound<OpenXrSession>(m, "OpenXrSession")
       .def(py::init([](const std::string& application) {
              py::gil_scoped_release release;
              return std::make_unique<OpenXrSession>(application);

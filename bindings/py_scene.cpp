@@ -1,17 +1,32 @@
+// ambfplus/scene: Simulator, World, Model, Object and the objects a scene shows (Camera, Light,
+// Volume), the real-time loop, the state lock. Every method of these classes is here; the
+// add_* methods turn keywords into specs through the engine's option tables.
+
 #include <pybind11/eigen.h>
+#include <pybind11/functional.h>
+#include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <filesystem>
 #include <optional>
 #include <sstream>
+#include <variant>
 
+#include "ambfplus/adf/adf.h"
 #include "ambfplus/adf/volume_adf.h"
 #include "ambfplus/haptics/device.h"
+#include "ambfplus/haptics/drill.h"
+#include "ambfplus/haptics/input_device.h"
+#include "ambfplus/plugin/registry.h"
 #include "ambfplus/render/render_stats.h"
 #include "ambfplus/scene/ghost.h"
+#include "ambfplus/scene/realtime.h"
 #include "ambfplus/scene/simulator.h"
+#include "ambfplus/scene/step_log.h"
 #include "bindings.h"
+#include "enums.h"
 
 namespace py = pybind11;
 
@@ -49,6 +64,7 @@ namespace {
 
 using Vec3 = Eigen::Vector3d;
 using Mat4 = Eigen::Matrix4d;
+using Path = std::filesystem::path;
 
 template <typename T>
 py::list to_python_list(const std::vector<T*>& objects) {
@@ -57,100 +73,153 @@ py::list to_python_list(const std::vector<T*>& objects) {
   return out;
 }
 
-std::array<float, 4> rgba(const std::vector<double>& c, const char* what) {
-  if (c.size() != 3 && c.size() != 4) {
-    throw py::value_error(std::string(what) + " must be (r, g, b) or (r, g, b, a) in 0..1");
+OptionValue vec(const Vec3& v) { return OptionValue::from_numbers({v.x(), v.y(), v.z()}); }
+OptionValue mat(const Mat4& m) {
+  std::vector<double> flat;
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) flat.push_back(m(r, c));
   }
-  std::array<float, 4> out{0, 0, 0, 1};
-  for (std::size_t i = 0; i < c.size(); ++i) {
-    if (!(c[i] >= 0.0 && c[i] <= 1.0)) {
-      throw py::value_error(std::string(what) + " components must be in 0..1");
-    }
-    out[i] = static_cast<float>(c[i]);
-  }
-  return out;
+  return OptionValue::from_numbers(flat);
 }
 
-std::array<float, 3> rgb(const std::vector<double>& c, const char* what) {
-  if (c.size() != 3) throw py::value_error(std::string(what) + " must be (r, g, b)");
-  const auto four = rgba(c, what);
-  return {four[0], four[1], four[2]};
+// Keyword arguments after the named ones, in their order.
+OptionMap with_kwargs(OptionMap named, const py::kwargs& kw) {
+  for (OptionEntry& e : to_options(kw)) named.push_back(std::move(e));
+  return named;
 }
 
-// Rejects a dimension given for a shape it does not apply to.
-void reject(bool given, const char* key, Shape::Kind kind) {
-  if (given) {
-    throw py::value_error(std::string(key) + " does not apply to a " + shape_kind_name(kind) +
-                          " body");
+// Destroys a loop with the GIL released: its polling thread may be waiting for the GIL.
+struct ReleaseGilDelete {
+  void operator()(RealTimeLoop* loop) const {
+    py::gil_scoped_release release;
+    delete loop;
   }
+};
+using LoopHolder = std::unique_ptr<RealTimeLoop, ReleaseGilDelete>;
+
+// Holds a world's state lock for a `with` block (acquired with the GIL released).
+struct StateLock {
+  std::shared_ptr<World> world;
+  std::unique_lock<StateMutex> lock;
+};
+
+py::dict stats_dict(const RealTimeStats& s) {
+  py::dict d;
+  d["steps"] = s.steps;
+  d["seconds"] = s.seconds;
+  d["mean_rate"] = s.mean_rate;
+  d["p99"] = s.p99;
+  d["max"] = s.max;
+  d["over_2ms"] = s.over_2ms;
+  d["step_cpu_p99"] = s.step_p99;
+  d["step_cpu_max"] = s.step_cpu_max;
+  d["step_wall_max"] = s.step_wall_max;
+  d["lock_wait_max"] = s.lock_wait_max;
+  d["lock_wait_p99"] = s.lock_wait_p99;
+  d["late"] = s.late;
+  d["late_step_wall"] = s.late_step_wall;
+  d["late_step_cpu"] = s.late_step_cpu;
+  d["periods"] = py::array_t<double>(static_cast<py::ssize_t>(s.periods.size()), s.periods.data());
+  return d;
 }
 
-RigidBodySpec body_spec(const std::string& name, const std::string& shape, std::optional<Vec3> size,
-                        std::optional<double> radius, std::optional<double> height,
-                        std::optional<std::string> mesh, double scale, std::optional<Mat4> pose,
-                        double mass, std::optional<std::vector<double>> color,
-                        std::optional<double> specular, std::optional<double> shininess,
-                        const py::kwargs& physics) {
-  RigidBodySpec spec;
-  spec.name = name;
-  spec.shape.kind = parse_shape_kind(shape.empty() ? (mesh ? "mesh" : "box") : shape);
-  const Shape::Kind kind = spec.shape.kind;
-  const auto need = [&](bool given, const char* key) {
-    if (!given) {
-      throw py::value_error("body '" + name + "': a " + shape_kind_name(kind) + " needs " + key);
-    }
+// A step log's rows as NumPy columns: step (int64), time, and each "<object>.<field>" (N, width),
+// (N,) for one value or (N, 4, 4) for poses; flags bool, indices int32, buttons uint32, the rest
+// float64.
+py::dict step_log_arrays(const StepLog& log) {
+  const auto n = static_cast<py::ssize_t>(log.rows());
+  py::dict d;
+  d["step"] = py::array_t<std::int64_t>(n, log.steps().data());
+  d["time"] = py::array_t<double>(n, log.times().data());
+  auto ends_with = [](const std::string& s, const char* end) {
+    const std::string e(end);
+    return s.size() >= e.size() && s.compare(s.size() - e.size(), e.size(), e) == 0;
   };
-  switch (kind) {
-    case Shape::Kind::kBox:
-      need(size.has_value(), "size=(x, y, z)");
-      reject(radius.has_value(), "radius", kind);
-      reject(height.has_value(), "height", kind);
-      spec.shape.size = *size;
-      break;
-    case Shape::Kind::kSphere:
-      need(radius.has_value(), "radius");
-      reject(size.has_value(), "size", kind);
-      reject(height.has_value(), "height", kind);
-      spec.shape.radius = *radius;
-      break;
-    case Shape::Kind::kCylinder:
-    case Shape::Kind::kCapsule:
-    case Shape::Kind::kCone:
-      need(radius.has_value() && height.has_value(), "radius and height");
-      reject(size.has_value(), "size", kind);
-      spec.shape.radius = *radius;
-      spec.shape.height = *height;
-      break;
-    case Shape::Kind::kPlane:
-      reject(size.has_value(), "size", kind);
-      reject(radius.has_value(), "radius", kind);
-      reject(height.has_value(), "height", kind);
-      break;
-    case Shape::Kind::kNone:
-      reject(size.has_value(), "size", kind);
-      reject(radius.has_value(), "radius", kind);
-      reject(height.has_value(), "height", kind);
-      break;
-    case Shape::Kind::kMesh:
-      need(mesh.has_value(), "mesh='file'");
-      reject(size.has_value(), "size", kind);
-      reject(radius.has_value(), "radius", kind);
-      reject(height.has_value(), "height", kind);
-      spec.shape.mesh = *mesh;
-      spec.shape.scale = scale;
-      break;
+  for (const StepLog::Column& c : log.columns()) {
+    py::array_t<double> values =
+        c.width == 1 ? py::array_t<double>(n, c.values.data())
+                     : py::array_t<double>({n, static_cast<py::ssize_t>(c.width)}, c.values.data());
+    py::object column = values;
+    if (c.width == 16) {
+      column = values.attr("reshape")(n, 4, 4);  // poses: 4x4 row by row
+    } else if (ends_with(c.name, ".on")) {
+      column = values.attr("astype")("bool");
+    } else if (ends_with(c.name, ".burr") || ends_with(c.name, ".leading")) {
+      column = values.attr("astype")("int32");
+    } else if (ends_with(c.name, ".buttons")) {
+      column = values.attr("astype")("uint32");
+    }
+    d[py::str(c.name)] = column;
   }
-  if (kind != Shape::Kind::kMesh) {
-    if (mesh) throw py::value_error("mesh= needs shape='mesh' (or no shape)");
-    if (scale != 1.0) throw py::value_error("scale applies to mesh bodies only");
+  return d;
+}
+
+std::string repr_object(const Object& o) {
+  std::ostringstream s;
+  s << "<" << object_kind_name(o.kind()) << " '" << o.name() << "' id=" << o.id() << ">";
+  return s.str();
+}
+
+// ---- Name lookup (AMBF's rules).
+
+std::optional<ObjectKind> parse_kind(const std::optional<std::string>& kind) {
+  if (!kind) return std::nullopt;
+  for (ObjectKind k :
+       {ObjectKind::kRigidBody, ObjectKind::kJoint, ObjectKind::kCamera, ObjectKind::kLight,
+        ObjectKind::kVolume, ObjectKind::kDrill, ObjectKind::kSoftBody, ObjectKind::kSensor,
+        ObjectKind::kActuator, ObjectKind::kInputDevice}) {
+    if (*kind == object_kind_name(k)) return k;
   }
-  if (pose) spec.pose = *pose;
-  spec.dynamics.mass = mass;
-  if (color) spec.material.color = rgba(*color, "color");
-  if (specular) spec.material.specular = static_cast<float>(*specular);
-  if (shininess) spec.material.shininess = static_cast<float>(*shininess);
-  apply_body_options(spec, physics);
-  return spec;
+  throw ArgumentError("unknown kind '" + *kind +
+                      "': expected body, joint, camera, light, volume, drill, soft body, "
+                      "sensor, actuator or input device");
+}
+
+// One object for a name: exact name first, then AMBF's lookup; NotFound (a KeyError) says why not.
+py::object get(World& w, const std::string& name, const std::optional<std::string>& kind) {
+  const std::optional<ObjectKind> k = parse_kind(kind);
+  if (Object* o = w.find(name); o != nullptr && (!k || o->kind() == *k)) return to_python(o);
+  std::vector<Object*> found = w.lookup(name, k);
+  if (found.size() > 1 && !k) {
+    // AMBF's clients find bodies, cameras and lights; joints only when asked for.
+    std::vector<Object*> objects;
+    for (Object* o : found) {
+      if (o->kind() != ObjectKind::kJoint) objects.push_back(o);
+    }
+    if (objects.size() == 1) found = objects;
+  }
+  if (found.size() == 1) return to_python(found.front());
+  if (found.empty()) throw NotFound("no object named '" + name + "' in the world");
+  std::string names;
+  for (std::size_t i = 0; i < found.size() && i < 6; ++i) {
+    names += (i ? ", " : "") + found[i]->qualified_name();
+  }
+  throw NotFound("'" + name + "' is ambiguous: it matches " + std::to_string(found.size()) +
+                 " objects (" + names + (found.size() > 6 ? ", ..." : "") + ")");
+}
+
+// ---- The add_* methods, shared by Model and World (which adds to its default model).
+
+// A body's spec from add_body's (and add_ghost's) arguments.
+RigidBodySpec body_spec(const std::string& name, const OptionalKindOrName<Shape::Kind>& shape,
+                        std::optional<Vec3> size, std::optional<double> radius,
+                        std::optional<double> height, std::optional<Path> mesh, double scale,
+                        std::optional<Mat4> pose, std::optional<double> mass,
+                        std::optional<std::vector<double>> color, std::optional<double> specular,
+                        std::optional<double> shininess, const py::kwargs& physics) {
+  OptionMap named;
+  if (!shape.is_none()) named.push_back({"shape", to_option(shape)});
+  if (size) named.push_back({"size", vec(*size)});
+  if (radius) named.push_back({"radius", *radius});
+  if (height) named.push_back({"height", *height});
+  if (mesh) named.push_back({"mesh", mesh->string()});
+  named.push_back({"scale", scale});
+  if (pose) named.push_back({"pose", mat(*pose)});
+  if (mass) named.push_back({"mass", *mass});
+  if (color) named.push_back({"color", OptionValue::from_numbers(*color)});
+  if (specular) named.push_back({"specular", *specular});
+  if (shininess) named.push_back({"shininess", *shininess});
+  return make_spec(name, rigid_body_options(), with_kwargs(std::move(named), physics));
 }
 
 RigidBody& add_body(Model& model, const RigidBodySpec& spec) {
@@ -158,47 +227,81 @@ RigidBody& add_body(Model& model, const RigidBodySpec& spec) {
   return model.add_body(spec);
 }
 
+Joint& add_joint(Model& model, const std::string& name, RigidBody& parent, RigidBody& child,
+                 const KindOrName<JointType>& type, const py::kwargs& kw) {
+  JointSpec spec;
+  spec.parent = &parent;
+  spec.child = &child;
+  return model.add_joint(
+      make_spec(name, joint_options(), with_kwargs({{"type", to_option(type)}}, kw), spec));
+}
+
 Camera& add_camera(Model& model, const std::string& name, int width, int height, double fov_y,
                    double near, double far, std::optional<Mat4> pose,
                    const std::vector<double>& background) {
-  CameraSpec spec;
-  spec.name = name;
-  spec.width = width;
-  spec.height = height;
-  spec.fov_y = fov_y;
-  spec.near = near;
-  spec.far = far;
-  if (pose) spec.pose = *pose;
-  spec.background = rgb(background, "background");
-  return model.add_camera(spec);
+  OptionMap o{{"width", width}, {"height", height},
+              {"fov_y", fov_y}, {"near", near},
+              {"far", far},     {"background", OptionValue::from_numbers(background)}};
+  if (pose) o.push_back({"pose", mat(*pose)});
+  return model.add_camera(make_spec(name, camera_options(), o));
 }
 
-Light& add_light(Model& model, const std::string& name, const std::string& type,
+Light& add_light(Model& model, const std::string& name, const KindOrName<LightSpec::Type>& type,
                  const Vec3& position, const Vec3& direction, const std::vector<double>& color,
                  double intensity, double spot_cutoff, double spot_exponent,
                  const Vec3& attenuation) {
-  LightSpec spec;
-  spec.name = name;
-  spec.type = parse_light_type(type);
-  spec.position = position;
-  spec.direction = direction;
-  spec.color = rgb(color, "color");
-  spec.intensity = static_cast<float>(intensity);
-  spec.spot_cutoff = static_cast<float>(spot_cutoff);
-  spec.spot_exponent = static_cast<float>(spot_exponent);
-  for (int i = 0; i < 3; ++i) spec.attenuation[i] = static_cast<float>(attenuation[i]);
-  return model.add_light(spec);
+  const OptionMap o{{"type", to_option(type)},        {"position", vec(position)},
+                    {"direction", vec(direction)},    {"color", OptionValue::from_numbers(color)},
+                    {"intensity", intensity},         {"spot_cutoff", spot_cutoff},
+                    {"spot_exponent", spot_exponent}, {"attenuation", vec(attenuation)}};
+  return model.add_light(make_spec(name, light_options(), o));
 }
 
-// The add_* methods, shared by Model and World (which adds to its default model).
+Volume& add_volume(Model& model, const std::string& name, std::shared_ptr<VolumeData> data,
+                   std::optional<Mat4> pose, double iso, double quality, double optical_density,
+                   std::optional<double> specular, std::optional<double> shininess) {
+  VolumeSpec spec;
+  spec.data = std::move(data);
+  OptionMap o{{"iso", iso}, {"quality", quality}, {"optical_density", optical_density}};
+  if (pose) o.push_back({"pose", mat(*pose)});
+  if (specular) o.push_back({"specular", *specular});
+  if (shininess) o.push_back({"shininess", *shininess});
+  return model.add_volume(make_spec(name, volume_options(), o, spec));
+}
+
+InputDevice& add_input_device(Model& model, const std::string& name,
+                              const std::shared_ptr<Device>& device, Drill& drill,
+                              const py::kwargs& kw) {
+  InputDeviceSpec spec;
+  spec.device = device;
+  spec.drill = &drill;
+  spec = make_spec(name, input_device_options(), to_options(kw), spec);
+  if (spec.reference != nullptr && &spec.reference->world() != &model.world()) {
+    throw ArgumentError("add_input_device(): the reference is in another world");
+  }
+  return model.add_input_device(spec);
+}
+
+// A method's docstring: what it does, then its keywords from the spec's option table (one
+// source for the engine, the docs and the stubs).
+template <typename Spec>
+std::string with_keywords(const char* what, const OptionTable<Spec>& table) {
+  std::string doc = std::string(what) + " Keywords:";
+  for (const auto& o : table.options()) {
+    doc += "\n  " + o.key + " (" + o.type + ")" + (o.help.empty() ? "" : ": " + o.help);
+  }
+  return doc;
+}
+
 template <typename Class, typename GetModel>
 void def_adders(Class& cls, GetModel get_model) {
+  using Self = typename Class::type;
   cls.def(
          "add_body",
-         [get_model](typename Class::type& self, const std::string& name, const std::string& shape,
-                     std::optional<Vec3> size, std::optional<double> radius,
-                     std::optional<double> height, std::optional<std::string> mesh, double scale,
-                     std::optional<Mat4> pose, double mass,
+         [get_model](Self& self, const std::string& name,
+                     const OptionalKindOrName<Shape::Kind>& shape, std::optional<Vec3> size,
+                     std::optional<double> radius, std::optional<double> height,
+                     std::optional<Path> mesh, double scale, std::optional<Mat4> pose, double mass,
                      std::optional<std::vector<double>> color, std::optional<double> specular,
                      std::optional<double> shininess, const py::kwargs& physics) {
            Model& model = get_model(self);
@@ -206,41 +309,43 @@ void def_adders(Class& cls, GetModel get_model) {
                                                 pose, mass, color, specular, shininess, physics);
            return handle(&add_body(model, spec), model.world());
          },
-         py::arg("name"), py::arg("shape") = "", py::kw_only(), py::arg("size") = py::none(),
-         py::arg("radius") = py::none(), py::arg("height") = py::none(),
-         py::arg("mesh") = py::none(), py::arg("scale") = 1.0, py::arg("pose") = py::none(),
-         py::arg("mass") = 1.0, py::arg("color") = py::none(), py::arg("specular") = py::none(),
-         py::arg("shininess") = py::none(),
+         py::arg("name"), py::arg("shape") = py::none(), py::kw_only(),
+         py::arg("size") = py::none(), py::arg("radius") = py::none(),
+         py::arg("height") = py::none(), py::arg("mesh") = py::none(), py::arg("scale") = 1.0,
+         py::arg("pose") = py::none(), py::arg("mass") = 1.0, py::arg("color") = py::none(),
+         py::arg("specular") = py::none(), py::arg("shininess") = py::none(),
          "Adds a rigid body: shape is box (size = full extents), sphere (radius), cylinder, "
          "capsule or cone (radius, height along axis, z unless axis='x' or 'y'; a capsule's "
-         "height includes its caps), plane (z = 0, infinite) or mesh (mesh = file, scale); pose "
-         "is a 4x4 world-from-body matrix. Physics (mass > 0 moves under gravity; 0 is static): "
-         "inertia, inertial_offset (4x4), friction, rolling_friction, restitution, "
-         "linear_damping, angular_damping, kinematic, collision (False: none), collision_mesh, "
-         "collision_type (concave, convex_mesh, convex_hull, point_cloud), collision_shapes "
-         "([{shape, size/radius/height/axis, pose}]), margin, groups ([0..31]).")
+         "height includes its caps), plane (z = 0, infinite) or mesh (mesh = file, scale; the "
+         "default when mesh is given); pose is a 4x4 world-from-body matrix. Physics (mass > 0 "
+         "moves under gravity; 0 is static): inertia, inertial_offset (4x4), friction, "
+         "rolling_friction, restitution, linear_damping, angular_damping, kinematic, collision "
+         "(False: none), collision_mesh, collision_type (concave, convex_mesh, convex_hull, "
+         "point_cloud), collision_shapes ([{shape, size/radius/height/axis, pose}]), margin, "
+         "groups ([0..31]), axis.")
       .def(
           "add_ghost",
-          [get_model](typename Class::type& self, const std::string& name, const std::string& shape,
-                      std::optional<Vec3> size, std::optional<double> radius,
-                      std::optional<double> height, std::optional<std::string> mesh, double scale,
-                      std::optional<Mat4> pose, std::optional<std::vector<double>> color,
-                      bool visible, const py::kwargs& collision) {
+          [get_model](
+              Self& self, const std::string& name, const OptionalKindOrName<Shape::Kind>& shape,
+              std::optional<Vec3> size, std::optional<double> radius, std::optional<double> height,
+              std::optional<Path> mesh, double scale, std::optional<Mat4> pose,
+              std::optional<std::vector<double>> color, bool visible, const py::kwargs& collision) {
             Model& model = get_model(self);
-            RigidBodySpec spec = body_spec(name, shape, size, radius, height, mesh, scale, pose,
-                                           0.0, color, std::nullopt, std::nullopt, collision);
+            RigidBodySpec spec =
+                body_spec(name, shape, size, radius, height, mesh, scale, pose, std::nullopt, color,
+                          std::nullopt, std::nullopt, collision);
             spec.material.visible = visible;
             RigidBody* ghost = nullptr;
             {
               py::gil_scoped_release release;
-              ghost = &add_ghost(model, spec);
+              ghost = &add_ghost(model, std::move(spec));
             }
             return handle(ghost, model.world());
           },
-          py::arg("name"), py::arg("shape") = "", py::kw_only(), py::arg("size") = py::none(),
-          py::arg("radius") = py::none(), py::arg("height") = py::none(),
-          py::arg("mesh") = py::none(), py::arg("scale") = 1.0, py::arg("pose") = py::none(),
-          py::arg("color") = py::none(), py::arg("visible") = true,
+          py::arg("name"), py::arg("shape") = py::none(), py::kw_only(),
+          py::arg("size") = py::none(), py::arg("radius") = py::none(),
+          py::arg("height") = py::none(), py::arg("mesh") = py::none(), py::arg("scale") = 1.0,
+          py::arg("pose") = py::none(), py::arg("color") = py::none(), py::arg("visible") = true,
           "Adds a ghost object (AMBF's ghost objects): a shape as add_body takes it that "
           "touches nothing (no force, rays pass through) and reports, after every step, the "
           "bodies overlapping it (body.overlapping, Bullet's narrow phase). It moves by its pose "
@@ -248,21 +353,21 @@ void def_adders(Class& cls, GetModel get_model) {
           "collision_type, collision_shapes, margin) shape what it tests.")
       .def(
           "add_joint",
-          [get_model](typename Class::type& self, const std::string& name, RigidBody& parent,
-                      RigidBody& child, const std::string& type, const py::kwargs& kw) {
+          [get_model](Self& self, const std::string& name, RigidBody& parent, RigidBody& child,
+                      const KindOrName<JointType>& type, const py::kwargs& kw) {
             Model& model = get_model(self);
             return handle(&add_joint(model, name, parent, child, type, kw), model.world());
           },
           py::arg("name"), py::arg("parent"), py::arg("child"), py::arg("type") = "revolute",
-          "Adds a joint (revolute/hinge/continuous, prismatic/slider, fixed, spring, torsion "
-          "spring, p2p, cone twist, six dof, six dof spring) between two bodies. Keywords: "
-          "parent_pivot, parent_axis, child_pivot, child_axis (each body's frame), offset, "
-          "child_offset, lower, upper, damping, stiffness, equilibrium, max_motor_impulse, erp, "
-          "cfm, controller ({p, i, d, output}), passive, ignore_inter_collision.")
+          with_keywords("Adds a joint between two bodies (type: revolute/hinge/continuous, "
+                        "prismatic/slider, fixed, spring, torsion spring, p2p, cone twist, six "
+                        "dof, six dof spring); pivots and axes are in each body's frame.",
+                        joint_options())
+              .c_str())
       .def(
           "add_camera",
-          [get_model](typename Class::type& self, const std::string& name, int width, int height,
-                      double fov_y, double near, double far, std::optional<Mat4> pose,
+          [get_model](Self& self, const std::string& name, int width, int height, double fov_y,
+                      double near, double far, std::optional<Mat4> pose,
                       const std::vector<double>& background) {
             Model& model = get_model(self);
             return handle(
@@ -276,7 +381,7 @@ void def_adders(Class& cls, GetModel get_model) {
           "vertical field of view in radians, near and far the clipping distances in metres.")
       .def(
           "add_light",
-          [get_model](typename Class::type& self, const std::string& name, const std::string& type,
+          [get_model](Self& self, const std::string& name, const KindOrName<LightSpec::Type>& type,
                       const Vec3& position, const Vec3& direction, const std::vector<double>& color,
                       double intensity, double spot_cutoff, double spot_exponent,
                       const Vec3& attenuation) {
@@ -294,21 +399,13 @@ void def_adders(Class& cls, GetModel get_model) {
           "lights is lit by a headlight at each camera.")
       .def(
           "add_volume",
-          [get_model](typename Class::type& self, const std::string& name,
-                      std::shared_ptr<VolumeData> data, std::optional<Mat4> pose, double iso,
-                      double quality, double optical_density, std::optional<float> specular,
-                      std::optional<float> shininess) {
+          [get_model](Self& self, const std::string& name, std::shared_ptr<VolumeData> data,
+                      std::optional<Mat4> pose, double iso, double quality, double optical_density,
+                      std::optional<double> specular, std::optional<double> shininess) {
             Model& model = get_model(self);
-            VolumeSpec spec;
-            spec.name = name;
-            spec.data = std::move(data);
-            if (pose) spec.pose = *pose;
-            spec.iso = iso;
-            spec.quality = quality;
-            spec.optical_density = optical_density;
-            if (specular) spec.specular = *specular;
-            if (shininess) spec.shininess = *shininess;
-            return handle(&model.add_volume(spec), model.world());
+            return handle(&add_volume(model, name, std::move(data), pose, iso, quality,
+                                      optical_density, specular, shininess),
+                          model.world());
           },
           py::arg("name"), py::arg("data"), py::kw_only(), py::arg("pose") = py::none(),
           py::arg("iso") = 0.5, py::arg("quality") = 0.5, py::arg("optical_density") = 1.0,
@@ -318,118 +415,117 @@ void def_adders(Class& cls, GetModel get_model) {
           "exponent) set the surface's material (defaults 0.15 and 24).")
       .def(
           "add_drill",
-          [get_model](typename Class::type& self, const std::string& name, Volume& volume,
-                      const py::kwargs& kw) {
+          [get_model](Self& self, const std::string& name, Volume& volume, const py::kwargs& kw) {
             Model& model = get_model(self);
-            return handle(&add_drill(model, name, volume, kw), model.world());
+            DrillSpec spec;
+            spec.volume = &volume;
+            return handle(&model.add_drill(make_spec(name, drill_options(), to_options(kw), spec)),
+                          model.world());
           },
           py::arg("name"), py::arg("volume"),
-          "Adds a drill working on `volume`. Options: burr_diameters (m), burr (index), cursors, "
-          "spacing, shaft_radii, stiffness (N/m), damping, max_force, soft_start, "
-          "static_friction, dynamic_friction, removal ('physical' or 'compatible'), "
-          "cutting_rate (m^3/(s N)), voxels_per_step, pose (initial goal, 4x4).")
+          with_keywords("Adds a drill working on `volume`.", drill_options()).c_str())
       .def(
           "add_input_device",
-          [get_model](typename Class::type& self, const std::string& name,
-                      const std::shared_ptr<Device>& device, Drill& drill, const py::kwargs& kw) {
+          [get_model](Self& self, const std::string& name, const std::shared_ptr<Device>& device,
+                      Drill& drill, const py::kwargs& kw) {
             Model& model = get_model(self);
             return handle(&add_input_device(model, name, device, drill, kw), model.world());
           },
           py::arg("name"), py::arg("device"), py::arg("drill"),
-          "Binds a device to a drill. Options: workspace_scale (world m per device m), reference "
-          "(an object, e.g. a camera, whose axes device motion follows: x right, y up, z towards "
-          "the viewer), drill_button (0), clutch_button (1), burr_button (-1: none), max_force "
-          "(N), force_scale.")
+          with_keywords("Binds a device to a drill, as a surgeon holds it.", input_device_options())
+              .c_str())
       .def(
           "add_soft_body",
-          [get_model](typename Class::type& self, const std::string& name,
-                      const std::filesystem::path& mesh, const py::kwargs& kw) {
+          [get_model](Self& self, const std::string& name, const Path& mesh, const py::kwargs& kw) {
             Model& model = get_model(self);
-            return handle(&add_soft_body(model, name, mesh.string(), kw), model.world());
+            SoftBodySpec spec;
+            spec.mesh = mesh.string();
+            spec = make_spec(name, soft_body_options(), to_options(kw), spec);
+            SoftBody* body = nullptr;
+            {
+              py::gil_scoped_release release;  // reads a mesh file
+              body = &model.add_soft_body(spec);
+            }
+            return handle(body, model.world());
           },
           py::arg("name"), py::arg("mesh"),
-          "Adds a soft body made from a mesh file (STL, OBJ, ...): nodes at its distinct "
-          "vertices, links along its triangle edges. Keywords: scale, pose (4x4 world from the "
-          "mesh frame), mass (kg, shared evenly), margin (collision margin, m), config (AMBF's "
-          "config block as a dict: kLST, kAST, kVST, kVCF, kDP, kDG, kLF, kPR, kVC, kDF, kMT, "
-          "kCHR, kKHR, kSHR, kAHR, cluster keys, viterations, piterations, diterations, "
-          "citerations, flags, 'bending constraint', clusters, 'fixed nodes'), fixed_nodes, "
-          "randomize_constraints, color, specular, shininess.")
+          with_keywords("Adds a soft body made from a mesh file (STL, OBJ, ...): nodes at its "
+                        "distinct vertices, links along its triangle edges.",
+                        soft_body_options())
+              .c_str())
       .def(
           "add_sensor",
-          [get_model](typename Class::type& self, const std::string& name, RigidBody& parent,
+          [get_model](Self& self, const std::string& name, RigidBody& parent,
                       const py::kwargs& kw) {
             Model& model = get_model(self);
-            return handle(&add_sensor(model, name, parent, kw), model.world());
+            ProximitySensorSpec spec;
+            spec.parent = &parent;
+            return handle(&model.add_sensor(
+                              make_spec(name, proximity_sensor_options(), to_options(kw), spec)),
+                          model.world());
           },
           py::arg("name"), py::arg("parent"),
-          "Adds a proximity sensor fixed to parent, updated after every physics step. Keywords: "
-          "location (4x4 in the parent's frame) or pose (4x4 world, now), range (m, 0.5), one "
-          "ray by offset and direction (sensor frame, default +x from the origin), or rays "
-          "([{offset, direction}]) or parametric ({resolution, horizontal angle, vertical "
-          "angle, start offset}); a ray reaches offset + direction * range. visible, "
-          "visible_size.")
+          with_keywords(
+              "Adds a proximity sensor fixed to parent, updated after every physics step; a ray "
+              "reaches offset + direction * range (sensor frame, default +x from the origin).",
+              proximity_sensor_options())
+              .c_str())
       .def(
           "add_actuator",
-          [get_model](typename Class::type& self, const std::string& name, RigidBody& parent,
+          [get_model](Self& self, const std::string& name, RigidBody& parent,
                       const py::kwargs& kw) {
             Model& model = get_model(self);
-            return handle(&add_actuator(model, name, parent, kw), model.world());
+            ConstraintActuatorSpec spec;
+            spec.parent = &parent;
+            return handle(&model.add_actuator(
+                              make_spec(name, constraint_actuator_options(), to_options(kw), spec)),
+                          model.world());
           },
           py::arg("name"), py::arg("parent"),
-          "Adds a constraint actuator on parent that holds bodies on request. Keywords: "
-          "location (4x4 in the parent's frame) or pose (4x4 world, now), hold ('fixed': the "
-          "body keeps its pose relative to the actuator, or 'point': only the point is held), "
-          "max_impulse (N s per step, point hold), tau (point hold), visible, visible_size.");
+          with_keywords(
+              "Adds a constraint actuator on parent that holds bodies on request (hold 'fixed': "
+              "the body keeps its pose relative to the actuator; 'point': only the point is held).",
+              constraint_actuator_options())
+              .c_str());
 }
 
-std::string repr_object(const Object& o) {
-  std::ostringstream s;
-  s << "<" << object_kind_name(o.kind()) << " '" << o.name() << "' id=" << o.id() << ">";
-  return s.str();
+// ---- The classes' methods.
+
+AdfLoadOptions load_options(std::optional<std::vector<int>> models, const std::vector<Path>& extra,
+                            const std::vector<int>& devices, bool strict, bool load_world,
+                            const std::string& prefix, const std::vector<std::string>& plugins) {
+  AdfLoadOptions o;
+  o.plugins = plugins;
+  o.indices = std::move(models);
+  for (const Path& p : extra) o.extra.push_back(p.string());
+  o.devices = devices;
+  o.strict = strict;
+  o.load_world = load_world;
+  o.namespace_prefix = prefix;
+  return o;
 }
 
-}  // namespace
+std::shared_ptr<AdfReport> load_launch_into(World& w, const Path& path,
+                                            std::optional<std::vector<int>> models,
+                                            const std::vector<Path>& extra,
+                                            const std::vector<int>& devices, bool strict,
+                                            bool load_world, const std::string& prefix,
+                                            const std::vector<std::string>& plugins) {
+  const AdfLoadOptions options =
+      load_options(std::move(models), extra, devices, strict, load_world, prefix, plugins);
+  py::gil_scoped_release release;
+  return std::make_shared<AdfReport>(load_launch(w, path.string(), options));
+}
 
-void register_scene(py::module_& m) {
-  py::class_<Simulator, std::shared_ptr<Simulator>> simulator(
-      m, "Simulator", "The top of the hierarchy Simulator > World > Model > Object.");
-  py::class_<World, std::shared_ptr<World>> world(
-      m, "World", "The scene (models and their objects) and the simulation clock.");
-  py::class_<Model, std::shared_ptr<Model>> model(
-      m, "Model", "A group of objects; names are unique across the whole world.");
-  py::class_<Object, std::shared_ptr<Object>> object(m, "Object",
-                                                     "Anything in a world with a unique name.");
-  py::class_<RigidBody, Object, std::shared_ptr<RigidBody>> body(
-      m, "RigidBody", "A rigid body: a shape with mass and a material.");
-  py::class_<Joint, Object, std::shared_ptr<Joint>> joint(
-      m, "Joint", "A joint between two bodies, with a controller and limits.");
-  py::class_<Camera, Object, std::shared_ptr<Camera>> camera(
-      m, "Camera", "A pinhole camera; pose is world from camera in the OpenCV frame.");
-  py::class_<Light, Object, std::shared_ptr<Light>> light(
-      m, "Light", "A directional, point or spot light shining along its +z axis.");
-  py::class_<Volume, Object, std::shared_ptr<Volume>> volume(
-      m, "Volume", "Segmented volume data placed in a world, rendered by ray casting.");
-  py::class_<Drill, Object, std::shared_ptr<Drill>> drill(
-      m, "Drill", "A burr and shaft of finger-proxy cursors that drills a volume.");
-  register_haptics(m, drill);
-  py::class_<InputDevice, Object, std::shared_ptr<InputDevice>> input(
-      m, "InputDevice",
-      "A device bound to a drill: its motion moves the drill's goal (workspace scale, clutch, "
-      "the reference's axes), its buttons turn and change the burr, the drill's force goes back; "
-      "every reading is logged with its step.");
-  register_devices(m, input);
-  register_world_io(world);
-  register_physics(m, body, joint);
-  py::class_<SoftBody, Object, std::shared_ptr<SoftBody>> soft_body(
-      m, "SoftBody",
-      "A deformable body: Bullet nodes at a mesh's vertices, links along its edges.");
-  py::class_<ProximitySensor, Object, std::shared_ptr<ProximitySensor>> sensor(
-      m, "ProximitySensor", "Rays fixed to a body reporting the nearest body along each.");
-  py::class_<ConstraintActuator, Object, std::shared_ptr<ConstraintActuator>> actuator(
-      m, "ConstraintActuator", "Holds a body to its parent body on request (a grasp).");
-  register_soft(m, soft_body, sensor, actuator);
+constexpr const char* kLaunchDoc =
+    "Loads an AMBF launch file: its world file, then the model files at the launch indices "
+    "`models` (AMBF's -l; None: index 1 unless `extra` is given), then `extra` files (-a), then "
+    "the simulated multibodies of input `devices` (-i), then the launch file's and `plugins`' "
+    "simulator plugins (--plugins). A model that fails is reported in the result's errors and "
+    "leaves nothing behind, a plugin that fails is reported there too; strict=True raises "
+    "instead.";
 
+void define_simulator(py::class_<Simulator, std::shared_ptr<Simulator>>& simulator) {
   simulator
       .def(py::init([](double time_step, const std::string& world_name) {
              SimulatorOptions options;
@@ -445,8 +541,180 @@ void register_scene(py::module_& m) {
             py::gil_scoped_release release;
             s.step(n);
           },
-          py::arg("n") = 1, "Advances the world by n fixed steps.");
+          py::arg("n") = 1, "Advances the world by n fixed steps.")
+      .def_static(
+          "from_launch",
+          [](const Path& path, std::optional<std::vector<int>> models,
+             const std::vector<Path>& extra, const std::vector<int>& devices, bool strict,
+             bool load_world, const std::string& prefix, double time_step,
+             const std::vector<std::string>& plugins, const std::vector<std::string>& arguments) {
+            SimulatorOptions options;
+            options.time_step = time_step;
+            auto sim = Simulator::create(options);
+            sim->set_arguments(arguments);
+            auto report = load_launch_into(sim->world(), path, std::move(models), extra, devices,
+                                           strict, load_world, prefix, plugins);
+            sim->set_load_report(report);
+            return sim;
+          },
+          py::arg("path"), py::arg("models") = py::none(), py::arg("extra") = std::vector<Path>{},
+          py::arg("devices") = std::vector<int>{}, py::arg("strict") = false,
+          py::arg("load_world") = true, py::arg("namespace_prefix") = "",
+          py::arg("time_step") = 0.001, py::arg("plugins") = std::vector<std::string>{},
+          py::arg("arguments") = std::vector<std::string>{},
+          (std::string(kLaunchDoc) +
+           " arguments: command-line arguments for simulator plugins (AMBF forwards those it "
+           "does not know; Simulator.arguments). Returns a new simulator; see its load_report.")
+              .c_str())
+      .def_property(
+          "arguments", [](Simulator& s) { return s.arguments(); },
+          [](Simulator& s, std::vector<std::string> a) { s.set_arguments(std::move(a)); },
+          "command-line arguments for simulator plugins (set before they load)")
+      .def_property_readonly(
+          "load_report",
+          [](Simulator& s) -> std::shared_ptr<AdfReport> {
+            return std::const_pointer_cast<AdfReport>(s.load_report());
+          },
+          "what from_launch loaded and reported (None otherwise)")
+      .def(
+          "get",
+          [](Simulator& s, const std::string& name, const std::optional<std::string>& kind) {
+            return get(s.world(), name, kind);
+          },
+          py::arg("name"), py::arg("kind") = py::none(), "world.get(name, kind)");
+}
 
+void define_world_input(py::class_<World, std::shared_ptr<World>>& world) {
+  // Input events reach the plugins under the world's lock (a real-time loop may be stepping).
+  world
+      .def(
+          "keyboard",
+          [](World& w, int key, int scancode, int action, int mods) {
+            py::gil_scoped_release release;
+            auto lock = w.lock_state();
+            w.plugins().keyboard(key, scancode, action, mods);
+          },
+          py::arg("key"), py::arg("scancode"), py::arg("action"), py::arg("mods"),
+          "Gives the plugins a key event (GLFW codes).")
+      .def(
+          "mouse_button",
+          [](World& w, int button, int action, int mods) {
+            py::gil_scoped_release release;
+            auto lock = w.lock_state();
+            w.plugins().mouse_button(button, action, mods);
+          },
+          py::arg("button"), py::arg("action"), py::arg("mods"),
+          "Gives the plugins a mouse button event (GLFW codes).")
+      .def(
+          "mouse_move",
+          [](World& w, double x, double y) {
+            py::gil_scoped_release release;
+            auto lock = w.lock_state();
+            w.plugins().mouse_move(x, y);
+          },
+          py::arg("x"), py::arg("y"), "Gives the plugins the mouse's position (pixels).")
+      .def(
+          "mouse_scroll",
+          [](World& w, double dx, double dy) {
+            py::gil_scoped_release release;
+            auto lock = w.lock_state();
+            w.plugins().mouse_scroll(dx, dy);
+          },
+          py::arg("dx"), py::arg("dy"), "Gives the plugins a scroll event.");
+}
+
+void define_world_logs(py::class_<World, std::shared_ptr<World>>& world) {
+  world
+      .def(
+          "start_step_log",
+          [](World& w, const std::vector<Object*>& objects) {
+            std::vector<const Object*> logged(objects.begin(), objects.end());
+            py::gil_scoped_release release;
+            w.start_step_log(logged);
+          },
+          py::arg("objects"),
+          "Logs every step's state of these objects from now on (poses; drills: goal, force, "
+          "on, burr; input devices: readings and force); take_step_log() drains it.")
+      .def(
+          "stop_step_log",
+          [](World& w) {
+            py::gil_scoped_release release;
+            w.stop_step_log();
+          },
+          "Stops logging steps (rows not taken are dropped).")
+      .def(
+          "take_step_log",
+          [](World& w) {
+            StepLog log(std::vector<const Object*>{});
+            {
+              py::gil_scoped_release release;
+              log = w.take_step_log();
+            }
+            return step_log_arrays(log);
+          },
+          "The steps logged since the last call: {'step', 'time', '<object>.<field>': ...}.");
+}
+
+void define_world_adf(py::class_<World, std::shared_ptr<World>>& world) {
+  world
+      .def("load_launch", &load_launch_into, py::arg("path"), py::arg("models") = py::none(),
+           py::arg("extra") = std::vector<Path>{}, py::arg("devices") = std::vector<int>{},
+           py::arg("strict") = false, py::arg("load_world") = true,
+           py::arg("namespace_prefix") = "", py::arg("plugins") = std::vector<std::string>{},
+           kLaunchDoc)
+      .def(
+          "load_adf",
+          [](World& w, const Path& path) {
+            Model* model = nullptr;
+            {
+              py::gil_scoped_release release;
+              model = &load_model_file(w, path.string());
+            }
+            return handle(model, w);
+          },
+          py::arg("path"),
+          "Loads an AMBF model file as a new model (all or nothing) and returns it.")
+      .def(
+          "load_world_file",
+          [](World& w, const Path& path) {
+            py::gil_scoped_release release;
+            load_world_file(w, path.string());
+          },
+          py::arg("path"),
+          "Loads an AMBF world file: gravity, namespace, environment, lights and cameras.")
+      .def(
+          "load_volumes",
+          [](World& w, const Path& path, std::optional<Path> labels) {
+            std::vector<Volume*> loaded;
+            {
+              py::gil_scoped_release release;
+              loaded = load_adf_volumes(w, path.string(), labels ? labels->string() : "");
+            }
+            return to_python_list(loaded);
+          },
+          py::arg("path"), py::arg("labels") = py::none(),
+          "Loads the volumes: of an AMBF model file (its bodies and joints come with ADF "
+          "loading) into a new model, then the drills: it declares on them (ambfplus "
+          "extension); labels (CSV/YAML) overrides their label tables. Returns the volumes.")
+      .def("get", &get, py::arg("name"), py::arg("kind") = py::none(),
+           "The object a name refers to: the exact name, else AMBF's lookup (qualified name "
+           "'/ambf/env/l1', identifier 'BODY l1', or a unique part of either; a part that also "
+           "matches joints means the one other object). KeyError (ambfplus.NotFound) when none "
+           "or several match; kind ('body', 'joint', ...) narrows the search.")
+      .def(
+          "lookup",
+          [](World& w, const std::string& query, const std::optional<std::string>& kind) {
+            py::list out;
+            for (Object* o : w.lookup(query, parse_kind(kind))) out.append(to_python(o));
+            return out;
+          },
+          py::arg("query"), py::arg("kind") = py::none(),
+          "Every object the query refers to (exact matches, else substring matches).")
+      .def_property("namespace", &World::name_space, &World::set_name_space,
+                    "namespace of models whose files name none");
+}
+
+void define_world(py::class_<World, std::shared_ptr<World>>& world) {
   world
       .def(py::init([](double time_step, const std::string& name) {
              SimulatorOptions options;
@@ -480,19 +748,11 @@ void register_scene(py::module_& m) {
       .def(
           "add_model",
           [](World& w, const std::string& name) { return handle(&w.add_model(name), w); },
-          py::arg("name"))
-      .def(
-          "get",
-          [](World& w, const std::string& name) {
-            Object* o = w.find(name);
-            if (o == nullptr) throw py::key_error("no object named '" + name + "' in the world");
-            return to_python(o);
-          },
-          py::arg("name"), "The object with exactly this name; KeyError if there is none.")
+          py::arg("name"), "Adds an empty model (a group of objects).")
       .def("__getitem__",
            [](World& w, const std::string& name) {
              Object* o = w.find(name);
-             if (o == nullptr) throw py::key_error(name);
+             if (o == nullptr) throw NotFound(name);
              return to_python(o);
            })
       .def("__contains__",
@@ -507,12 +767,6 @@ void register_scene(py::module_& m) {
                              [](World& w) { return to_python_list(w.objects_of_kind<Light>()); })
       .def_property_readonly("volumes",
                              [](World& w) { return to_python_list(w.objects_of_kind<Volume>()); })
-      .def_property("gravity", &World::gravity, &World::set_gravity, "m/s^2, world frame")
-      .def_property(
-          "shader", [](World& w) { return from_shader(w.shader()); },
-          [](World& w, const py::object& v) { w.set_shader(to_shader(v, "shader")); },
-          "the shader of bodies whose model and own material name none (AMBF's world "
-          "`shaders`): None (the engine's own), 'builtin', or (vertex_path, fragment_path)")
       .def_property_readonly("joints",
                              [](World& w) { return to_python_list(w.objects_of_kind<Joint>()); })
       .def_property_readonly("drills",
@@ -520,32 +774,28 @@ void register_scene(py::module_& m) {
       .def_property_readonly(
           "input_devices",
           [](World& w) { return to_python_list(w.objects_of_kind<InputDevice>()); })
+      .def_property("gravity", &World::gravity, &World::set_gravity, "m/s^2, world frame")
+      .def_property(
+          "shader", [](World& w) { return from_shader(w.shader()); },
+          [](World& w, const py::object& v) { w.set_shader(to_shader(v, "shader")); },
+          "the shader of bodies whose model and own material name none (AMBF's world "
+          "`shaders`): None (the engine's own), 'builtin', or (vertex_path, fragment_path)")
       .def("lock", &state_lock,
            "A context manager holding the world's state lock: a real-time loop's steps and "
            "captures from other threads wait meanwhile.")
-      .def(
-          "load_volumes",
-          [](World& w, const std::filesystem::path& path,
-             std::optional<std::filesystem::path> labels) {
-            std::vector<Volume*> loaded;
-            {
-              py::gil_scoped_release release;
-              loaded = load_adf_volumes(w, path.string(), labels ? labels->string() : "");
-            }
-            return to_python_list(loaded);
-          },
-          py::arg("path"), py::arg("labels") = py::none(),
-          "Loads the volumes: of an AMBF model file (its bodies and joints come with ADF "
-          "loading) into a new model, then the drills: it declares on them (ambfplus "
-          "extension); labels (CSV/YAML) overrides their label tables. Returns the volumes.")
       .def("__repr__", [](World& w) {
         std::ostringstream s;
         s << "<World '" << w.name() << "' objects=" << w.objects().size()
           << " step=" << w.step_index() << ">";
         return s.str();
       });
+  define_world_input(world);
+  define_world_logs(world);
+  define_world_adf(world);
   def_adders(world, [](World& w) -> Model& { return w.default_model(); });
+}
 
+void define_model(py::class_<Model, std::shared_ptr<Model>>& model) {
   model.def_property_readonly("name", &Model::name)
       .def_property_readonly("world", [](Model& md) { return handle(&md.world(), md.world()); })
       .def_property(
@@ -556,7 +806,9 @@ void register_scene(py::module_& m) {
       .def_property_readonly("objects", [](Model& md) { return to_python_list(md.objects()); })
       .def("__repr__", [](Model& md) { return "<Model '" + md.name() + "'>"; });
   def_adders(model, [](Model& md) -> Model& { return md; });
+}
 
+void define_object(py::class_<Object, std::shared_ptr<Object>>& object) {
   object.def_property_readonly("name", &Object::name)
       .def_property_readonly("id", &Object::id, "stable instance id (>= 1) used by segmentation")
       .def_property_readonly("kind", [](Object& o) { return object_kind_name(o.kind()); })
@@ -565,33 +817,29 @@ void register_scene(py::module_& m) {
           "pose", [](Object& o) { return Mat4(o.pose().matrix()); },
           [](Object& o, const Mat4& m) { o.set_pose(checked_pose(m)); },
           "4x4 world-from-object rigid transform (a copy; assign to change it)")
+      .def_property("namespace", &Object::name_space, &Object::set_name_space,
+                    "AMBF namespace, e.g. '/ambf/env/'")
+      .def_property_readonly("qualified_name", &Object::qualified_name, "namespace + name")
+      .def_property_readonly("identifier", &Object::identifier,
+                             "the ADF block it was loaded from ('BODY l1'), or ''")
+      .def_property_readonly(
+          "attached_to", [](Object& o) { return to_python(const_cast<Object*>(o.attached_to())); })
+      .def(
+          "attach_to",
+          [](Object& o, std::shared_ptr<Object> parent, std::optional<Mat4> local) {
+            Eigen::Isometry3d l = parent ? parent->pose().inverse() * o.pose() : o.pose();
+            if (local) l = checked_pose(*local);
+            o.attach_to(parent.get(), l);
+          },
+          py::arg("parent"), py::arg("local") = py::none(),
+          "Rides on parent after every step at `local` (4x4 parent-from-object; default: where "
+          "it is now). None detaches.")
       .def("__repr__", &repr_object);
+}
 
-  body.def_property_readonly("shape", [](RigidBody& b) { return shape_kind_name(b.shape().kind); })
-      .def_property_readonly("mass", &RigidBody::mass)
-      .def_property_readonly("size", [](RigidBody& b) { return Vec3(b.shape().size); })
-      .def_property_readonly("radius", [](RigidBody& b) { return b.shape().radius; })
-      .def_property_readonly("height", [](RigidBody& b) { return b.shape().height; })
-      .def_property_readonly("mesh", [](RigidBody& b) { return b.shape().mesh; })
-      .def_property(
-          "color", [](RigidBody& b) { return b.material().color; },
-          [](RigidBody& b, const std::vector<double>& c) {
-            Material m = b.material();
-            m.color = rgba(c, "color");
-            b.set_material(m);
-          },
-          "RGBA in 0..1")
-      .def_property(
-          "shader", [](RigidBody& b) { return from_shader(b.material().shader); },
-          [](RigidBody& b, const py::object& v) {
-            Material m = b.material();
-            m.shader = to_shader(v, "shader");
-            b.set_material(m);
-          },
-          "the body's own shader (AMBF's body `shaders`): None (its model's), 'builtin' (the "
-          "engine's own), or (vertex_path, fragment_path); it colours the rgb image only");
-
+void define_camera(py::class_<Camera, Object, std::shared_ptr<Camera>>& camera) {
   camera.def_property_readonly("width", &Camera::width)
+      .def_property_readonly("height", &Camera::height)
       .def_property_readonly(
           "publish",
           [](Camera& c) {
@@ -609,7 +857,6 @@ void register_scene(py::module_& m) {
           },
           "what an ADF asked it to publish: image/depth flags and intervals (every n-th "
           "render), depth noise (mean, std_dev, bias) or None")
-      .def_property_readonly("height", &Camera::height)
       .def_property("fov_y", &Camera::fov_y, &Camera::set_fov_y,
                     "vertical field of view, radians (the principal point stays)")
       .def_property_readonly("near", &Camera::near)
@@ -625,11 +872,10 @@ void register_scene(py::module_& m) {
       .def("capture", &capture, py::arg("out") = py::none(), py::arg("passes") = py::none(),
            py::arg("poses") = py::none(),
            "Renders (GIL released) and returns a Frame of NumPy views. passes: the images to "
-           "render ('rgb', 'depth', 'label', 'instance', 'voxel', 'segmentation'; default "
-           "camera.passes), and "
-           "only those. out=Frame refills that frame's images in place; out={'rgb': a, "
-           "'depth': b, ...} renders into preallocated arrays. poses: object names (or True for "
-           "all) whose world poses the frame records in frame.poses.")
+           "render (names from capture_passes(); default camera.passes), and only those. "
+           "out=Frame refills that frame's images in place; out={'rgb': a, 'depth': b, ...} "
+           "renders into preallocated arrays. poses: object names (or True for all) whose world "
+           "poses the frame records in frame.poses, taken with the images.")
       .def_property(
           "preprocessing_shader", [](Camera& c) { return from_shader(c.preprocessing_shader()); },
           [](Camera& c, const py::object& v) {
@@ -645,7 +891,9 @@ void register_scene(py::module_& m) {
           "principal_point", [](Camera& c) { return c.principal_point(); },
           [](Camera& c, const Eigen::Vector2d& p) { c.set_principal_point(p.x(), p.y()); },
           "(cx, cy) in pixels; (W/2, H/2) unless moved (an off-axis camera)");
+}
 
+void define_volume_object(py::class_<Volume, Object, std::shared_ptr<Volume>>& volume) {
   volume.def_property_readonly("data", &Volume::data)
       .def_property_readonly(
           "labels",
@@ -666,7 +914,8 @@ void register_scene(py::module_& m) {
                              "4x4: voxel (i, j, k)'s centre is this times (i, j, k, 1)")
       .def("world_to_voxel", &Volume::world_to_voxel, py::arg("point"),
            "fractional voxel indices (centres at integers) of a world point")
-      .def("voxel_to_world", &Volume::voxel_to_world, py::arg("ijk"))
+      .def("voxel_to_world", &Volume::voxel_to_world, py::arg("ijk"),
+           "the world point of fractional voxel indices")
       .def(
           "remove_sphere",
           [](Volume& v, const Vec3& c, double r, bool only_removable) {
@@ -694,8 +943,11 @@ void register_scene(py::module_& m) {
              std::optional<std::array<int, 3>> hi) {
             v.data()->mark_dirty(box_from(lo, hi, *v.data()));
           },
-          py::arg("lo") = py::none(), py::arg("hi") = py::none())
-      .def("reset", [](Volume& v) { v.data()->reset(); })
+          py::arg("lo") = py::none(), py::arg("hi") = py::none(),
+          "declares voxels [lo, hi) (default: all) changed through the labels view")
+      .def(
+          "reset", [](Volume& v) { v.data()->reset(); },
+          "restores the data's labels as loaded (or last committed)")
       .def_property_readonly(
           "last_upload",
           [](Volume& v) {
@@ -708,11 +960,145 @@ void register_scene(py::module_& m) {
             return d;
           },
           "what the last render sent to the GPU: rendered, full, voxels, seconds");
+}
 
+void define_light(py::class_<Light, Object, std::shared_ptr<Light>>& light) {
   light.def_property_readonly("type", [](Light& l) { return light_type_name(l.type()); })
       .def_property_readonly("direction", &Light::direction)
       .def_property_readonly("color", &Light::color)
       .def_property_readonly("intensity", &Light::intensity);
+}
+
+void define_realtime(py::module_& m) {
+  bound<StateLock>(m, "_StateLock")
+      .def(
+          "__enter__",
+          [](StateLock& s) {
+            py::gil_scoped_release release;
+            s.lock = s.world->lock_state();
+          },
+          "Takes the world's state lock (waiting with the GIL released).")
+      .def(
+          "__exit__",
+          [](StateLock& s, py::args) {
+            if (s.lock.owns_lock()) s.lock.unlock();
+            return false;
+          },
+          "Gives the lock back.");
+
+  bound<RealTimeLoop, LoopHolder>(m, "RealTimeLoop")
+      .def(py::init([](std::shared_ptr<World> world, double rate, int fifo_priority, int cpu,
+                       double poll_rate) {
+             RealTimeOptions o;
+             o.rate = rate;
+             o.fifo_priority = fifo_priority;
+             o.cpu = cpu;
+             o.poll_rate = poll_rate;
+             LoopHolder loop(new RealTimeLoop(*world, o));
+             World* w = world.get();
+             // Python plugins get their physics update on the low-rate thread.
+             loop->set_poll_hook([w](double dt) {
+               auto lock = w->lock_state();
+               if (dt > 0) w->plugins().foreign_physics_update(dt);
+             });
+             return loop;
+           }),
+           py::arg("world"), py::arg("rate") = 1000.0, py::arg("fifo_priority") = 80,
+           py::arg("cpu") = -1, py::arg("poll_rate") = 100.0, py::keep_alive<1, 2>(),
+           "rate: steps per second; fifo_priority: SCHED_FIFO priority to ask for (0: none); "
+           "cpu: pin to this CPU (-1: the last, only if SCHED_FIFO is refused; -2: never); "
+           "poll_rate: Hz of the thread serving Python devices and plugins.")
+      .def(
+          "start",
+          [](RealTimeLoop& l) {
+            py::gil_scoped_release release;
+            l.start();
+          },
+          "Starts stepping.")
+      .def(
+          "stop",
+          [](RealTimeLoop& l) {
+            py::gil_scoped_release release;
+            l.stop();
+          },
+          "Stops after the step in progress; re-raises an error that stopped a step.")
+      .def_property_readonly("running", &RealTimeLoop::running)
+      .def_property_readonly("scheduling", &RealTimeLoop::scheduling,
+                             "how the loop's thread is scheduled (SCHED_FIFO, or what it fell "
+                             "back to and why)")
+      .def_property_readonly(
+          "stats", [](RealTimeLoop& l) { return stats_dict(l.stats()); },
+          "steps, seconds, mean_rate (Hz), p99 and max period (s), over_2ms (count), "
+          "step_cpu_p99 (s), lock waits (s), periods (array, s)")
+      .def(
+          "lock", [](RealTimeLoop& l) { return state_lock(l.world()); },
+          "A context manager holding the world's state lock (the loop waits meanwhile).")
+      .def(
+          "__enter__",
+          [](RealTimeLoop& l) -> RealTimeLoop& {
+            py::gil_scoped_release release;
+            l.start();
+            return l;
+          },
+          py::return_value_policy::reference, "Starts stepping.")
+      .def(
+          "__exit__",
+          [](RealTimeLoop& l, py::args) {
+            py::gil_scoped_release release;
+            l.stop();
+            return false;
+          },
+          "Stops stepping.");
+}
+
+}  // namespace
+
+py::object state_lock(World& world) { return py::cast(StateLock{handle(&world, world), {}}); }
+
+void declare_scene(py::module_& m) {
+  declare_enum<LightSpec::Type>(m, "LightType", "How a light shines.",
+                                {{"directional", LightSpec::Type::kDirectional},
+                                 {"point", LightSpec::Type::kPoint},
+                                 {"spot", LightSpec::Type::kSpot}},
+                                &parse_light_type);
+  py::class_<Simulator, std::shared_ptr<Simulator>>(
+      m, "Simulator", "The top of the hierarchy Simulator > World > Model > Object.");
+  py::class_<World, std::shared_ptr<World>>(
+      m, "World", "The scene (models and their objects) and the simulation clock.");
+  py::class_<Model, std::shared_ptr<Model>>(
+      m, "Model", "A group of objects; names are unique across the whole world.");
+  py::class_<Object, std::shared_ptr<Object>>(m, "Object",
+                                              "Anything in a world with a unique name.");
+  py::class_<Camera, Object, std::shared_ptr<Camera>>(
+      m, "Camera", "A pinhole camera; pose is world from camera in the OpenCV frame.");
+  py::class_<Light, Object, std::shared_ptr<Light>>(
+      m, "Light", "A directional, point or spot light shining along its +z axis.");
+  py::class_<Volume, Object, std::shared_ptr<Volume>>(
+      m, "Volume", "Segmented volume data placed in a world, rendered by ray casting.");
+  py::class_<StateLock>(m, "_StateLock", "The world's state lock, held by a `with` block.");
+  py::class_<RealTimeLoop, LoopHolder>(
+      m, "RealTimeLoop",
+      "Steps a world in real time on its own thread (1 kHz by default, absolute deadlines, "
+      "SCHED_FIFO where allowed), while other threads capture. Use as a context manager, or "
+      "start()/stop(). Change the world from Python only inside `with loop.lock():`.");
+}
+
+void define_scene(py::module_& m) {
+  auto simulator = bound<Simulator, std::shared_ptr<Simulator>>(m, "Simulator");
+  define_simulator(simulator);
+  auto world = bound<World, std::shared_ptr<World>>(m, "World");
+  define_world(world);
+  auto model = bound<Model, std::shared_ptr<Model>>(m, "Model");
+  define_model(model);
+  auto object = bound<Object, std::shared_ptr<Object>>(m, "Object");
+  define_object(object);
+  auto camera = bound<Camera, Object, std::shared_ptr<Camera>>(m, "Camera");
+  define_camera(camera);
+  auto light = bound<Light, Object, std::shared_ptr<Light>>(m, "Light");
+  define_light(light);
+  auto volume = bound<Volume, Object, std::shared_ptr<Volume>>(m, "Volume");
+  define_volume_object(volume);
+  define_realtime(m);
 }
 
 }  // namespace ambfplus::bindings

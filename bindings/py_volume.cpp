@@ -1,3 +1,6 @@
+// ambfplus/volume: Label, VolumeData (its grids as views with the data as owner), the volume
+// readers and writers, the phantom.
+
 #include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -9,6 +12,7 @@
 #include <sstream>
 
 #include "ambfplus/adf/volume_adf.h"
+#include "ambfplus/errors.h"
 #include "ambfplus/render/render_stats.h"
 #include "ambfplus/scene/simulator.h"
 #include "ambfplus/volume/phantom.h"
@@ -29,10 +33,7 @@ py::array grid_view(py::object owner, const VolumeData& v, void* data, py::dtype
   const auto size = static_cast<py::ssize_t>(dtype.itemsize());
   py::array a(dtype, {py::ssize_t(n[0]), py::ssize_t(n[1]), py::ssize_t(n[2])},
               {size, size * n[0], size * n[0] * n[1]}, data, owner);
-  if (!writeable) {
-    py::detail::array_proxy(a.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
-  }
-  return a;
+  return writeable ? a : readonly(a);
 }
 
 py::dtype label_dtype(LabelType t) {
@@ -71,23 +72,23 @@ LabelTable table_from(const py::object& labels) {
 
 std::shared_ptr<VolumeData> from_array(py::array labels, std::optional<Vec3> dimensions,
                                        std::optional<Vec3> voxel_size, const py::object& table) {
-  if (labels.ndim() != 3) throw py::value_error("labels must be a 3D array (nx, ny, nz)");
+  if (labels.ndim() != 3) throw ArgumentError("labels must be a 3D array (nx, ny, nz)");
   const bool u8 = labels.dtype().is(py::dtype::of<std::uint8_t>());
   const bool u16 = labels.dtype().is(py::dtype::of<std::uint16_t>());
   if (!u8 && !u16) {
-    throw py::type_error("labels must be uint8 or uint16, got " +
-                         py::str(labels.dtype()).cast<std::string>());
+    throw ArgumentTypeError("labels must be uint8 or uint16, got " +
+                            py::str(labels.dtype()).cast<std::string>());
   }
   const std::array<int, 3> shape = {int(labels.shape(0)), int(labels.shape(1)),
                                     int(labels.shape(2))};
   Vec3 dims;
-  if (dimensions && voxel_size) throw py::value_error("give dimensions or voxel_size, not both");
+  if (dimensions && voxel_size) throw ArgumentError("give dimensions or voxel_size, not both");
   if (dimensions) {
     dims = *dimensions;
   } else if (voxel_size) {
     dims = voxel_size->cwiseProduct(Vec3(shape[0], shape[1], shape[2]));
   } else {
-    throw py::value_error("give the volume's size: dimensions=(x, y, z) metres or voxel_size=");
+    throw ArgumentError("give the volume's size: dimensions=(x, y, z) metres or voxel_size=");
   }
   LabelTable t = table_from(table);
   const LabelType type = u8 ? LabelType::kUInt8 : LabelType::kUInt16;
@@ -130,16 +131,23 @@ py::object hit_dict(const VolumeHit& h) {
   return d;
 }
 
-void register_volume(py::module_& m) {
-  py::class_<Label>(m, "Label", "One structure of a segmented volume (id 0 means no label).")
+void declare_volume(py::module_& m) {
+  py::class_<Label>(m, "Label", "One structure of a segmented volume (id 0 means no label).");
+  py::class_<VolumeData, std::shared_ptr<VolumeData>>(
+      m, "VolumeData",
+      "A segmented volume: label grid (a view, indexed [i, j, k]), label table, size, edits.");
+}
+
+void define_volume(py::module_& m) {
+  bound<Label>(m, "Label")
       .def(py::init([](int id, std::string name, std::array<int, 3> color, bool removable,
                        bool critical) {
-             if (id < 1 || id > 65535) throw py::value_error("label id must be in 1..65535");
+             if (id < 1 || id > 65535) throw ArgumentError("label id must be in 1..65535");
              Label l;
              l.id = static_cast<std::uint16_t>(id);
              l.name = std::move(name);
              for (int c = 0; c < 3; ++c) {
-               if (color[c] < 0 || color[c] > 255) throw py::value_error("color must be 0..255");
+               if (color[c] < 0 || color[c] > 255) throw ArgumentError("color must be 0..255");
                l.color[c] = static_cast<std::uint8_t>(color[c]);
              }
              l.removable = removable;
@@ -169,10 +177,8 @@ void register_volume(py::module_& m) {
         return s.str();
       });
 
-  py::class_<VolumeData, std::shared_ptr<VolumeData>> data(
-      m, "VolumeData",
-      "A segmented volume: label grid (a view, indexed [i, j, k]), label table, size, edits.");
-  data.def(py::init(&from_array), py::arg("labels"), py::kw_only(),
+  bound<VolumeData, std::shared_ptr<VolumeData>>(m, "VolumeData")
+      .def(py::init(&from_array), py::arg("labels"), py::kw_only(),
            py::arg("dimensions") = py::none(), py::arg("voxel_size") = py::none(),
            py::arg("label_table") = py::none(),
            "A volume from a (nx, ny, nz) uint8/uint16 label array (copied), its size in metres "
@@ -229,7 +235,8 @@ void register_volume(py::module_& m) {
             const Label* l = py::isinstance<py::str>(key)
                                  ? v.label_table().find(key.cast<std::string>())
                                  : v.label_table().find(key.cast<std::uint16_t>());
-            if (l == nullptr) throw py::key_error(py::str(key).cast<std::string>());
+            if (l == nullptr)
+              throw NotFound("no label " + py::repr(key).cast<std::string>() + " in the table");
             return *l;
           },
           py::arg("id_or_name"))
@@ -258,7 +265,7 @@ void register_volume(py::module_& m) {
       .def(
           "set_region",
           [](VolumeData& v, std::array<int, 3> lo, std::array<int, 3> hi, int label) {
-            if (label < 0 || label > 65535) throw py::value_error("label must be 0..65535");
+            if (label < 0 || label > 65535) throw ArgumentError("label must be 0..65535");
             return v.set_region(VoxelBox{lo, hi}, static_cast<std::uint16_t>(label));
           },
           py::arg("lo"), py::arg("hi"), py::arg("label"), "sets voxels [lo, hi) to label")
@@ -286,6 +293,14 @@ void register_volume(py::module_& m) {
             return out;
           },
           "returns the edit log and starts a new one")
+      .def_property_readonly(
+          "edit_log_dropped", &VolumeData::edit_log_dropped,
+          "edits dropped from the log because it was full (it keeps the newest "
+          "VolumeData.EDIT_LOG_EDITS edits, holding at most VolumeData.EDIT_LOG_VOXELS voxels)")
+      .def_readonly_static("EDIT_LOG_EDITS", &VolumeData::kEditLogEdits,
+                           "edits kept in the log until taken")
+      .def_readonly_static("EDIT_LOG_VOXELS", &VolumeData::kEditLogVoxels,
+                           "removed voxels the kept edits hold at most")
       .def(
           "raycast",
           [](VolumeData& v, const Vec3& origin, const Vec3& direction, double iso) {
@@ -338,10 +353,9 @@ void register_volume(py::module_& m) {
          int count, std::optional<Vec3> dimensions, std::optional<Vec3> voxel_size,
          const py::object& labels, int alpha_threshold) {
         if (dimensions && voxel_size)
-          throw py::value_error("give dimensions or voxel_size, not both");
+          throw ArgumentError("give dimensions or voxel_size, not both");
         if (!dimensions && !voxel_size) {
-          throw py::value_error(
-              "give the stack's size: dimensions=(x, y, z) metres or voxel_size=");
+          throw ArgumentError("give the stack's size: dimensions=(x, y, z) metres or voxel_size=");
         }
         SliceStackSpec spec;
         spec.folder = folder.string();
@@ -380,7 +394,7 @@ void register_volume(py::module_& m) {
         } else if (kind == "segmentation") {
           o.kind = NrrdOptions::Kind::kSegmentation;
         } else {
-          throw py::value_error("kind must be auto, labels, intensity or segmentation");
+          throw ArgumentError("kind must be auto, labels, intensity or segmentation");
         }
         o.threshold = threshold;
         py::gil_scoped_release release;

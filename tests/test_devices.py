@@ -201,7 +201,7 @@ def test_device_inputs_are_checked():
     device = ambfplus.NullDevice()
     with pytest.raises(ValueError, match="workspace scale"):
         world.add_input_device("a", device, drill, workspace_scale=0.0)
-    with pytest.raises(TypeError, match="unknown option 'scale'"):
+    with pytest.raises(TypeError, match="unexpected keyword argument 'scale'.*workspace_scale"):
         world.add_input_device("a", device, drill, scale=2.0)
     with pytest.raises(ValueError, match="needs 'position'"):
         ambfplus.ScriptedDevice().set_waypoints([{"time": 0.0}])
@@ -415,3 +415,17 @@ def test_options_from_an_ambf_input_device_file(fixtures):
     binding = world.add_input_device("touch", ambfplus.NullDevice(), drill, **touch)
     world.step(1)
     assert binding.state["buttons"] == 0
+
+
+def test_an_untaken_device_log_keeps_its_newest_readings_and_counts_the_rest():
+    world, volume, drill = drill_over_slab(height=0.03)
+    binding = world.add_input_device("dev", ambfplus.NullDevice(), drill)
+    cap = ambfplus.InputDevice.MAX_LOG
+    world.step(cap + 25)
+    log = binding.log
+    assert len(log["step"]) == cap and binding.log_dropped == 25
+    assert log["step"][0] == 26 and log["step"][-1] == cap + 25, "the newest are kept"
+    taken = binding.take_log()
+    assert len(taken["step"]) == cap and len(binding.log["step"]) == 0
+    world.step(10)
+    assert len(binding.log["step"]) == 10 and binding.log_dropped == 25

@@ -364,6 +364,31 @@ def test_drills_declared_in_a_model_file(tmp_path, caplog):
     assert drill.cursor_radii[0] == 0.0025, "a burr change at run time resizes the tip"
 
 
+def test_a_drill_block_and_add_drill_share_their_keys(tmp_path):
+    """A DRILL block's keys are add_drill's keywords with spaces for underscores (one table)."""
+    keys = {
+        "burr diameters": [0.002, 0.004],
+        "burr": 1,
+        "cursors": 3,
+        "cursor spacing": 0.002,
+        "shaft radii": [0.0006, 0.0007],
+        "stiffness": 450.0,
+        "max force": 4.0,
+        "removal": "compatible",
+        "voxels per step": [2, 5],
+        "friction": {"static": 0.3, "dynamic": 0.2},
+    }
+    block = "DRILL burr:\n  volume: slab\n" + "".join(f"  {k}: {v}\n" for k, v in keys.items())
+    from_file = ambfplus.World()
+    (volume,) = from_file.load_volumes(adf_with_drill(tmp_path, block.replace("'", "")))
+    (loaded,) = from_file.drills
+    kwargs = {k.replace(" ", "_"): v for k, v in keys.items()}
+    kwargs["spacing"] = kwargs.pop("cursor_spacing")  # Python's name; the file's is an alias
+    made = from_file.add_drill("d", volume, **kwargs)
+    for attribute in ("burr_diameters", "burr", "cursor_radii", "stiffness", "removal"):
+        assert getattr(made, attribute) == getattr(loaded, attribute), attribute
+
+
 @pytest.mark.parametrize(
     "block, message",
     [
@@ -381,3 +406,18 @@ def test_bad_drill_blocks_name_the_file_and_key(tmp_path, block, message):
     with pytest.raises(ambfplus.ConfigError, match=message) as error:
         world.load_volumes(path)
     assert error.value.filename == str(path)
+
+
+def test_the_drill_logs_are_bounded_and_say_what_they_dropped():
+    world = ambfplus.World()
+    volume = world.add_volume("v", ambfplus.phantom(16, 0))
+    drill = world.add_drill("d", volume)
+    assert ambfplus.Drill.MAX_REMOVED == 262144 and ambfplus.Drill.MAX_EVENTS == 65536
+    assert drill.removed_dropped == 0 and drill.events_dropped == 0
+    data = volume.data
+    cap = ambfplus.VolumeData.EDIT_LOG_EDITS
+    for i in range(cap + 3):
+        data.set_region((0, 0, 0), (1, 1, 1), 1 + i % 2)
+    assert len(data.edit_log) == cap and data.edit_log_dropped == 3
+    assert data.edit_log[-1]["revision"] == data.revision, "the newest edits are kept"
+    assert len(data.take_edit_log()) == cap and data.edit_log == []

@@ -39,7 +39,7 @@ def test_engine_errors_are_typed_whatever_throws_them(tmp_path):
         "v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nv 0 0 0.1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"
     )
     soft = world.add_soft_body("soft", str(cube))
-    with pytest.raises(IndexError, match="nodes 0"):
+    with pytest.raises(ambfplus.OutOfRange, match="nodes 0"):
         soft.fix_nodes([1000])
     loop = ambfplus.RealTimeLoop(world)
     loop.start()

@@ -38,8 +38,9 @@ def test_stubs_cover_the_extension_module():
     # Every method and property of the bound classes appears in its stub class.
     classes = {n.name: n for n in tree.body if isinstance(n, ast.ClassDef)}
 
-    def members(node):  # with those of stub base classes
+    def members(node):  # with those of stub base classes; a plain property may be a field
         own = {m.name for m in node.body if isinstance(m, ast.FunctionDef)}
+        own |= {m.target.id for m in node.body if isinstance(m, ast.AnnAssign)}
         for base in node.bases:
             if isinstance(base, ast.Name) and base.id in classes:
                 own |= members(classes[base.id])

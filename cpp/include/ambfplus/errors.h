@@ -135,6 +135,21 @@ class AMBFPLUS_API ArgumentError : public Error {
   explicit ArgumentError(const std::string& message) : Error(message) {}
 };
 
+/// An argument or option of the wrong type, or a keyword option that does not exist (the message
+/// names it and the known ones). In Python, an ambfplus.ArgumentTypeError, which is an
+/// ArgumentError that is also a TypeError (as Python's own unexpected keywords are).
+class AMBFPLUS_API ArgumentTypeError : public ArgumentError {
+ public:
+  explicit ArgumentTypeError(const std::string& message) : ArgumentError(message) {}
+};
+
+/// A name or key that names nothing where it was looked up (an object of a world, a label). In
+/// Python, an ambfplus.NotFound, which is also a KeyError.
+class AMBFPLUS_API NotFound : public Error {
+ public:
+  explicit NotFound(const std::string& message) : Error(message) {}
+};
+
 /// An index outside what it indexes (a sensor's ray, a soft body's node). In Python, an
 /// ambfplus.OutOfRange, which is also an IndexError.
 class AMBFPLUS_API OutOfRange : public Error {

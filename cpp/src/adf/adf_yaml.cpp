@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdlib>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -181,6 +182,34 @@ void Diagnostics::unknown_keys(const Doc& doc, const std::string& where, const Y
       warn(doc.path, at(entry.first) + where + ": unknown key '" + key + "' ignored");
     }
   }
+}
+
+OptionValue option_value(const YAML::Node& node) {
+  if (!node || node.IsNull()) return {};
+  if (node.IsSequence()) {
+    std::vector<OptionValue> items;
+    for (const YAML::Node& item : node) items.push_back(option_value(item));
+    return OptionValue(std::move(items));
+  }
+  if (node.IsMap()) {
+    OptionMap entries;
+    for (const auto& entry : node) {
+      entries.push_back({entry.first.as<std::string>(), option_value(entry.second)});
+    }
+    return OptionValue::mapping(std::move(entries));
+  }
+  const std::string& text = node.Scalar();
+  if (!text.empty()) {
+    char* end = nullptr;
+    const long long i = std::strtoll(text.c_str(), &end, 10);
+    if (*end == '\0') return OptionValue(static_cast<std::int64_t>(i));
+    const double d = std::strtod(text.c_str(), &end);
+    if (*end == '\0') return OptionValue(d);
+  }
+  // YAML's booleans as yaml-cpp reads them, but for the one-letter y and n (an axis is "y").
+  bool b = false;
+  if (text.size() > 1 && YAML::convert<bool>::decode(node, b)) return OptionValue(b);
+  return OptionValue(text);
 }
 
 }  // namespace ambfplus::adf

@@ -15,6 +15,7 @@
 
 #include "ambfplus/adf/adf.h"
 #include "ambfplus/errors.h"
+#include "ambfplus/scene/options.h"
 
 namespace ambfplus::adf {
 
@@ -85,6 +86,27 @@ std::string remove_spaces(std::string s);
 
 /// A path from a file, made absolute against dir (absolute paths are kept).
 std::string resolve(const fs::path& dir, const std::string& path);
+
+/// A YAML value as an option value: numbers, true/false (yes/no, on/off), text, lists, mappings.
+OptionValue option_value(const YAML::Node& node);
+
+/// Sets spec's fields from those of `keys` that block has, through the spec's option table (a
+/// file's key is Python's keyword with spaces for underscores); a bad value fails naming the
+/// file, line and block.
+template <typename Spec>
+void set_options(const Doc& doc, const std::string& id, const YAML::Node& block,
+                 const OptionTable<Spec>& table, Spec& spec,
+                 std::initializer_list<const char*> keys) {
+  for (const char* key : keys) {
+    const YAML::Node value = block[key];
+    if (!value) continue;
+    try {
+      table.set(spec, key, option_value(value));
+    } catch (const ArgumentError& e) {
+      fail(doc, value, id, e.what());
+    }
+  }
+}
 
 /// Warnings of a load, logged as they come and kept for the report.
 class Diagnostics {

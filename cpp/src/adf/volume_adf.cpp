@@ -91,46 +91,12 @@ std::vector<AdfDrillBlock> read_adf_drills(const std::string& path) {
     if (!block["volume"]) adf::fail(doc, block, id, "needs 'volume' (the VOLUME block it drills)");
     d.volume = adf::text(doc, block["volume"], id, "volume");
     s.pose = adf::frame(doc, block["location"], id, "location");
-    auto number = [&](const char* key, double& into) {
-      into = adf::number_or(doc, block, key, id, into);
-    };
-    auto integer = [&](const char* key, int& into) {
-      if (block[key]) into = adf::integer(doc, block[key], id, key);
-    };
-    if (block["burr diameters"]) {
-      s.burr_diameters = adf::as<std::vector<double>>(doc, block["burr diameters"], id,
-                                                      "burr diameters", "a list of numbers");
-    }
-    integer("burr", s.burr);
-    integer("cursors", s.cursors);
-    number("cursor spacing", s.spacing);
-    if (block["shaft radii"]) {
-      s.shaft_radii = adf::as<std::vector<double>>(doc, block["shaft radii"], id, "shaft radii",
-                                                   "a list of numbers");
-    }
-    number("stiffness", s.stiffness);
-    number("damping", s.damping);
-    number("max force", s.max_force);
-    number("soft start", s.soft_start);
-    if (const YAML::Node f = block["friction"]) {
-      s.friction.static_coefficient =
-          adf::number_or(doc, f, "static", id, s.friction.static_coefficient);
-      s.friction.dynamic_coefficient =
-          adf::number_or(doc, f, "dynamic", id, s.friction.dynamic_coefficient);
-    }
-    if (block["removal"]) {
-      const std::string mode = adf::text(doc, block["removal"], id, "removal");
-      if (mode != "physical" && mode != "compatible") {
-        adf::fail(doc, block["removal"], id,
-                  "'removal' must be physical or compatible, got '" + mode + "'");
-      }
-      s.removal = mode == "physical" ? RemovalMode::kPhysical : RemovalMode::kCompatible;
-    }
-    number("cutting rate", s.cutting_rate);
-    if (block["voxels per step"]) {
-      s.voxels_per_step = adf::as<std::vector<int>>(doc, block["voxels per step"], id,
-                                                    "voxels per step", "a list of integers");
-    } else if (block["burr diameters"]) {
+    // Every other key is add_drill's keyword with spaces for underscores.
+    adf::set_options(doc, id, block, drill_options(), s,
+                     {"burr diameters", "burr", "cursors", "cursor spacing", "shaft radii",
+                      "stiffness", "damping", "max force", "soft start", "friction", "removal",
+                      "cutting rate", "voxels per step"});
+    if (!block["voxels per step"] && block["burr diameters"]) {
       // The original's counts go with its four burrs; other burrs take 1 per step.
       s.voxels_per_step.assign(s.burr_diameters.size(), 1);
       const std::vector<int> original{1, 3, 6, 10};

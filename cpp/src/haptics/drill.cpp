@@ -34,26 +34,9 @@ Drill::Drill(Model& model, const DrillSpec& spec, int id)
   if (&volume_->world() != &model.world()) {
     throw ArgumentError(who + "its volume must be in the same world");
   }
-  if (spec_.burr_diameters.empty()) throw ArgumentError(who + "needs at least one burr");
-  for (double d : spec_.burr_diameters) {
-    if (!(d > 0)) throw ArgumentError(who + "burr diameters must be > 0");
-  }
-  if (spec_.cursors < 1 || spec_.cursors > 16) {
-    throw ArgumentError(who + "cursors must be 1..16, got " + std::to_string(spec_.cursors));
-  }
-  if (!(spec_.spacing > 0)) throw ArgumentError(who + "cursor spacing must be > 0");
+  spec_.validate();
   if (spec_.shaft_radii.empty()) {
     for (int i = 1; i < spec_.cursors; ++i) spec_.shaft_radii.push_back(0.00065 + 0.0001 * (i - 1));
-  }
-  if (static_cast<int>(spec_.shaft_radii.size()) != spec_.cursors - 1) {
-    throw ArgumentError(who + "needs " + std::to_string(spec_.cursors - 1) + " shaft radii, got " +
-                        std::to_string(spec_.shaft_radii.size()));
-  }
-  if (spec_.voxels_per_step.size() != spec_.burr_diameters.size()) {
-    throw ArgumentError(who + "voxels_per_step needs one count per burr");
-  }
-  if (!(spec_.max_force > 0) || spec_.damping < 0 || spec_.soft_start < 0) {
-    throw ArgumentError(who + "max_force must be > 0, damping and soft_start >= 0");
   }
   set_stiffness(spec_.stiffness);
   set_cutting_rate(spec_.cutting_rate);

@@ -14,12 +14,7 @@ InputDevice::InputDevice(Model& model, const InputDeviceSpec& spec, int id)
   const std::string who = "input device '" + spec.name + "': ";
   if (!spec_.device) throw ArgumentError(who + "needs a device");
   if (spec_.drill == nullptr) throw ArgumentError(who + "needs a drill to drive");
-  if (!(spec_.workspace_scale > 0)) {
-    throw ArgumentError(who + "workspace scale must be > 0");
-  }
-  if (!(spec_.max_force >= 0) || !(spec_.force_scale >= 0)) {
-    throw ArgumentError(who + "max force and force scale must be >= 0");
-  }
+  spec_.validate();
 }
 
 Eigen::Matrix3d InputDevice::reference_rotation() const {

@@ -404,20 +404,11 @@ AmbfplusId ambfplus_world_add(AmbfplusWorld* world, const char* model, const cha
       }
       if (target == nullptr) target = &w.add_model(model);
     }
-    std::vector<ambfplus::plugin::Option> list;
-    for (int i = 0; i < count; ++i) {
-      const AmbfplusOption& o = options[i];
-      list.push_back({o.key != nullptr ? o.key : "",
-                      std::vector<double>(o.values, o.values + std::max(o.count, 0)),
-                      o.text != nullptr ? std::optional<std::string>(o.text) : std::nullopt});
-    }
     const std::string what = kind != nullptr ? kind : "";
     const std::string called = name != nullptr ? name : "";
-    if (what == "body") return ambfplus::plugin::add_body(*target, called, list).id();
-    if (what == "ghost") return ambfplus::plugin::add_ghost(*target, called, list).id();
-    if (what == "drill") return ambfplus::plugin::add_drill(*target, called, list).id();
-    throw ArgumentError("ambfplus_world_add makes a 'body', a 'ghost' or a 'drill', not '" + what +
-                        "'");
+    return ambfplus::plugin::add_object(*target, what, called,
+                                        ambfplus::plugin::to_options(options, count))
+        .id();
   });
 }
 

@@ -1,36 +1,28 @@
 #pragma once
 
-// Objects a plugin creates through the C API (ambfplus_world_add), from keyword options named
-// as ambfplus's Python add_body and add_drill name them.
+// Objects a plugin creates through the C API (ambfplus_world_add): its options go through the
+// same keyword tables as Python's add_body and add_drill, so a key means the same in both.
 
-#include <optional>
 #include <string>
-#include <vector>
+
+#include "ambfplus/plugin/api.h"
+#include "ambfplus/scene/options.h"
 
 namespace ambfplus {
 
-class Drill;
 class Model;
-class RigidBody;
+class Object;
 
 namespace plugin {
 
-/// One keyword: numbers or a text.
-struct Option {
-  std::string key;
-  std::vector<double> values;
-  std::optional<std::string> text;
-};
+/// ambfplus_world_add's options as keyword options: a text, one number, or a list of numbers;
+/// whole numbers are integers (so 0 and 1 also stand for False and True).
+OptionMap to_options(const AmbfplusOption* options, int count);
 
-/// A body: shape (box, sphere, cylinder, capsule, cone, plane, none; or mesh with `mesh` and
-/// `scale`), size, radius, height, axis, mass, kinematic, collision, color, visible, pose.
-RigidBody& add_body(Model& model, const std::string& name, const std::vector<Option>& options);
-/// A ghost object (ambfplus::add_ghost): a body's options; mass and kinematic are ignored.
-RigidBody& add_ghost(Model& model, const std::string& name, const std::vector<Option>& options);
-/// A drill: volume (a volume's name), burr_diameters, burr, cursors, spacing, shaft_radii,
-/// stiffness, damping, max_force, soft_start, removal (physical or compatible), cutting_rate,
-/// voxels_per_step, pose.
-Drill& add_drill(Model& model, const std::string& name, const std::vector<Option>& options);
+/// A "body" (add_body's keywords), a "ghost" (a body's keywords; mass and kinematic are ignored)
+/// or a "drill" (add_drill's, plus `volume`: a volume's name).
+Object& add_object(Model& model, const std::string& kind, const std::string& name,
+                   const OptionMap& options);
 
 }  // namespace plugin
 }  // namespace ambfplus

@@ -20,18 +20,7 @@ Camera::Camera(Model& model, const CameraSpec& spec, int id)
       cy_(spec.height / 2.0),
       background_(spec.background),
       publish_(spec.publish) {
-  const std::string who = "camera '" + spec.name + "': ";
-  if (width_ <= 0 || height_ <= 0 || width_ > 16384 || height_ > 16384) {
-    throw ArgumentError(who + "width and height must be in 1..16384, got " +
-                        std::to_string(width_) + "x" + std::to_string(height_));
-  }
-  if (!(fov_y_ > 0.0 && fov_y_ < M_PI)) {
-    throw ArgumentError(who + "fov_y must be in (0, pi) radians, got " + std::to_string(fov_y_));
-  }
-  if (!(near_ > 0.0 && far_ > near_ && std::isfinite(far_))) {
-    throw ArgumentError(who + "clipping planes need 0 < near < far, got near " +
-                        std::to_string(near_) + ", far " + std::to_string(far_));
-  }
+  spec.validate();
   set_pose(checked_pose(spec.pose));
 }
 

@@ -21,18 +21,7 @@ ConstraintActuator::ConstraintActuator(Model& model, const ConstraintActuatorSpe
     throw ArgumentError("actuator '" + name + "': its parent '" + spec_.parent->name() +
                         "' is in another world");
   }
-  checked_pose(spec_.location);
-  if (!(spec_.max_impulse > 0) || !std::isfinite(spec_.max_impulse)) {
-    throw ArgumentError("actuator '" + name + "': max impulse must be > 0 N s, got " +
-                        std::to_string(spec_.max_impulse));
-  }
-  if (!(spec_.tau > 0 && spec_.tau <= 1)) {
-    throw ArgumentError("actuator '" + name + "': tau must be in (0, 1], got " +
-                        std::to_string(spec_.tau));
-  }
-  if (!(spec_.visible_size >= 0) || !std::isfinite(spec_.visible_size)) {
-    throw ArgumentError("actuator '" + name + "': visible size must be >= 0");
-  }
+  spec_.validate();
   update();
 }
 

@@ -48,21 +48,7 @@ ProximitySensor::ProximitySensor(Model& model, const ProximitySensorSpec& spec, 
     throw ArgumentError("sensor '" + name + "': its parent '" + spec_.parent->name() +
                         "' is in another world");
   }
-  checked_pose(spec_.location);
-  set_range(spec_.range);
-  if (spec_.rays.empty()) {
-    throw ArgumentError("sensor '" + name + "' needs at least one ray");
-  }
-  for (std::size_t i = 0; i < spec_.rays.size(); ++i) {
-    const SensorRay& r = spec_.rays[i];
-    if (!r.offset.allFinite() || !r.direction.allFinite() || r.direction.norm() == 0) {
-      throw ArgumentError("sensor '" + name + "': ray " + std::to_string(i) +
-                          " needs a finite offset and a finite, non-zero direction");
-    }
-  }
-  if (!(spec_.visible_size >= 0) || !std::isfinite(spec_.visible_size)) {
-    throw ArgumentError("sensor '" + name + "': visible size must be >= 0");
-  }
+  spec_.validate();
   hits_.resize(spec_.rays.size());
   Object::set_pose(spec_.parent->pose() * checked_pose(spec_.location));
 }

@@ -13,72 +13,6 @@
 namespace ambfplus {
 namespace {
 
-// Throws unless lo <= value <= hi (and finite).
-void require_range(double value, double lo, double hi, const std::string& body, const char* key) {
-  if (!(value >= lo && value <= hi)) {
-    throw ArgumentError("soft body '" + body + "': " + key + " must be in " + std::to_string(lo) +
-                        ".." + std::to_string(hi) + ", got " + std::to_string(value));
-  }
-}
-
-void require_at_least(double value, double lo, const std::string& body, const char* key) {
-  if (!(value >= lo) || !std::isfinite(value)) {
-    throw ArgumentError("soft body '" + body + "': " + key + " must be >= " + std::to_string(lo) +
-                        ", got " + std::to_string(value));
-  }
-}
-
-void check_config(const SoftBodyConfig& c, const std::string& name) {
-  require_range(c.linear_stiffness, 0, 1, name, "kLST (linear stiffness)");
-  require_range(c.area_stiffness, 0, 1, name, "kAST (area stiffness)");
-  require_range(c.volume_stiffness, 0, 1, name, "kVST (volume stiffness)");
-  require_at_least(c.velocity_correction, 0, name, "kVCF (velocity correction)");
-  require_range(c.damping, 0, 1, name, "kDP (damping)");
-  require_at_least(c.drag, 0, name, "kDG (drag)");
-  require_at_least(c.lift, 0, name, "kLF (lift)");
-  if (!std::isfinite(c.pressure)) {
-    throw ArgumentError("soft body '" + name + "': kPR (pressure) must be finite");
-  }
-  require_at_least(c.volume_conservation, 0, name, "kVC (volume conservation)");
-  require_range(c.dynamic_friction, 0, 1, name, "kDF (dynamic friction)");
-  if (c.pose_matching) require_range(*c.pose_matching, 0, 1, name, "kMT (pose matching)");
-  require_range(c.rigid_hardness, 0, 1, name, "kCHR (rigid contact hardness)");
-  require_range(c.kinetic_hardness, 0, 1, name, "kKHR (kinetic contact hardness)");
-  require_range(c.soft_hardness, 0, 1, name, "kSHR (soft contact hardness)");
-  require_range(c.anchor_hardness, 0, 1, name, "kAHR (anchor hardness)");
-  require_range(c.cluster_rigid_hardness, 0, 1, name, "kSRHR_CL");
-  require_range(c.cluster_kinetic_hardness, 0, 1, name, "kSKHR_CL");
-  require_range(c.cluster_soft_hardness, 0, 1, name, "kSSHR_CL");
-  require_range(c.cluster_rigid_impulse_split, 0, 1, name, "kSR_SPLT_CL");
-  require_range(c.cluster_kinetic_impulse_split, 0, 1, name, "kSK_SPLT_CL");
-  require_range(c.cluster_soft_impulse_split, 0, 1, name, "kSS_SPLT_CL");
-  require_at_least(c.max_volume, 0, name, "maxvolume");
-  if (!(c.time_scale > 0) || !std::isfinite(c.time_scale)) {
-    throw ArgumentError("soft body '" + name + "': timescale must be > 0");
-  }
-  require_at_least(c.velocity_iterations, 0, name, "viterations");
-  require_at_least(c.position_iterations, 0, name, "piterations");
-  require_at_least(c.drift_iterations, 0, name, "diterations");
-  require_at_least(c.cluster_iterations, 0, name, "citerations");
-  require_at_least(c.collision_flags, 0, name, "flags");
-  if (c.bending_constraint && *c.bending_constraint < 2) {
-    throw ArgumentError("soft body '" + name +
-                        "': bending constraint is a distance in links and must be >= 2, "
-                        "got " +
-                        std::to_string(*c.bending_constraint));
-  }
-  if (c.clusters) require_at_least(*c.clusters, 0, name, "clusters");
-}
-
-// An integer config value: throws unless `value` is a whole number.
-int whole(double value, const std::string& key) {
-  if (!std::isfinite(value) || std::floor(value) != value) {
-    throw ArgumentError("soft body config key '" + key + "' takes a whole number, got " +
-                        std::to_string(value));
-  }
-  return static_cast<int>(value);
-}
-
 // Positions as a hashable key (bit patterns, with -0 folded onto +0).
 struct PositionKey {
   float p[3];
@@ -96,93 +30,10 @@ struct PositionHash {
 
 }  // namespace
 
-bool set_soft_body_config(SoftBodyConfig& c, const std::string& key, double v) {
-  std::string k = key;
-  for (char& ch : k) {
-    if (ch == '_' && k.rfind("k", 0) != 0) ch = ' ';  // "bending_constraint", not "kSR_SPLT_CL"
-  }
-  if (k == "kLST") {
-    c.linear_stiffness = v;
-  } else if (k == "kAST") {
-    c.area_stiffness = v;
-  } else if (k == "kVST") {
-    c.volume_stiffness = v;
-  } else if (k == "kVCF") {
-    c.velocity_correction = v;
-  } else if (k == "kDP") {
-    c.damping = v;
-  } else if (k == "kDG") {
-    c.drag = v;
-  } else if (k == "kLF") {
-    c.lift = v;
-  } else if (k == "kPR") {
-    c.pressure = v;
-  } else if (k == "kVC") {
-    c.volume_conservation = v;
-  } else if (k == "kDF") {
-    c.dynamic_friction = v;
-  } else if (k == "kMT") {
-    c.pose_matching = v;
-  } else if (k == "kCHR") {
-    c.rigid_hardness = v;
-  } else if (k == "kKHR") {
-    c.kinetic_hardness = v;
-  } else if (k == "kSHR") {
-    c.soft_hardness = v;
-  } else if (k == "kAHR") {
-    c.anchor_hardness = v;
-  } else if (k == "kSRHR_CL") {
-    c.cluster_rigid_hardness = v;
-  } else if (k == "kSKHR_CL") {
-    c.cluster_kinetic_hardness = v;
-  } else if (k == "kSSHR_CL") {
-    c.cluster_soft_hardness = v;
-  } else if (k == "kSR_SPLT_CL") {
-    c.cluster_rigid_impulse_split = v;
-  } else if (k == "kSK_SPLT_CL") {
-    c.cluster_kinetic_impulse_split = v;
-  } else if (k == "kSS_SPLT_CL") {
-    c.cluster_soft_impulse_split = v;
-  } else if (k == "maxvolume") {
-    c.max_volume = v;
-  } else if (k == "timescale") {
-    c.time_scale = v;
-  } else if (k == "viterations") {
-    c.velocity_iterations = whole(v, key);
-  } else if (k == "piterations") {
-    c.position_iterations = whole(v, key);
-  } else if (k == "diterations") {
-    c.drift_iterations = whole(v, key);
-  } else if (k == "citerations") {
-    c.cluster_iterations = whole(v, key);
-  } else if (k == "flags") {
-    c.collision_flags = whole(v, key);
-  } else if (k == "bending constraint") {
-    c.bending_constraint = whole(v, key);
-  } else if (k == "clusters") {
-    c.clusters = whole(v, key);
-  } else {
-    return false;
-  }
-  return true;
-}
-
 SoftBody::SoftBody(Model& model, const SoftBodySpec& spec, int id)
     : Object(model, spec.name, id), spec_(spec) {
   const std::string& name = spec.name;
-  if (spec_.mesh.empty()) {
-    throw ArgumentError("soft body '" + name + "' needs a mesh file (STL, OBJ, ...)");
-  }
-  if (!(spec_.scale > 0) || !std::isfinite(spec_.scale)) {
-    throw ArgumentError("soft body '" + name + "': scale must be > 0, got " +
-                        std::to_string(spec_.scale));
-  }
-  if (!(spec_.mass > 0) || !std::isfinite(spec_.mass)) {
-    throw ArgumentError("soft body '" + name + "': mass must be > 0 kg, got " +
-                        std::to_string(spec_.mass));
-  }
-  require_at_least(spec_.margin, 0, name, "collision margin");
-  check_config(spec_.config, name);
+  spec.validate();
   const Eigen::Isometry3d pose = checked_pose(spec_.pose);
 
   const MeshData mesh = load_mesh(spec_.mesh, spec_.scale);

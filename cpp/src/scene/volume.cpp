@@ -13,8 +13,7 @@ Volume::Volume(Model& model, const VolumeSpec& spec, int id)
       optical_density_(spec.optical_density),
       specular_(spec.specular),
       shininess_(spec.shininess) {
-  if (!data_) throw ArgumentError("volume '" + spec.name + "' needs volume data");
-  set_iso(spec.iso);
+  spec.validate();
   set_pose(checked_pose(spec.pose));
 }
 

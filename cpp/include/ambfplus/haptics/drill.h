@@ -13,6 +13,7 @@
 #include "ambfplus/haptics/proxy.h"
 #include "ambfplus/haptics/voxel_collider.h"
 #include "ambfplus/scene/object.h"
+#include "ambfplus/scene/options.h"
 
 namespace ambfplus {
 
@@ -28,6 +29,9 @@ enum class RemovalMode {
   /// The original's rule: a fixed number of voxels per step for each burr (1, 3, 6, 10).
   kCompatible,
 };
+/// Parses "physical" and "compatible" (any case).
+AMBFPLUS_API RemovalMode parse_removal_mode(const std::string& name);
+AMBFPLUS_API const char* removal_mode_name(RemovalMode mode);
 
 /// Everything needed to create a drill.
 struct AMBFPLUS_API DrillSpec {
@@ -48,7 +52,19 @@ struct AMBFPLUS_API DrillSpec {
   std::vector<int> voxels_per_step{1, 3, 6, 10};  ///< per burr (compatible mode)
   /// Initial goal: world from drill, the burr's centre at the origin and the shaft along +x.
   Eigen::Matrix4d pose = Eigen::Matrix4d::Identity();
+
+  /// Throws ArgumentError naming the drill and the value unless every value can be used (burrs
+  /// > 0 with a valid index, 1..16 cursors with spacing > 0 and one shaft radius each when
+  /// given, one voxel count per burr, forces, rates and friction finite and in range, a rigid
+  /// pose); its volume is the constructor's to check.
+  void validate() const;
 };
+
+/// add_drill's keyword options (a DRILL block's keys, spaces for underscores): burr_diameters,
+/// burr, cursors, spacing (cursor spacing), shaft_radii, stiffness, damping, max_force,
+/// soft_start, static_friction, dynamic_friction, friction ({static, dynamic}), removal,
+/// cutting_rate, voxels_per_step, pose.
+AMBFPLUS_API const OptionTable<DrillSpec>& drill_options();
 
 /// One voxel taken by the burr.
 struct AMBFPLUS_API RemovedVoxel {

@@ -10,6 +10,7 @@
 
 #include "ambfplus/haptics/device.h"
 #include "ambfplus/scene/object.h"
+#include "ambfplus/scene/options.h"
 
 namespace ambfplus {
 
@@ -30,7 +31,16 @@ struct AMBFPLUS_API InputDeviceSpec {
   /// Largest force sent to the device, N; infinity: the device's own maximum.
   double max_force = std::numeric_limits<double>::infinity();
   double force_scale = 1.0;  ///< force sent per newton of the drill's force
+
+  /// Throws ArgumentError naming the input device and the value unless every value can be used
+  /// (workspace scale > 0, max force and force scale >= 0, buttons -1..31); its device and
+  /// drill are the constructor's to check.
+  void validate() const;
 };
+
+/// add_input_device's keyword options: workspace_scale, reference, drill_button, clutch_button,
+/// burr_button, max_force, force_scale.
+AMBFPLUS_API const OptionTable<InputDeviceSpec>& input_device_options();
 
 /// A device bound to a drill, as a surgeon holds it: each step, before physics, the device's
 /// motion since the previous reading moves the drill's goal, scaled by the workspace scale and

@@ -11,6 +11,7 @@
 #include "ambfplus/capture/frame.h"
 #include "ambfplus/render/shader.h"
 #include "ambfplus/scene/object.h"
+#include "ambfplus/scene/options.h"
 
 namespace ambfplus {
 
@@ -35,7 +36,15 @@ struct AMBFPLUS_API CameraSpec {
   Eigen::Matrix4d pose = Eigen::Matrix4d::Identity();
   std::array<float, 3> background{0.0f, 0.0f, 0.0f};  ///< RGB, 0..1, where nothing is hit
   CameraPublish publish;
+
+  /// Throws ArgumentError naming the camera and the value unless every value can be used (size
+  /// 1..16384, fov_y in (0, pi), 0 < near < far, a rigid pose, background in 0..1, intervals
+  /// >= 1).
+  void validate() const;
 };
+
+/// add_camera's keyword options: width, height, fov_y, near, far, pose, background.
+AMBFPLUS_API const OptionTable<CameraSpec>& camera_options();
 
 /// A pinhole camera in the OpenCV frame (x right, y down, z forward). pose() is world from camera.
 class AMBFPLUS_API Camera : public Object {

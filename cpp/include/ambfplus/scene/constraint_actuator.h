@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 
 #include "ambfplus/scene/object.h"
+#include "ambfplus/scene/options.h"
 
 namespace ambfplus {
 
@@ -21,6 +22,9 @@ enum class ActuatorHold {
   /// only the point is held, the body may turn about it; `max impulse` and `tau` apply (AMBF 1.x)
   kPoint,
 };
+/// Parses "fixed" and "point" (any case).
+AMBFPLUS_API ActuatorHold parse_actuator_hold(const std::string& name);
+AMBFPLUS_API const char* actuator_hold_name(ActuatorHold hold);
 
 /// Everything needed to create a constraint actuator: AMBF's `type: Constraint` block.
 struct AMBFPLUS_API ConstraintActuatorSpec {
@@ -33,7 +37,15 @@ struct AMBFPLUS_API ConstraintActuatorSpec {
   bool visible = false;        ///< `visible`; AMBF false (not drawn yet)
   double visible_size = 0.02;  ///< `visible size`, m; AMBF 0.02
   ActuatorHold hold = ActuatorHold::kFixed;  ///< ambfplus: how the body is held
+
+  /// Throws ArgumentError naming the actuator and the value unless every value can be used (a
+  /// rigid location, max impulse > 0, tau in (0, 1], visible size >= 0).
+  void validate() const;
 };
+
+/// add_actuator's keyword options: location (4x4 in the parent's frame) or pose (4x4 world,
+/// now; the parent must be set first), hold, max_impulse, tau, visible, visible_size.
+AMBFPLUS_API const OptionTable<ConstraintActuatorSpec>& constraint_actuator_options();
 
 /// Holds a body to its parent body at the actuator's frame on request (a gripper's grasp): a
 /// Bullet constraint made by actuate() and removed by deactuate().

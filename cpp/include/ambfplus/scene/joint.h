@@ -8,6 +8,7 @@
 
 #include "ambfplus/export.h"
 #include "ambfplus/scene/object.h"
+#include "ambfplus/scene/options.h"
 
 namespace ambfplus {
 
@@ -28,7 +29,8 @@ enum class JointType {
   kSixDof,         ///< all six degrees of freedom, within the limits (six dof)
   kSixDofSpring,   ///< six degrees of freedom with a spring on the axis (six dof spring)
 };
-/// Parses AMBF's joint type names (any case; `continuous` is a revolute joint without limits).
+/// Parses AMBF's joint type names (any case, spaces or underscores; `continuous` is a revolute
+/// joint without limits).
 AMBFPLUS_API JointType parse_joint_type(const std::string& name);
 AMBFPLUS_API const char* joint_type_name(JointType type);
 
@@ -37,6 +39,9 @@ enum class ControlOutput {
   kEffort,    ///< torque or force on the bodies
   kVelocity,  ///< the joint motor's target velocity
 };
+/// Parses "effort" (or "force") and "velocity", any case.
+AMBFPLUS_API ControlOutput parse_control_output(const std::string& name);
+AMBFPLUS_API const char* control_output_name(ControlOutput output);
 
 /// A P/I/D controller of a joint's position (AMBF: absent => P 10, I 0, D 1, velocity output;
 /// declared => effort output). With effort output, effort = P e + I sum(e dt) - D v. With
@@ -47,7 +52,13 @@ struct AMBFPLUS_API JointController {
   double i = 0.0;
   double d = 1.0;
   ControlOutput output = ControlOutput::kVelocity;
+
+  /// Throws ArgumentError (naming `who`) unless the gains are finite.
+  void validate(const std::string& who) const;
 };
+
+/// A controller's keys: p, i, d and output.
+AMBFPLUS_API const OptionTable<JointController>& joint_controller_options();
 
 /// Everything needed to create a joint. Pivots and axes are in each body's own frame.
 struct AMBFPLUS_API JointSpec {
@@ -74,7 +85,20 @@ struct AMBFPLUS_API JointSpec {
   JointController controller;
   bool passive = false;  ///< not listed among its root body's joints (AMBF), not controlled
   bool ignore_inter_collision = true;  ///< parent and child do not collide
+  /// Given as AMBF's `continuous` type (a revolute joint): it takes no limits.
+  bool continuous = false;
+
+  /// Throws ArgumentError naming the joint and the value unless every value can be used
+  /// (finite pivots, non-zero axes, ordered limits, gains >= 0); its bodies are the
+  /// constructor's to check.
+  void validate() const;
 };
+
+/// add_joint's keyword options: type, parent_pivot, parent_axis, child_pivot, child_axis,
+/// offset, child_offset, lower, upper, damping, stiffness, equilibrium, max_motor_impulse, erp,
+/// cfm, controller ({p, i, d, output}; declared, it drives efforts unless told otherwise),
+/// passive, ignore_inter_collision.
+AMBFPLUS_API const OptionTable<JointSpec>& joint_options();
 
 /// A joint between two bodies of the same world. Position 0 is where the parent's and the child's
 /// joint frames coincide; positive is a right-handed turn (or a move) of the child about (along)

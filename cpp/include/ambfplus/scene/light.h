@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 
 #include "ambfplus/scene/object.h"
+#include "ambfplus/scene/options.h"
 
 namespace ambfplus {
 
@@ -21,11 +22,20 @@ struct AMBFPLUS_API LightSpec {
   float spot_cutoff = 0.7f;    ///< half-angle of a spot light's cone, radians (AMBF's default)
   float spot_exponent = 0.7f;  ///< falloff towards the cone's edge (AMBF's default)
   std::array<float, 3> attenuation{1.0f, 0.0f, 0.0f};  ///< constant, linear, quadratic
+
+  /// Throws ArgumentError naming the light and the value unless every value can be used (a
+  /// finite position, a non-zero direction, colour in 0..1, intensity, cutoff and attenuation
+  /// finite and >= 0).
+  void validate() const;
 };
 
 /// Parses "directional", "point", "spot" (any case).
 AMBFPLUS_API LightSpec::Type parse_light_type(const std::string& name);
 AMBFPLUS_API const char* light_type_name(LightSpec::Type type);
+
+/// add_light's keyword options: type, position, direction, color, intensity, spot_cutoff,
+/// spot_exponent, attenuation.
+AMBFPLUS_API const OptionTable<LightSpec>& light_options();
 
 /// A world holds at most this many lights of each type.
 constexpr int kMaxLightsPerType = 8;

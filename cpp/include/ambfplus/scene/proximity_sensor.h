@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 
 #include "ambfplus/scene/object.h"
+#include "ambfplus/scene/options.h"
 
 namespace ambfplus {
 
@@ -38,7 +39,21 @@ struct AMBFPLUS_API ProximitySensorSpec {
   std::vector<SensorRay> rays;
   bool visible = false;        ///< `visible`; AMBF false (not drawn yet)
   double visible_size = 0.02;  ///< `visible size`, m; AMBF 0.02
+
+  /// Throws ArgumentError naming the sensor and the value unless every value can be used (a
+  /// rigid location, range > 0, at least one ray, each with a finite offset and a finite,
+  /// non-zero direction); its parent is the constructor's to check.
+  void validate() const;
 };
+
+/// AMBF's `parametric` block as a mapping: resolution (2), horizontal angle, vertical angle,
+/// start offset (0 each; spaces or underscores), turned into its rays.
+AMBFPLUS_API std::vector<SensorRay> parametric_sensor_rays(const OptionMap& parametric);
+
+/// add_sensor's keyword options: location (4x4 in the parent's frame) or pose (4x4 world, now;
+/// the parent must be set first), range, one ray by offset and direction, or rays ([{offset,
+/// direction}] or [(offset, direction)]) or parametric, visible, visible_size.
+AMBFPLUS_API const OptionTable<ProximitySensorSpec>& proximity_sensor_options();
 
 /// What one ray saw at the last update.
 struct AMBFPLUS_API SensorHit {

@@ -13,6 +13,7 @@
 #include "ambfplus/io/mesh.h"
 #include "ambfplus/render/shader.h"
 #include "ambfplus/scene/object.h"
+#include "ambfplus/scene/options.h"
 
 namespace ambfplus {
 
@@ -34,7 +35,16 @@ struct AMBFPLUS_API Shape {
   std::string mesh;
   double scale = 1.0;
   // Planes are z = 0 in the body frame, normal +z, infinite.
+
+  /// Throws ArgumentError (naming `who`, e.g. "body 'b'") unless the dimensions fit the kind.
+  void validate(const std::string& who) const;
 };
+
+/// A body axis: what Shape::axis holds (0, 1, 2).
+enum class Axis { kX = 0, kY = 1, kZ = 2 };
+/// Parses "x", "y", "z" (any case).
+AMBFPLUS_API Axis parse_axis(const std::string& name);
+AMBFPLUS_API const char* axis_name(Axis axis);
 
 /// How a body's collision geometry is made from a mesh.
 enum class MeshCollision {
@@ -46,6 +56,8 @@ enum class MeshCollision {
 /// Parses AMBF's collision mesh types (CONCAVE_MESH, TRIMESH, CONVEX_MESH, CONVEX_HULL, hull,
 /// POINT_CLOUD, in any case).
 AMBFPLUS_API MeshCollision parse_mesh_collision(const std::string& name);
+/// "concave", "convex_mesh", "convex_hull" or "point_cloud".
+AMBFPLUS_API const char* mesh_collision_name(MeshCollision type);
 
 /// A body's collision geometry, in the body frame.
 struct AMBFPLUS_API Collision {
@@ -111,7 +123,18 @@ struct AMBFPLUS_API RigidBodySpec {
   Dynamics dynamics;
   Collision collision;
   Material material;
+
+  /// Throws ArgumentError naming the body and the value unless every value can be used (finite,
+  /// in range, consistent); the constructor calls it, the ADF loader too before creating anything.
+  void validate() const;
 };
+
+/// add_body's keyword options: shape, size, radius, height, axis, mesh, scale, pose, mass, color,
+/// specular, shininess, visible, inertia, inertial_offset, friction, rolling_friction, restitution,
+/// linear_damping, angular_damping, kinematic, collision, collision_mesh, collision_type,
+/// collision_shapes, margin, groups; a shape's dimensions must fit it (a box needs size, a
+/// sphere takes no height ...).
+AMBFPLUS_API const OptionTable<RigidBodySpec>& rigid_body_options();
 
 namespace physics {
 class PhysicsWorld;

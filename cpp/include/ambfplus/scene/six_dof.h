@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "ambfplus/export.h"
+#include "ambfplus/scene/options.h"
 
 namespace ambfplus {
 
@@ -23,6 +24,10 @@ struct AMBFPLUS_API SixDofAxes {
   /// (N/m or N m/rad), damping (N s/m or N m s/rad) and rest position (m or rad).
   std::array<double, 6> stiffness{}, damping{}, equilibrium{};
 };
+
+/// SixDofAxes' keys (lower, upper: 6 limits each, None for free; stiffness, damping,
+/// equilibrium: 6 values each), as Joint.six_dof takes them from Python.
+AMBFPLUS_API const OptionTable<SixDofAxes>& six_dof_options();
 
 /// Sets a six dof or six dof spring joint's limits and springs, per axis (AMBF's `joint
 /// limits: {linear: {low: {x, y, z}, high: ...}, angular: ...}`, `stiffness`, `damping` and

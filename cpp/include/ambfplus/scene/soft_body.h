@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 
 #include "ambfplus/scene/object.h"
+#include "ambfplus/scene/options.h"
 #include "ambfplus/scene/rigid_body.h"
 
 namespace ambfplus {
@@ -63,12 +64,19 @@ struct AMBFPLUS_API SoftBodyConfig {
   /// 0..k-1 for a list of k entries (their positions in the list, not their values); the values
   /// are what a file means.
   std::vector<int> fixed_nodes;
+
+  /// Throws ArgumentError naming `who` and the key unless every coefficient is in its range.
+  void validate(const std::string& who) const;
 };
 
-/// Sets the SoftBodyConfig field an AMBF `config` key names (kLST ... kSS_SPLT_CL, maxvolume,
-/// timescale, viterations, piterations, diterations, citerations, flags, `bending constraint`,
-/// clusters; spaces or underscores). Returns false for a key it does not know; throws
-/// ArgumentError for an integer key given a fraction.
+/// The keys of an AMBF soft body's `config` block, Python's and the file's alike: kLST ...
+/// kSS_SPLT_CL, maxvolume, timescale, viterations, piterations, diterations, citerations, flags,
+/// `bending constraint`, clusters, `fixed nodes` (spaces or underscores).
+AMBFPLUS_API const OptionTable<SoftBodyConfig>& soft_body_config_options();
+
+/// Sets the numeric SoftBodyConfig field an AMBF `config` key names (as
+/// soft_body_config_options()). Returns false for a key it does not know (and for `fixed
+/// nodes`, a list); throws ArgumentError for an integer key given a fraction.
 AMBFPLUS_API bool set_soft_body_config(SoftBodyConfig& config, const std::string& key,
                                        double value);
 
@@ -89,7 +97,15 @@ struct AMBFPLUS_API SoftBodySpec {
   /// on whenever the key is present, even as false.)
   bool randomize_constraints = false;
   Material material;  ///< `color` / `color rgba` / `color components`
+
+  /// Throws ArgumentError naming the soft body and the key unless every value can be used (the
+  /// fixed nodes are checked against the mesh when it is read).
+  void validate() const;
 };
+
+/// add_soft_body's keyword options: scale, pose, mass, margin, config (a dict of the `config`
+/// keys), fixed_nodes, randomize_constraints, color, specular, shininess, visible.
+AMBFPLUS_API const OptionTable<SoftBodySpec>& soft_body_options();
 
 namespace physics {
 class PhysicsWorld;

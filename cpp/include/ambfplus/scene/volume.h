@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 
 #include "ambfplus/scene/object.h"
+#include "ambfplus/scene/options.h"
 #include "ambfplus/volume/volume_data.h"
 
 namespace ambfplus {
@@ -20,7 +21,14 @@ struct AMBFPLUS_API VolumeSpec {
   double optical_density = 1.0;  ///< AMBF's key, kept for files
   float specular = 0.15f;
   float shininess = 24.0f;
+
+  /// Throws ArgumentError naming the volume and the value unless every value can be used (data
+  /// given, a rigid pose, iso in (0, 1), the rest finite and >= 0).
+  void validate() const;
 };
+
+/// add_volume's keyword options: pose, iso, quality, optical_density, specular, shininess.
+AMBFPLUS_API const OptionTable<VolumeSpec>& volume_options();
 
 /// A segmented volume placed in a world and rendered by ray casting its iso-surface. Several
 /// volumes may share one VolumeData.

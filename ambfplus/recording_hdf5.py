@@ -1,22 +1,30 @@
 """HDF5 access for the recording reader that cannot hang on a damaged file.
 
-libhdf5 keeps the data of variable-length strings (and other variable-length types) in *global
-heap collections*, and loops forever when it loads a damaged one: its collection parser
-(``H5HG__cache_heap_deserialize``, HDF5 2.0) steps from object to object by each object's size,
-and a free-space object of size 0 never moves it on. So:
+libhdf5 keeps variable-length data (strings, sequences, region references) and the mappings of
+virtual datasets in *global heap collections*, and loops forever when it loads a damaged one:
+its collection parser (``H5HG__cache_heap_deserialize``, HDF5 2.0) steps from object to object
+by each object's size, and a free-space object of size 0 never moves it on. So:
 
 - Files of format 1.1 (``ambfplus_recording_minor_version`` >= 1, every file this ambfplus
   writes) hold no variable-length data: every text is a fixed-length UTF-8 string. Before any
   attribute is read, its type is inspected through the low-level API without reading its data,
   and a variable-length type (or a reference) in such a file is a ``RecordingError`` naming the
-  file and the attribute; datasets are checked the same way before they are listed.
+  file and the attribute; each dataset's type is checked the same way when a part is listed.
+  A part then holds no global heap at all.
 - Files of format 1.0 (written before) store text as variable-length strings. Each is read only
   after every global heap collection in it has been walked the way libhdf5 walks it: a walk that
   would not end exactly at the collection's end is a ``RecordingError`` naming the file and the
-  collection's byte offset. This reads the whole file once when it is first opened (then not
-  again while its size and modification time stay the same).
+  collection's byte offset. This reads the whole file once (then not again while its size and
+  modification time stay the same).
+- Heads of either format are checked that way too (they are small, and their virtual datasets'
+  mappings live in a global heap), before any attribute is read.
 
-No timeouts: both guards are structural."""
+What is left: a part of format 1.1 whose dataset header was rewritten into a virtual dataset
+pointing at a crafted, looping collection. Random damage does not make one (such a part holds
+no collection to point at); ``validate`` checks every file's global heaps before it opens the
+recording, so it also refuses that.
+
+No timeouts: every guard is structural."""
 
 from __future__ import annotations
 
@@ -32,8 +40,8 @@ from .recording_schema import MINOR_VERSION_ATTR, RecordingError
 
 # A global heap collection starts with this signature and its version (1, the only one).
 GLOBAL_HEAP_START = b"GCOL\x01"
-# Files of format 1.0 whose global heaps passed the check: (device, inode, size, mtime) keys.
-_HEAPS_CHECKED: OrderedDict[tuple, None] = OrderedDict()
+# Files whose global heaps passed the check, by (device, inode, size, mtime): collections found.
+_HEAPS_CHECKED: OrderedDict[tuple, int] = OrderedDict()
 _HEAPS_CHECKED_LIMIT = 4096
 
 
@@ -50,25 +58,31 @@ class CheckedFile:
         self.file.close()
 
 
-def open_checked(path: Path) -> CheckedFile:
-    """Opens one file of a recording: format 1.1 files as they are, older ones after their
-    global heaps have been checked."""
-    if not path.is_file():
-        raise RecordingError(f"{path}: no such file")
-    try:
-        file = h5py.File(path, "r")
-    except OSError as error:
-        raise RecordingError(f"{path}: not a readable HDF5 file ({error})") from None
+def open_checked(path: Path, heaps: str = "if_variable") -> CheckedFile:
+    """Opens one file of a recording. Its global heaps are checked first when `heaps` is
+    "always" (heads, which keep their virtual datasets' mappings there), or "if_variable" and
+    the file is of format 1.0 (whose text is variable-length)."""
+    file = open_hdf5(path)
     try:
         checked = CheckedFile(path, file, fixed_text=False)
         minor = read_attribute(checked, file, MINOR_VERSION_ATTR, expect="integer")
         checked.fixed_text = minor is not None and int(minor) >= 1
-        if not checked.fixed_text:
+        if heaps == "always" or not checked.fixed_text:
             check_global_heaps(path, file)
         return checked
     except BaseException:
         file.close()
         raise
+
+
+def open_hdf5(path: Path) -> h5py.File:
+    """h5py.File(path, "r"), with a RecordingError naming the file if it cannot be opened."""
+    if not path.is_file():
+        raise RecordingError(f"{path}: no such file")
+    try:
+        return h5py.File(path, "r")
+    except OSError as error:
+        raise RecordingError(f"{path}: not a readable HDF5 file ({error})") from None
 
 
 def read_attribute(checked: CheckedFile, obj, name: str, expect: str | None = None):
@@ -138,14 +152,19 @@ def heap_type(type_id) -> str | None:
     return None
 
 
-def check_global_heaps(path: Path, file: h5py.File) -> None:
+def check_global_heaps(path: Path, file: h5py.File | None = None) -> int:
     """Walks every global heap collection in the file as libhdf5 would, refusing one whose
-    walk would loop or run past its end (a format 1.0 file, read only after this)."""
+    walk would loop or run past its end; returns how many there are. Reads the whole file
+    (once: a file checked before is not read again while its size and time stay the same)."""
     stat = path.stat()
     key = (stat.st_dev, stat.st_ino, stat.st_size, stat.st_mtime_ns)
     if key in _HEAPS_CHECKED:
-        return
+        return _HEAPS_CHECKED[key]
+    if file is None:
+        with open_hdf5(path) as opened:
+            return check_global_heaps(path, opened)
     _, size_bytes = file.id.get_create_plist().get_sizes()
+    collections = 0
     with open(path, "rb") as raw:
         if stat.st_size:
             with mmap.mmap(raw.fileno(), 0, access=mmap.ACCESS_READ) as data:
@@ -154,13 +173,16 @@ def check_global_heaps(path: Path, file: h5py.File) -> None:
                     problem = collection_problem(data, start, size_bytes)
                     if problem:
                         raise RecordingError(
-                            f"{path}: damaged global heap collection at byte {start} (the "
-                            f"variable-length strings of a format 1.0 recording): {problem}"
+                            f"{path}: damaged global heap collection at byte {start} (where "
+                            "HDF5 keeps variable-length data and virtual dataset mappings): "
+                            f"{problem}"
                         )
+                    collections += 1
                     start = data.find(GLOBAL_HEAP_START, start + 1)
-    _HEAPS_CHECKED[key] = None
+    _HEAPS_CHECKED[key] = collections
     while len(_HEAPS_CHECKED) > _HEAPS_CHECKED_LIMIT:
         _HEAPS_CHECKED.popitem(last=False)
+    return collections
 
 
 def collection_problem(data, start: int, size_bytes: int) -> str | None:

@@ -406,7 +406,7 @@ class _PartFiles:
 
 def _read_head(path: Path) -> dict:
     """The head's attributes, checked: format, version, JSON metadata and legend."""
-    checked = open_checked(path)
+    checked = open_checked(path, heaps="always")
     with checked.file as f:
         attrs = read_attributes(checked, f)
         found = text_value(attrs.get("format"))

@@ -26,7 +26,8 @@ from the head alone::
     import h5py, json
     with h5py.File("session.h5") as f:          # keep the parts beside it
         depth = f["cameras/rig_left/depth"][5]  # float32 (H, W), metres
-        legend = json.loads(f.attrs["legend"])
+        legend = json.loads(f.attrs["legend"])  # text attributes come back as UTF-8 bytes
+        kinds = f["events/kind"].asstr()[:]     # text columns as str
 
 After a crash the head has no virtual datasets yet (``complete`` is False): read the parts in
 order and concatenate along axis 0 (``open_recording`` does this), or call ``repair(path)``,
@@ -62,8 +63,15 @@ All datasets of a group have the same length N (their rows belong together).
 ``events/``: ``step`` int64, ``kind`` UTF-8 string, ``label`` uint16, ``voxel`` int32 (K, 3)
     (-1, -1, -1 when an event has no voxel).
 
-Attributes of the head's root (parts carry the first four):
-    ``format`` = "ambfplus.recording", ``ambfplus_recording_version`` = 1, ``recording_id`` (a
+Text, in attributes and in datasets (``events/kind``, text step columns), is stored as
+fixed-length UTF-8 strings (NUL-padded; text may not contain NUL), never as variable-length
+strings: libhdf5 keeps those in a global heap and loops forever when it reads a damaged one
+(``ambfplus.recording_hdf5`` says how the reader guards against it). That is format 1.1;
+format 1.0 (ambfplus before it) stored text as variable-length strings, and is still read.
+
+Attributes of the head's root (parts carry the first five):
+    ``format`` = "ambfplus.recording", ``ambfplus_recording_version`` = 1,
+    ``ambfplus_recording_minor_version`` = 1 (absent in format 1.0), ``recording_id`` (a
     UUID every part repeats), ``part`` (in parts: its number), ``created`` (ISO 8601 UTC),
     ``software_version`` (ambfplus), ``h5py_version``, ``hdf5_version``, ``metadata`` (JSON: the
     user's dict), ``legend`` (JSON: object id -> {name, kind, model, color}; volumes add
@@ -81,8 +89,10 @@ and dataset otherwise. ``rec.cameras[name]`` has ``len``, ``[i]`` (a ``RecordedF
 time, step, intrinsics, pose) and lazy columns ``.rgb``, ``.depth``, ... that read only what is
 indexed; ``rec.rigs[name][i]`` is an ``ambfplus.stereo.StereoFrame`` of two recorded frames;
 ``rec.steps`` (dict of arrays), ``rec.removed``, ``rec.events``, ``rec.metadata``,
-``rec.legend`` (integer ids again), ``rec.version``. ``validate(path)`` (``ambfplus validate
-PATH``) checks the recording against itself and the conventions.
+``rec.legend`` (integer ids again), ``rec.version`` and ``rec.minor_version``. ``validate(path)``
+(``ambfplus validate PATH``) checks the recording against itself and the conventions. Neither
+hangs on a damaged file: a damaged global heap, a variable-length text in a format 1.1 file, an
+attribute larger than its file are ``RecordingError``s naming the file (and the attribute).
 
 Unlike the original system's recordings: depth stays float32 and poses float64, with no scale
 factors; every frame carries its own intrinsics and pose; voxel indices are global; nothing is
@@ -147,6 +157,8 @@ from .recording_schema import (
     FRAME_COLUMNS,
     IMAGE_PASSES,
     IMAGE_ROW_BYTES,
+    MINOR_VERSION,
+    MINOR_VERSION_ATTR,
     REMOVED_COLUMNS,
     RIG_COLUMNS,
     SMALL_CHUNK_BYTES,
@@ -156,10 +168,12 @@ from .recording_schema import (
     GroupSummary,
     PartSummary,
     RecordingError,
+    check_text,
     find_parts,
     part_name,
-    string_dtype,
     temporary_name,
+    text_attribute,
+    text_column,
     to_json,
 )
 from .recording_validate import Check, ValidationReport, leftover_files, validate
@@ -286,8 +300,8 @@ class Recorder:
         self.flush_interval_s = float(flush_interval_s)
         self.compression = compression
         self._head = _HeadInfo(
-            recording_id=recording_id or uuid.uuid4().hex,
-            created=created or datetime.now(timezone.utc).isoformat(),
+            recording_id=check_text(str(recording_id or uuid.uuid4().hex), "recording_id"),
+            created=check_text(str(created or datetime.now(timezone.utc).isoformat()), "created"),
             metadata=to_json(metadata or {}, "metadata"),
         )
         # Producer side: what each group holds, so that a mismatch fails in the caller.
@@ -575,7 +589,7 @@ def _close_open_recorders() -> None:
 
 def _camera_name(frame, default: str) -> str:
     name = frame.get("camera") if isinstance(frame, Mapping) else getattr(frame, "camera", None)
-    return str(name) if name else default
+    return check_text(str(name), "camera name") if name else default
 
 
 def _field(frame, name: str):
@@ -667,7 +681,8 @@ def _removed_rows(removed: Mapping, volume: str | None) -> _Rows | None:
             raise ValueError(f"removed/{name}: expected shape (M,) + {trailing}")
         _check_row(columns[name][0], trailing, f"removed/{name}")
     _check_lengths(columns, "removed")
-    return _Rows("removed", columns, {"volume": volume} if volume else {})
+    attrs = {"volume": check_text(str(volume), "removed volume name")} if volume else {}
+    return _Rows("removed", columns, attrs)
 
 
 def _event_rows(events: list) -> _Rows | None:
@@ -683,7 +698,7 @@ def _event_rows(events: list) -> _Rows | None:
             )
     columns = {
         "step": np.array([e["step"] for e in events]),
-        "kind": np.array([str(e["kind"]) for e in events], dtype=object),
+        "kind": np.array([check_text(str(e["kind"]), "events/kind") for e in events], dtype=object),
         "label": np.array([e.get("label", 0) for e in events]),
         "voxel": np.array([tuple(e.get("voxel", (-1, -1, -1))) for e in events]).reshape(-1, 3),
     }
@@ -710,6 +725,8 @@ def _copy_column(array: np.ndarray, where: str) -> np.ndarray:
     if array.dtype.kind == "U" or (
         array.dtype.kind == "O" and all(isinstance(v, str) for v in array.ravel())
     ):
+        for value in array.ravel():
+            check_text(str(value), where)
         return np.array(array.tolist(), dtype=object)
     if array.dtype.kind not in "biufcS":
         raise ValueError(f"{where}: cannot record values of dtype {array.dtype}")
@@ -742,8 +759,8 @@ def _check_lengths(columns: dict, group: str) -> None:
 
 
 def _check_name(name: str, what: str) -> None:
-    if not name or "/" in name or name in (".", ".."):
-        raise ValueError(f"invalid {what} name '{name}' (non-empty, no '/')")
+    if not name or "/" in name or "\0" in name or name in (".", ".."):
+        raise ValueError(f"invalid {what} name {name!r} (non-empty, no '/', no NUL)")
 
 
 def _schema_difference(known: dict, got: dict) -> str:
@@ -799,13 +816,15 @@ class _PartFile:
         self.compression = compression
         self.tmp = temporary_name(path)
         self.file = _memory_file(self.tmp)
-        self.file.attrs.update(
+        _set_attributes(
+            self.file,
             {
                 "format": FORMAT,
                 VERSION_ATTR: VERSION,
+                MINOR_VERSION_ATTR: MINOR_VERSION,
                 "recording_id": head.recording_id,
                 "part": _number_of(path),
-            }
+            },
         )
         self.summary = PartSummary(path)
         self._buffers: dict[tuple[str, str], list[np.ndarray]] = {}
@@ -817,7 +836,7 @@ class _PartFile:
         group = self.summary.groups.get(rows.group)
         if group is None:
             group = self.summary.groups[rows.group] = _new_group_summary(rows)
-            self.file.require_group(rows.group).attrs.update(rows.attrs)
+            _set_attributes(self.file.require_group(rows.group), rows.attrs)
         is_camera = rows.group.startswith("cameras/")
         for name, data in rows.columns.items():
             if (is_camera and name in IMAGE_PASSES) or data.nbytes // len(data) >= IMAGE_ROW_BYTES:
@@ -843,16 +862,29 @@ class _PartFile:
             self._append(group, name, data, chunk_rows)
 
     def _append(self, group: str, name: str, data: np.ndarray, chunk_rows: int) -> None:
-        """Appends rows to a chunked dataset resizable along axis 0, creating it if needed."""
+        """Appends rows to a chunked dataset resizable along axis 0, creating it if needed.
+        Text is stored as fixed-length UTF-8 strings, widened when longer text comes."""
+        if data.dtype.kind == "O":
+            data = text_column(data)
         dataset = self._datasets.get((group, name))
         if dataset is None:
-            self._datasets[group, name] = _create(
-                self.file[group], name, data, chunk_rows, self.compression
-            )
-            return
-        start = dataset.shape[0]
-        dataset.resize(start + len(data), axis=0)
-        dataset[start:] = data
+            dataset = _create(self.file[group], name, data, chunk_rows, self.compression)
+        else:
+            if data.dtype.kind == "S" and data.dtype.itemsize > dataset.dtype.itemsize:
+                dataset = self._widen(group, name, dataset, data.dtype)
+            start = dataset.shape[0]
+            dataset.resize(start + len(data), axis=0)
+            dataset[start:] = data
+        self._datasets[group, name] = dataset
+        string = h5py.check_string_dtype(dataset.dtype)
+        if string:
+            self.summary.groups[group].strings[name] = (string.encoding, string.length)
+
+    def _widen(self, group: str, name: str, dataset: h5py.Dataset, dtype) -> h5py.Dataset:
+        """The text dataset rewritten with wider fixed-length strings (the part is in memory)."""
+        rows, chunk_rows = dataset[()], dataset.chunks[0]
+        del self.file[group][name]
+        return _create(self.file[group], name, rows.astype(dtype), chunk_rows, self.compression)
 
     def close(self) -> PartSummary:
         for group, name in list(self._buffers):
@@ -870,16 +902,23 @@ def _new_group_summary(rows: _Rows) -> GroupSummary:
 def _create(
     group: h5py.Group, name: str, data: np.ndarray, chunk_rows: int, compression: str | None
 ) -> h5py.Dataset:
-    is_text = data.dtype.kind == "O"
-    compression = None if is_text else compression
     return group.create_dataset(
         name,
         data=data,
-        dtype=string_dtype() if is_text else data.dtype,
+        dtype=data.dtype,
         maxshape=(None,) + data.shape[1:],
         chunks=(chunk_rows,) + data.shape[1:],
         **_filters(compression, data.dtype),
     )
+
+
+def _set_attributes(obj, values: Mapping) -> None:
+    """Sets attributes, text as fixed-length UTF-8 strings (never variable-length: reading
+    those needs HDF5's global heap, which libhdf5 loops on when it is damaged)."""
+    for key, value in values.items():
+        if isinstance(value, str):
+            value = text_attribute(value, f"attribute '{key}'")
+        obj.attrs[key] = value
 
 
 def _filters(compression: str | None, dtype: np.dtype) -> dict:
@@ -912,10 +951,12 @@ def write_head(path: Path, head: _HeadInfo, parts: list[PartSummary], complete: 
     concatenate the parts."""
     f = _memory_file(path, libver=("v110", "latest"))
     try:
-        f.attrs.update(
+        _set_attributes(
+            f,
             {
                 "format": FORMAT,
                 VERSION_ATTR: VERSION,
+                MINOR_VERSION_ATTR: MINOR_VERSION,
                 "recording_id": head.recording_id,
                 "created": head.created,
                 "software_version": __version__,
@@ -925,9 +966,9 @@ def write_head(path: Path, head: _HeadInfo, parts: list[PartSummary], complete: 
                 "legend": head.legend,
                 "complete": complete,
                 "parts": to_json([p.path.name for p in parts], "parts"),
-            }
+            },
         )
-        f.create_group("conventions").attrs.update(CONVENTIONS)
+        _set_attributes(f.create_group("conventions"), CONVENTIONS)
         if complete:
             _write_virtual_datasets(f, parts)
     except BaseException:
@@ -943,10 +984,11 @@ def _write_virtual_datasets(f: h5py.File, parts: list[PartSummary]) -> None:
             groups.setdefault(name, []).append((part, group))
     for name, pieces in groups.items():
         first = pieces[0][1]
-        f.require_group(name).attrs.update(first.attrs)
+        _set_attributes(f.require_group(name), first.attrs)
         total = sum(group.rows for _, group in pieces)
         for column, (dtype, trailing) in first.datasets.items():
-            dtype = string_dtype() if np.dtype(dtype).kind == "O" else dtype
+            if column in first.strings:
+                dtype = _text_union([group.strings.get(column) for _, group in pieces])
             sources = [(part.path.name, group.rows) for part, group in pieces]
             _virtual_dataset(f[name], column, dtype, (total,) + tuple(trailing), sources)
 
@@ -973,6 +1015,16 @@ def _virtual_dataset(group: h5py.Group, name: str, dtype, shape: tuple, sources:
                     space, dcpl=dcpl)  # fmt: skip
 
 
+def _text_union(stored: list) -> np.dtype:
+    """The string type a virtual dataset over text parts needs: as wide as the widest part,
+    variable-length only over format 1.0 parts that were (repair of an old recording)."""
+    encoding = stored[0][0] if stored[0] else "utf-8"
+    lengths = [entry[1] if entry else None for entry in stored]
+    if any(length is None for length in lengths):
+        return h5py.string_dtype(encoding)
+    return h5py.string_dtype(encoding, max(lengths))
+
+
 def repair(path) -> Recording:
     """Completes the head of a recording whose recorder did not close (a crash): virtual
     datasets over every closed part, so that plain h5py reads it as one file, and removes the
@@ -982,19 +1034,14 @@ def repair(path) -> Recording:
         leftover.unlink()
     with open_recording(path) as recording:
         parts = scan_parts(path, recording.recording_id)
-        with h5py.File(path, "r") as f:
-            head = _HeadInfo(
-                recording.recording_id,
-                recording.created,
-                _attr_text(f.attrs["metadata"]),
-                _attr_text(f.attrs["legend"]),
-            )
+        head = _HeadInfo(
+            recording.recording_id,
+            recording.created,
+            recording.metadata_text,
+            recording.legend_text,
+        )
     write_head(path, head, parts, complete=True)
     return open_recording(path)
-
-
-def _attr_text(value) -> str:
-    return value.decode() if isinstance(value, bytes) else str(value)
 
 
 def world_legend(world) -> dict:

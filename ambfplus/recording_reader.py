@@ -16,10 +16,23 @@ import h5py
 import hdf5plugin  # noqa: F401 (registers the Blosc filter recordings use)
 import numpy as np
 
+from .recording_hdf5 import (
+    CheckedFile,
+    check_dataset_type,
+    open_checked,
+    read_attribute,
+    read_attributes,
+    text_value,
+)
 from .recording_schema import (
+    EVENT_COLUMNS,
     FORMAT,
+    FRAME_COLUMNS,
     IMAGE_PASSES,
+    MINOR_VERSION_ATTR,
     REMOVED_COLUMNS,
+    RIG_COLUMNS,
+    STEP_REQUIRED,
     VERSION,
     VERSION_ATTR,
     GroupSummary,
@@ -98,7 +111,8 @@ def _damage_is_an_error(path, what: str):
 
 class Recording:
     """A recording opened for reading: ``cameras``, ``rigs``, ``steps``, ``removed``,
-    ``events``, ``metadata``, ``legend``, ``version``. Arrays are read when indexed."""
+    ``events``, ``metadata``, ``legend``, ``version`` (and ``minor_version``: 0 for format
+    1.0, 1 for 1.1). Arrays are read when indexed."""
 
     def __init__(self, path) -> None:
         self.path = Path(path)
@@ -108,6 +122,7 @@ class Recording:
     def _open(self) -> None:
         head = _read_head(self.path)
         self.version: int = head["version"]
+        self.minor_version: int = head["minor_version"]
         self.recording_id: str = head["recording_id"]
         self.created: str = head["created"]
         self.software_version: str = head["software_version"]
@@ -115,11 +130,15 @@ class Recording:
         self.metadata: dict = head["metadata"]
         self.legend: dict = head["legend"]
         self.conventions: dict = head["conventions"]
+        # The texts as stored, which repair() writes back unchanged.
+        self.metadata_text: str = head["metadata_text"]
+        self.legend_text: str = head["legend_text"]
         self.part_summaries = scan_parts(self.path, self.recording_id)
         if self.complete:
             _check_index(self.path, head["parts"], self.part_summaries)
         self._files = _PartFiles([p.path for p in self.part_summaries])
         self._groups = _concatenate_groups(self.path, self.part_summaries)
+        _check_layout(self.part_summaries, self._groups)
         self.cameras: dict[str, CameraStream] = {
             name.split("/", 1)[1]: CameraStream(self._columns(name), attrs)
             for name, (_, attrs) in self._groups.items()
@@ -195,7 +214,8 @@ class Recording:
     def __repr__(self) -> str:
         cameras = ", ".join(f"{n}: {len(s)}" for n, s in self.cameras.items())
         return (
-            f"<Recording {self.path} v{self.version}, {len(self.parts)} parts, cameras "
+            f"<Recording {self.path} v{self.version}.{self.minor_version}, {len(self.parts)} "
+            f"parts, cameras "
             f"{{{cameras}}}, rigs {list(self.rigs)}, {self.rows('steps')} steps, "
             f"{self.rows('removed')} removed voxels, {self.rows('events')} events"
             f"{'' if self.complete else ', not closed (interrupted)'}>"
@@ -321,6 +341,7 @@ class RigStream(Sequence):
     def __init__(self, name: str, columns: dict[str, Column], attrs: dict, recording) -> None:
         self.name = name
         self.columns = columns
+        self._path = recording.path
         try:
             self.left = recording.cameras[attrs["left"]]
             self.right = recording.cameras[attrs["right"]]
@@ -335,11 +356,20 @@ class RigStream(Sequence):
     def __getitem__(self, index):
         index = self.columns["baseline"]._normalise(int(index))
         return StereoFrame(
-            left=self.left[int(self.columns["left_index"][index])],
-            right=self.right[int(self.columns["right_index"][index])],
+            left=self._view(self.left, "left_index", index),
+            right=self._view(self.right, "right_index", index),
             baseline=float(self.columns["baseline"][index]),
             dcx=float(self.columns["dcx"][index]),
         )
+
+    def _view(self, stream: CameraStream, column: str, index: int) -> RecordedFrame:
+        row = int(self.columns[column][index])
+        if not 0 <= row < len(stream):
+            raise RecordingError(
+                f"{self._path}: rigs/{self.name}/{column}[{index}] is {row}, but stream "
+                f"{stream.name} has {len(stream)} frames"
+            )
+        return stream[row]
 
     def __getattr__(self, name: str):
         if name in ("columns", "left", "right", "name"):
@@ -355,7 +385,7 @@ class _PartFiles:
 
     def __init__(self, paths: list[Path]) -> None:
         self._paths = paths
-        self._open: OrderedDict[int, h5py.File] = OrderedDict()
+        self._open: OrderedDict[int, CheckedFile] = OrderedDict()
 
     def path(self, index: int) -> Path:
         return self._paths[index]
@@ -363,37 +393,23 @@ class _PartFiles:
     def get(self, index: int) -> h5py.File:
         f = self._open.get(index)
         if f is None:
-            f = self._open[index] = _open_hdf5(self._paths[index])
+            f = self._open[index] = open_checked(self._paths[index])
             if len(self._open) > MAX_OPEN_PARTS:
                 self._open.popitem(last=False)[1].close()
         self._open.move_to_end(index)
-        return f
+        return f.file
 
     def close(self) -> None:
         while self._open:
             self._open.popitem()[1].close()
 
 
-def _open_hdf5(path: Path) -> h5py.File:
-    if not path.is_file():
-        raise RecordingError(f"{path}: no such file")
-    try:
-        return h5py.File(path, "r")
-    except OSError as error:
-        raise RecordingError(f"{path}: not a readable HDF5 file ({error})") from None
-
-
-def _text(value) -> str | None:
-    if value is None:
-        return None
-    return value.decode() if isinstance(value, bytes) else str(value)
-
-
 def _read_head(path: Path) -> dict:
     """The head's attributes, checked: format, version, JSON metadata and legend."""
-    with _open_hdf5(path) as f:
-        attrs = f.attrs
-        found = _text(attrs.get("format"))
+    checked = open_checked(path, heaps="always")
+    with checked.file as f:
+        attrs = read_attributes(checked, f)
+        found = text_value(attrs.get("format"))
         if found != FORMAT:
             raise RecordingError(
                 f"{path}: not an ambfplus recording (root attribute 'format' is {found!r}, "
@@ -403,7 +419,7 @@ def _read_head(path: Path) -> dict:
             raise RecordingError(
                 f"{path}: this is one part of a recording; open its head file instead"
             )
-        version = attrs.get(VERSION_ATTR)
+        version = read_attribute(checked, f, VERSION_ATTR, expect="integer")
         if version is None or int(version) != VERSION:
             version = version.item() if isinstance(version, np.generic) else version
             raise RecordingError(
@@ -411,16 +427,23 @@ def _read_head(path: Path) -> dict:
                 f"supported; this ambfplus reads version {VERSION}"
             )
         try:
+            metadata = text_value(attrs.get("metadata")) or "{}"
+            legend = text_value(attrs.get("legend")) or "{}"
             return {
                 "version": int(version),
-                "recording_id": _text(attrs["recording_id"]),
-                "created": _text(attrs.get("created")),
-                "software_version": _text(attrs.get("software_version")),
+                "minor_version": int(attrs.get(MINOR_VERSION_ATTR, 0)),
+                "recording_id": text_value(attrs["recording_id"]),
+                "created": text_value(attrs.get("created")),
+                "software_version": text_value(attrs.get("software_version")),
                 "complete": bool(attrs.get("complete", False)),
-                "metadata": json.loads(_text(attrs.get("metadata")) or "{}"),
-                "legend": legend_from_json(_text(attrs.get("legend")) or "{}"),
-                "parts": json.loads(_text(attrs.get("parts")) or "[]"),
-                "conventions": {k: _text(v) for k, v in f["conventions"].attrs.items()}
+                "metadata": json.loads(metadata),
+                "metadata_text": metadata,
+                "legend": legend_from_json(legend),
+                "legend_text": legend,
+                "parts": json.loads(text_value(attrs.get("parts")) or "[]"),
+                "conventions": {
+                    k: text_value(v) for k, v in read_attributes(checked, f["conventions"]).items()
+                }
                 if "conventions" in f
                 else {},
             }
@@ -445,25 +468,29 @@ def scan_parts(head: Path, recording_id: str) -> list[PartSummary]:
 
 
 def _summarise_part(path: Path, recording_id: str, number: int) -> PartSummary:
-    with _open_hdf5(path) as f:
-        if _text(f.attrs.get("recording_id")) != recording_id or f.attrs.get("part") != number:
+    checked = open_checked(path)
+    with checked.file as f:
+        found_id = text_value(read_attribute(checked, f, "recording_id"))
+        found_number = read_attribute(checked, f, "part", expect="integer")
+        if found_id != recording_id or found_number != number:
             raise RecordingError(
                 f"{path}: not part {number} of recording {recording_id} (attributes "
-                f"'recording_id', 'part' say {_text(f.attrs.get('recording_id'))}, "
-                f"{f.attrs.get('part')})"
+                f"'recording_id', 'part' say {found_id}, {found_number})"
             )
         summary = PartSummary(path)
-        f.visititems(lambda name, obj: _summarise_group(path, summary, name, obj))
+        f.visititems(lambda name, obj: _summarise_group(checked, summary, name, obj))
         return summary
 
 
-def _summarise_group(path: Path, summary: PartSummary, name: str, obj) -> None:
+def _summarise_group(checked: CheckedFile, summary: PartSummary, name: str, obj) -> None:
     if not isinstance(obj, h5py.Dataset):
         return
+    path = checked.path
+    check_dataset_type(checked, name, obj)
     group, column = name.rsplit("/", 1) if "/" in name else ("", name)
     entry = summary.groups.get(group)
     if entry is None:
-        attrs = {k: _text(v) for k, v in obj.parent.attrs.items()}
+        attrs = {k: text_value(v) for k, v in read_attributes(checked, obj.parent).items()}
         entry = summary.groups[group] = GroupSummary(obj.shape[0] if obj.shape else 0, {}, attrs)
     if not obj.shape or obj.shape[0] != entry.rows:
         other = next(iter(entry.datasets), None)
@@ -471,8 +498,10 @@ def _summarise_group(path: Path, summary: PartSummary, name: str, obj) -> None:
             f"{path}: inconsistent lengths: dataset {name} has shape {obj.shape}, but "
             f"{group}/{other} has {entry.rows} rows"
         )
-    dtype = np.dtype(object) if h5py.check_string_dtype(obj.dtype) else obj.dtype
-    entry.datasets[column] = (dtype, obj.shape[1:])
+    string = h5py.check_string_dtype(obj.dtype)
+    if string:
+        entry.strings[column] = (string.encoding, string.length)
+    entry.datasets[column] = (np.dtype(object) if string else obj.dtype, obj.shape[1:])
 
 
 def _concatenate_groups(head: Path, parts: list[PartSummary]) -> dict:
@@ -490,6 +519,60 @@ def _concatenate_groups(head: Path, parts: list[PartSummary]) -> dict:
                 )
             pieces.append((index, group))
     return groups
+
+
+# Columns every group of a kind must have: name -> (dtype, trailing shape); None = text.
+_REQUIRED = {
+    "cameras/": FRAME_COLUMNS,
+    "rigs/": RIG_COLUMNS,
+    "removed": REMOVED_COLUMNS,
+    "events": EVENT_COLUMNS,
+    "steps": {name: (dtype, ()) for name, dtype in STEP_REQUIRED.items()},
+}
+
+
+def _check_layout(parts: list[PartSummary], groups: dict) -> None:
+    """Every group has its kind's columns with their types and shapes, and a camera stream at
+    least one image pass of its type (else a damaged file fails later, outside the reader)."""
+    for name, (pieces, _) in groups.items():
+        kind = name.split("/", 1)[0] + "/" if "/" in name else name
+        if kind not in _REQUIRED:
+            continue
+        path, datasets = parts[pieces[0][0]].path, pieces[0][1].datasets
+        expected = dict(_REQUIRED[kind])
+        if kind == "cameras/":
+            if not any(p in datasets for p in IMAGE_PASSES):
+                raise RecordingError(f"{path}: {name} holds no image pass of {list(IMAGE_PASSES)}")
+            expected.update({p: (d, (None, None) + t) for p, (d, t) in IMAGE_PASSES.items()})
+        for column, (dtype, trailing) in expected.items():
+            found = datasets.get(column)
+            if found is None and (kind != "cameras/" or column not in IMAGE_PASSES):
+                raise RecordingError(f"{path}: {name} has no dataset '{column}'")
+            if found is not None and not _same_layout(found, dtype, trailing):
+                want = "text" if dtype is None else f"{dtype} {_shape_text(trailing)}"
+                raise RecordingError(
+                    f"{path}: {name}/{column} is {found[0]} {tuple(found[1])} per row, "
+                    f"expected {want}"
+                )
+
+
+def _same_layout(found: tuple, dtype, trailing: tuple) -> bool:
+    """A dataset's (dtype, shape of a row) against the layout's (None in a shape: any size,
+    None as dtype: text). Byte order does not matter."""
+    found_dtype, found_trailing = np.dtype(found[0]), tuple(found[1])
+    if dtype is None:
+        return found_dtype.kind == "O" and found_trailing == tuple(trailing)
+    dtype = np.dtype(dtype)
+    if (found_dtype.kind, found_dtype.itemsize) != (dtype.kind, dtype.itemsize):
+        return False
+    return len(found_trailing) == len(trailing) and all(
+        want is None or want == got for want, got in zip(trailing, found_trailing)
+    )
+
+
+def _shape_text(trailing: tuple) -> str:
+    names = iter("HW")
+    return "(" + ", ".join(next(names) if n is None else str(n) for n in trailing) + ")"
 
 
 def _describe(datasets: dict) -> str:

@@ -16,6 +16,11 @@ from ._core import ConfigError
 FORMAT = "ambfplus.recording"
 VERSION = 1
 VERSION_ATTR = "ambfplus_recording_version"
+# 1.1: text (attributes, string columns) is stored as fixed-length UTF-8 strings, never
+# variable-length, so that reading needs no global heap (see ``recording_hdf5``). Files without
+# this attribute are 1.0. Readers of 1.0 read 1.1 files (fixed-length strings come back as bytes).
+MINOR_VERSION = 1
+MINOR_VERSION_ATTR = "ambfplus_recording_minor_version"
 
 # Per-pixel camera outputs: dtype and trailing shape after (H, W).
 IMAGE_PASSES = {
@@ -49,7 +54,7 @@ REMOVED_COLUMNS = {
 }
 EVENT_COLUMNS = {
     "step": (np.dtype(np.int64), ()),
-    "kind": (None, ()),  # variable-length UTF-8 string
+    "kind": (None, ()),  # UTF-8 text
     "label": (np.dtype(np.uint16), ()),
     "voxel": (np.dtype(np.int32), (3,)),
 }
@@ -88,10 +93,34 @@ class RecordingError(ConfigError):
     """A file that is not a readable ambfplus recording, or a recorder that failed."""
 
 
-def string_dtype():
+def text_dtype(length: int | None):
+    """h5py's dtype for UTF-8 text: fixed-length (`length` bytes), or variable-length for None
+    (format 1.0 only)."""
     import h5py
 
-    return h5py.string_dtype("utf-8")
+    return h5py.string_dtype("utf-8", length)
+
+
+def text_attribute(text: str, where: str) -> np.ndarray:
+    """A fixed-length UTF-8 string value for an HDF5 attribute (at least 1 byte long)."""
+    encoded = check_text(text, where).encode("utf-8")
+    return np.array(encoded, dtype=text_dtype(max(1, len(encoded))))
+
+
+def text_column(values: np.ndarray) -> np.ndarray:
+    """Text rows (an object array of str) as fixed-length UTF-8 strings, as wide as the
+    longest (at least 1 byte)."""
+    encoded = [value.encode("utf-8") for value in values.ravel()]
+    width = max([1] + [len(e) for e in encoded])
+    return np.array(encoded, dtype=text_dtype(width)).reshape(values.shape)
+
+
+def check_text(text: str, where: str) -> str:
+    """Text HDF5 can store: fixed-length strings drop trailing NULs, variable-length ones
+    refuse any."""
+    if "\0" in text:
+        raise ValueError(f"{where}: text may not contain NUL characters, got {text!r}")
+    return text
 
 
 def part_name(head: Path, number: int) -> Path:
@@ -127,11 +156,14 @@ def glob_escape(name: str) -> str:
 
 @dataclass
 class GroupSummary:
-    """One group of one part: its row count, datasets (dtype, trailing shape) and attributes."""
+    """One group of one part: its row count, datasets (dtype, trailing shape; text is dtype
+    object), attributes, and how each text dataset is stored: (encoding, length in bytes, None
+    for variable-length)."""
 
     rows: int
     datasets: dict[str, tuple[np.dtype, tuple[int, ...]]] = field(default_factory=dict)
     attrs: dict[str, object] = field(default_factory=dict)
+    strings: dict[str, tuple[str, int | None]] = field(default_factory=dict)
 
 
 @dataclass

@@ -8,8 +8,9 @@ from pathlib import Path
 
 import numpy as np
 
+from .recording_hdf5 import check_global_heaps
 from .recording_reader import _DAMAGE, CameraStream, Recording, RigStream, open_recording
-from .recording_schema import RecordingError, glob_escape
+from .recording_schema import RecordingError, find_parts, glob_escape
 from .stereo import disparity_agreement
 
 POINTS_RELATIVE_TOLERANCE = 1e-4
@@ -82,14 +83,16 @@ def validate(path, match_images: bool = True) -> ValidationReport:
     """Opens the recording and checks it: lengths, increasing steps and times, depth against
     points, rig geometry, removed labels against the legend, removed voxels not seen later.
     `match_images` also block-matches three stereo pairs against their depth and baseline (the
-    costliest check: about as much CPU as rendering the recording took)."""
+    costliest check: about as much CPU as rendering the recording took). Before it opens the
+    recording, it checks the global heaps of every file (see ``ambfplus.recording_hdf5``)."""
     path = Path(path)
     try:
+        heaps = _heaps_check(path)
         recording = open_recording(path)
     except (RecordingError, OSError) as error:
         return ValidationReport(path, [Check("open", "fail", str(error))])
     with recording:
-        checks = [_open_check(recording), _leftover_check(path)]
+        checks = [_open_check(recording), heaps, _leftover_check(path)]
         try:
             for name, stream in recording.cameras.items():
                 checks += _stream_checks(f"cameras/{name}", stream)
@@ -117,6 +120,15 @@ def _open_check(recording: Recording) -> Check:
         "flush; ambfplus.recording.repair(path) completes the head",
         numbers,
     )
+
+
+def _heaps_check(path: Path) -> Check:
+    """Every file's global heap collections walked as libhdf5 walks them (raises a
+    RecordingError naming the file and collection that would make libhdf5 loop)."""
+    files = [path] + [part for _, part in find_parts(path)]
+    collections = sum(check_global_heaps(file) for file in files)
+    numbers = {"files": len(files), "collections": collections}
+    return Check("global heaps", "pass", "every collection ends where it says it does", numbers)
 
 
 def _equal_lengths(name: str, columns: dict) -> Check:

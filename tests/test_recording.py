@@ -174,15 +174,17 @@ def test_plain_h5py_reads_the_closed_head_as_one_file(drilled_recording, tmp_pat
     path, _, snapshots, _ = drilled_recording
     monkeypatch.chdir(tmp_path.parent)  # parts are found beside the head, not in the cwd
     with h5py.File(path, "r") as f:
-        assert f.attrs["format"] == "ambfplus.recording"
+        # Text attributes are fixed-length UTF-8 strings, which h5py gives as bytes.
+        assert f.attrs["format"] == b"ambfplus.recording"
         assert f.attrs["ambfplus_recording_version"] == 1
+        assert f.attrs["ambfplus_recording_minor_version"] == 1
         depth = f["cameras/rig_left/depth"]
         assert depth.is_virtual and depth.shape == (4, 48, 64)
         for i, (want, _, baseline, _) in enumerate(snapshots):
             assert np.array_equal(depth[i], want["depth"])
             assert np.array_equal(f["cameras/rig_left/pose"][i], want["pose"])
             assert f["rigs/rig/baseline"][i] == baseline
-        assert f["rigs/rig"].attrs["left"] == "rig_left"
+        assert f["rigs/rig"].attrs["left"].decode() == "rig_left"
         assert json.loads(f.attrs["metadata"])["seed"] == 0
         assert f["events/kind"].asstr()[0] == "critical"
 

@@ -101,7 +101,8 @@ def recording_seeds() -> None:
 
         legend = {1: {"name": "ear", "kind": "volume", "labels": {1: {"name": "Bone"}},
                       "shape": [4, 4, 4]}}  # fmt: skip
-        with Recorder(path, metadata={"scene": "seed"}, compression="gzip") as rec:
+        with Recorder(path, metadata={"scene": "seed"}, compression="gzip",
+                      recording_id="seed", created="2026-01-01T00:00:00+00:00") as rec:  # fmt: skip
             rec.set_legend(legend)
             for i in range(2):
                 rec.add_stereo("rig", Pair(i))

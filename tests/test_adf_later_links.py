@@ -184,3 +184,39 @@ def test_load_volumes_still_refuses_a_drill_without_its_volume(tmp_path):
     path = write(tmp_path, "drill.yaml", DRILL_ON_SLAB)
     with pytest.raises(ambfplus.ConfigError, match="not one of the file's volumes"):
         ambfplus.World().load_volumes(path)
+
+
+VOLUME_PLUGIN_PY = """
+import os
+
+import ambfplus
+
+
+class Note(ambfplus.Plugin):
+    def init(self):
+        with open(os.environ["AMBFPLUS_TEST_VOLUME_PLUGIN"], "a") as f:
+            f.write(f"init {self.object.name} {self.object.kind}\\n")
+        return 1
+"""
+
+
+def test_volume_blocks_load_their_plugins_and_warn_of_keys_not_applied(
+    tmp_path, monkeypatch, caplog
+):
+    slices(tmp_path)
+    log = tmp_path / "volume_plugin.log"
+    monkeypatch.setenv("AMBFPLUS_TEST_VOLUME_PLUGIN", str(log))
+    (tmp_path / "note.py").write_text(VOLUME_PLUGIN_PY)
+    block = VOLUME_ON_BASE.replace("      parent: BODY base\n", "").rstrip(" ") + (
+        "      plugins: [{name: note, filename: note.py, path: .}]\n"
+        "      color rgba: {r: 1.0, g: 0.0, b: 0.0, a: 1.0}\n"
+        "      colour: red\n"
+    )
+    write(tmp_path, "volume.yaml", block)
+    world = ambfplus.World()
+    with caplog.at_level("WARNING"):
+        world.load_adf(tmp_path / "volume.yaml")
+    assert log.read_text().splitlines() == ["init slab volume"]
+    messages = " ".join(r.getMessage() for r in caplog.records)
+    assert "'color rgba' is not applied" in messages
+    assert "unknown key 'colour'" in messages

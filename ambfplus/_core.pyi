@@ -1608,7 +1608,7 @@ class RigidBody(Object):
     @property
     def overlapping(self) -> list:
         """
-        a ghost's overlapping bodies after the last step (Bullet's narrow phase), in creation order; ValueError for a body that is not a ghost
+        a ghost's overlapping bodies after the last step, in creation order: rigid bodies (Bullet's narrow phase) and soft bodies with a node inside its convex parts; ValueError for a body that is not a ghost
         """
     @property
     def radius(self) -> float:

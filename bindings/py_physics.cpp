@@ -225,11 +225,12 @@ void define_body(BodyClass& body) {
           "overlapping",
           [](RigidBody& b) {
             py::list out;
-            for (RigidBody* o : ghost_overlaps(b)) out.append(handle(o, b.world()));
+            for (Object* o : ghost_overlaps(b)) out.append(handle(o, b.world()));
             return out;
           },
-          "a ghost's overlapping bodies after the last step (Bullet's narrow phase), in "
-          "creation order; ValueError for a body that is not a ghost");
+          "a ghost's overlapping bodies after the last step, in creation order: rigid bodies "
+          "(Bullet's narrow phase) and soft bodies with a node inside its convex parts; "
+          "ValueError for a body that is not a ghost");
 }
 
 void define_joint(JointClass& joint) {

@@ -56,6 +56,10 @@ struct ObjectPlugins {
   std::vector<AdfPlugin> plugins;
 };
 
+/// Plugins of an object a deferred link made once a later file brought what it waited for:
+/// the resolve_deferred that made it loads them when it is done, into that load's report.
+void load_plugins_later(ObjectPlugins plugins, std::string file);
+
 /// A `shaders: {path, vertex, fragment}` block (key names it in messages): `path` relative to
 /// the file, the two files relative to `path`. A missing file is a warning and gives nullopt
 /// (the engine's own shader draws).
@@ -88,11 +92,13 @@ void add_cameras_and_lights(Model& model, const Doc& doc, const std::string& bas
 Model& load_model(World& world, const std::string& path, Context& ctx);
 
 /// Volumes (each from its slice stack) and then drills on them, added to model. A non-empty
-/// labels file overrides the blocks' label tables.
-std::vector<Volume*> add_adf_volumes(Model& model, const std::string& path,
-                                     const std::string& labels,
-                                     const std::vector<AdfVolumeBlock>& volumes,
-                                     std::vector<AdfDrillBlock> drills);
+/// labels file overrides the blocks' label tables. A volume's `parent` and a drill's volume
+/// that the file lacks are looked up in own (the file's bodies), then the world under ns,
+/// now or once a later file brings them.
+std::vector<Volume*> add_adf_volumes(
+    Model& model, const std::string& path, const std::string& labels,
+    const std::vector<AdfVolumeBlock>& volumes, std::vector<AdfDrillBlock> drills,
+    const std::string& ns = "", const std::vector<std::pair<std::string, RigidBody*>>& own = {});
 
 }  // namespace adf
 }  // namespace ambfplus

@@ -168,13 +168,14 @@ Eigen::Isometry3d parent_frame(const Object& parent) {
 
 }  // namespace
 
-void now_or_later(Model& model, const Doc& doc, const std::function<std::string()>& missing,
+void now_or_later(Model& model, const std::string& file,
+                  const std::function<std::string()>& missing,
                   std::function<bool(World&)> attempt) {
   if (attempt(model.world())) return;
-  model.world().defer_link({&model, doc.path, missing(), std::move(attempt)});
+  model.world().defer_link({&model, file, missing(), std::move(attempt)});
 }
 
-void attach_when_found(Model& model, const Doc& doc, Object& child, const std::string& id,
+void attach_when_found(Model& model, const std::string& file, Object& child, const std::string& id,
                        const std::string& parent, const std::string& ns,
                        const std::vector<std::pair<std::string, RigidBody*>>& own,
                        const Eigen::Isometry3d& local) {
@@ -188,7 +189,7 @@ void attach_when_found(Model& model, const Doc& doc, Object& child, const std::s
     return true;
   };
   now_or_later(
-      model, doc,
+      model, file,
       [&] {
         std::string why;
         find_object(model.world(), parent, ns, own, std::nullopt, why);
@@ -218,7 +219,7 @@ void add_cameras_and_lights(Model& model, const Doc& doc, const std::string& bas
     camera.set_name_space(c.ns);
     camera.set_preprocessing_shader(c.preprocessing);
     camera.look_at(c.eye, c.target, c.up);
-    attach_when_found(model, doc, camera, c.id, c.parent, c.ns, own, camera.pose());
+    attach_when_found(model, doc.path, camera, c.id, c.parent, c.ns, own, camera.pose());
     if (c.eye_separation > 0) {
       // AMBF's passive stereo: two eyes half the separation either side, converging (off-axis)
       // at the focal length when one is given.
@@ -243,7 +244,7 @@ void add_cameras_and_lights(Model& model, const Doc& doc, const std::string& bas
     Light& light = model.add_light(l.spec);
     light.set_identifier(l.id);
     light.set_name_space(l.ns);
-    attach_when_found(model, doc, light, l.id, l.parent, l.ns, own, light.pose());
+    attach_when_found(model, doc.path, light, l.id, l.parent, l.ns, own, light.pose());
     if (!l.plugins.empty()) plugins.push_back({&light, l.id, l.plugins});
   }
 }

@@ -10,6 +10,7 @@
 #include <Eigen/Geometry>
 
 #include "adf/adf_internal.h"
+#include "ambfplus/log.h"
 #include "ambfplus/plugin/registry.h"
 #include "ambfplus/scene/simulator.h"
 #include "ambfplus/scene/world.h"
@@ -83,12 +84,36 @@ void adf::load_plugins(const std::vector<ObjectPlugins>& objects, const std::str
   }
 }
 
+namespace {
+
+// The plugins of objects made while resolve_deferred runs, with their files.
+thread_local std::vector<std::pair<adf::ObjectPlugins, std::string>>* made_late = nullptr;
+
+}  // namespace
+
+void adf::load_plugins_later(ObjectPlugins plugins, std::string file) {
+  if (made_late == nullptr) {
+    // Deferred links are only resolved by resolve_deferred; kept honest all the same.
+    log(LogLevel::kWarning, file + ": " + plugins.where + ": its plugins are not loaded");
+    return;
+  }
+  made_late->emplace_back(std::move(plugins), std::move(file));
+}
+
 void adf::resolve_deferred(World& world, Context& ctx) {
+  std::vector<std::pair<ObjectPlugins, std::string>> made;
+  made_late = &made;
   try {
     world.resolve_deferred_links();
+    made_late = nullptr;
   } catch (const Error& e) {
+    made_late = nullptr;
     if (!ctx.report_plugin_errors) throw;
     ctx.diag->error("", std::string("attaching to a parent loaded later: ") + e.what());
+  }
+  // Their files are built, and so is the one that brought what they waited for.
+  for (const auto& [o, file] : made) {
+    load_plugins(o.plugins, PluginSite::of(*o.object), file, o.where, ctx);
   }
 }
 

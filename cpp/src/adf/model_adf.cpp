@@ -36,7 +36,7 @@ Object* find_object(World& world, const std::string& ref, const std::string& ns,
                 found.end());
   }
   if (found.size() == 1) return found.front();
-  const std::string what = kind ? "body" : "object";
+  const std::string what = kind ? object_kind_name(*kind) : "object";
   if (found.empty()) {
     why = "no " + what + " '" + ref + "' in the file or the world";
   } else {
@@ -217,14 +217,10 @@ Model& load_model(World& world, const std::string& path, Context& ctx) {
         return find_body(world, j.parent, model_ns, own, why) != nullptr &&
                find_body(world, j.child, model_ns, own, why) != nullptr;
       }();
-      if (!now && !j.plugins.empty()) {
-        ctx.diag->warn(doc.path, at(j.block) + j.id +
-                                     ": its plugins are not loaded: its bodies come in a later "
-                                     "file");
-      }
-      // Plugins only for a joint made now (a later one's file has finished loading).
+      // A joint made now has its plugins loaded with its file's; one made later when the load
+      // that brought its bodies is done.
       std::vector<ObjectPlugins>* sink = now ? &object_plugins : nullptr;
-      auto make = [target, plan = j, model_ns, own, sink](World& w) {
+      auto make = [target, plan = j, model_ns, own, sink, file = doc.path](World& w) {
         std::string why;
         RigidBody* parent = find_body(w, plan.parent, model_ns, own, why);
         RigidBody* child = find_body(w, plan.child, model_ns, own, why);
@@ -241,13 +237,18 @@ Model& load_model(World& world, const std::string& path, Context& ctx) {
         if (plan.six_dof) set_six_dof_axes(joint, *plan.six_dof);
         if (plan.cone)
           set_cone_twist_limits(joint, (*plan.cone)[0], (*plan.cone)[1], (*plan.cone)[2]);
-        if (sink != nullptr && !plan.plugins.empty()) {
-          sink->push_back({&joint, plan.id, plan.plugins});
+        if (!plan.plugins.empty()) {
+          ObjectPlugins plugins{&joint, plan.id, plan.plugins};
+          if (sink != nullptr) {
+            sink->push_back(std::move(plugins));
+          } else {
+            load_plugins_later(std::move(plugins), file);
+          }
         }
         return true;
       };
       now_or_later(
-          model, doc,
+          model, doc.path,
           [&] {
             std::string why_parent, why_child;
             const bool has_parent =
@@ -261,7 +262,12 @@ Model& load_model(World& world, const std::string& path, Context& ctx) {
     }
     for (SensorPlan& p : sensors) {
       current = p.id;
-      auto make = [target, plan = p, model_ns, own](World& w) {
+      std::vector<ObjectPlugins>* sink = [&] {
+        std::string why;
+        return find_body(world, p.parent, model_ns, own, why) != nullptr ? &object_plugins
+                                                                         : nullptr;
+      }();
+      auto make = [target, plan = p, model_ns, own, sink, file = doc.path](World& w) {
         std::string why;
         RigidBody* parent = find_body(w, plan.parent, model_ns, own, why);
         if (parent == nullptr) return false;
@@ -279,10 +285,18 @@ Model& load_model(World& world, const std::string& path, Context& ctx) {
         }
         made->set_identifier(plan.id);
         made->set_name_space(plan.ns);
+        if (!plan.plugins.empty()) {
+          ObjectPlugins plugins{made, plan.id, plan.plugins};
+          if (sink != nullptr) {
+            sink->push_back(std::move(plugins));
+          } else {
+            load_plugins_later(std::move(plugins), file);
+          }
+        }
         return true;
       };
       now_or_later(
-          model, doc,
+          model, doc.path,
           [&] {
             std::string why;
             find_body(world, p.parent, model_ns, own, why);
@@ -297,13 +311,21 @@ Model& load_model(World& world, const std::string& path, Context& ctx) {
       ghost.set_identifier(g.body.id);
       ghost.set_name_space(g.body.ns);
       if (!g.body.plugins.empty()) object_plugins.push_back({&ghost, g.body.id, g.body.plugins});
-      attach_when_found(model, doc, ghost, g.body.id, g.parent, g.body.ns, own,
+      attach_when_found(model, doc.path, ghost, g.body.id, g.parent, g.body.ns, own,
                         Eigen::Isometry3d(g.body.spec.pose));
     }
     current = "cameras and lights";
     add_cameras_and_lights(model, doc, model_ns, ctx, own, object_plugins);
     current = "volumes";
-    if (has_volumes || !drills.empty()) add_adf_volumes(model, path, "", volumes, drills);
+    if (has_volumes || !drills.empty()) {
+      const std::vector<Volume*> made =
+          add_adf_volumes(model, path, "", volumes, drills, model_ns, own);
+      for (std::size_t i = 0; i < made.size(); ++i) {
+        if (!volumes[i].plugins.empty()) {
+          object_plugins.push_back({made[i], volumes[i].identifier, volumes[i].plugins});
+        }
+      }
+    }
     // Plugins once the model is built: its objects' in creation order, then its own.
     load_plugins(object_plugins, doc.path, ctx);
     load_plugins(model_plugins, PluginSite::of(model), doc.path, where, ctx);

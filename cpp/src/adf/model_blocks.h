@@ -91,6 +91,7 @@ struct SensorPlan {
   bool actuator = false;
   ProximitySensorSpec sensor;
   ConstraintActuatorSpec act;
+  std::vector<AdfPlugin> plugins;
 };
 /// A `sensors` or `actuators` block (sensor_adf.cpp), or nothing (with a warning) for types
 /// ambfplus lacks.
@@ -113,12 +114,12 @@ RigidBody* find_body(World& world, const std::string& ref, const std::string& ns
 /// Runs attempt now; if what it names is not in the world yet, keeps it to run again when a later
 /// file brings it (AMBF resolves parents across files, in any order). `missing` is the warning
 /// if that never happens.
-void now_or_later(Model& model, const Doc& doc, const std::function<std::string()>& missing,
-                  std::function<bool(World&)> attempt);
+void now_or_later(Model& model, const std::string& file,
+                  const std::function<std::string()>& missing, std::function<bool(World&)> attempt);
 
 /// Attaches child to the object parent names (looked up in own, then the world) at local in
 /// that object's frame, now or once it appears.
-void attach_when_found(Model& model, const Doc& doc, Object& child, const std::string& id,
+void attach_when_found(Model& model, const std::string& file, Object& child, const std::string& id,
                        const std::string& parent, const std::string& ns,
                        const std::vector<std::pair<std::string, RigidBody*>>& own,
                        const Eigen::Isometry3d& local);

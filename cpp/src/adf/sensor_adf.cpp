@@ -26,12 +26,12 @@ std::optional<SensorPlan> plan_sensor(const Doc& doc, const std::string& model_n
   if (actuator) {
     ctx.diag->unknown_keys(doc, id, n,
                            {"name", "namespace", "type", "parent", "location", "max impulse", "tau",
-                            "visible", "visible size", "publish frequency", "passive"});
+                            "visible", "visible size", "publish frequency", "passive", "plugins"});
   } else {
     ctx.diag->unknown_keys(
         doc, id, n,
         {"name", "namespace", "type", "parent", "location", "range", "array", "parametric", "mesh",
-         "direction", "visible", "visible size", "publish frequency", "passive"});
+         "direction", "visible", "visible size", "publish frequency", "passive", "plugins"});
   }
   if (!n["parent"]) fail(doc, n, id, std::string("a ") + what + " needs 'parent'");
   SensorPlan p;
@@ -40,6 +40,7 @@ std::optional<SensorPlan> plan_sensor(const Doc& doc, const std::string& model_n
   p.actuator = actuator;
   p.ns = block_ns(doc, ctx, model_ns, id, n);
   p.parent = text(doc, n["parent"], id, "parent");
+  p.plugins = read_plugins(doc, n["plugins"], id);
   const std::string name = block_name(doc, id, n);
   const Eigen::Matrix4d location = frame(doc, n["location"], id, "location");
   if (actuator) {

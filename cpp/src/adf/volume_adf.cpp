@@ -1,10 +1,13 @@
 #include "ambfplus/adf/volume_adf.h"
 #include "ambfplus/errors.h"
 
+#include <algorithm>
+#include <climits>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 
-#include "adf/adf_internal.h"
+#include "adf/model_blocks.h"
 #include "ambfplus/log.h"
 #include "ambfplus/scene/world.h"
 
@@ -37,8 +40,21 @@ Eigen::Vector3d volume_dimensions(const Doc& doc, const YAML::Node& node, const 
 
 std::vector<AdfVolumeBlock> read_adf_volumes(const std::string& path) {
   const Doc doc = adf::load(path, "ADF file");
+  adf::Diagnostics diag;
   std::vector<AdfVolumeBlock> out;
   for (const auto& [id, block] : adf::listed(doc, "volumes")) {
+    // AMBF 2.0's volume keys, and `labels` (ambfplus's).
+    diag.unknown_keys(doc, id, block,
+                      {"name", "namespace", "parent", "location", "scale", "dimensions", "images",
+                       "labels", "iso-surface value", "quality", "optical density", "shaders",
+                       "plugins", "publish frequency", "passive", "color", "color rgba",
+                       "color components", "use material"});
+    for (const char* key : {"color", "color rgba", "color components", "use material"}) {
+      if (block[key]) {
+        diag.warn(doc.path, adf::at(block[key]) + id + ": '" + key +
+                                "' is not applied: a volume is coloured by its slices and labels");
+      }
+    }
     AdfVolumeBlock v;
     v.identifier = id;
     v.name = adf::block_name(doc, id, block);
@@ -70,6 +86,8 @@ std::vector<AdfVolumeBlock> read_adf_volumes(const std::string& path) {
     v.quality = adf::number_or(doc, block, "quality", id, v.quality);
     v.optical_density = adf::number_or(doc, block, "optical density", id, v.optical_density);
     v.custom_shaders = static_cast<bool>(block["shaders"]);
+    if (block["parent"]) v.parent = adf::text(doc, block["parent"], id, "parent");
+    v.plugins = adf::read_plugins(doc, block["plugins"], id);
     out.push_back(std::move(v));
   }
   return out;
@@ -109,11 +127,12 @@ std::vector<AdfDrillBlock> read_adf_drills(const std::string& path) {
   return out;
 }
 
-std::vector<Volume*> adf::add_adf_volumes(Model& model, const std::string& path,
-                                          const std::string& labels,
-                                          const std::vector<AdfVolumeBlock>& blocks,
-                                          std::vector<AdfDrillBlock> drills) {
-  // Drills are checked before any slices load, so a bad block costs no time.
+std::vector<Volume*> adf::add_adf_volumes(
+    Model& model, const std::string& path, const std::string& labels,
+    const std::vector<AdfVolumeBlock>& blocks, std::vector<AdfDrillBlock> drills,
+    const std::string& ns, const std::vector<std::pair<std::string, RigidBody*>>& own) {
+  // Drills are checked before any slices load, so a bad block costs no time. A drill on a
+  // volume of another file waits for it (SIZE_MAX).
   std::vector<std::size_t> drilled;  // the volume each drill is on
   for (const AdfDrillBlock& d : drills) {
     std::size_t i = 0;
@@ -121,11 +140,7 @@ std::vector<Volume*> adf::add_adf_volumes(Model& model, const std::string& path,
            adf::remove_spaces(d.volume) != blocks[i].name) {
       ++i;
     }
-    if (i == blocks.size()) {
-      throw ConfigError(path, d.identifier + ": 'volume' names '" + d.volume +
-                                  "', which is not one of the file's volumes");
-    }
-    drilled.push_back(i);
+    drilled.push_back(i == blocks.size() ? SIZE_MAX : i);
   }
   std::vector<Volume*> out;
   for (const AdfVolumeBlock& b : blocks) {
@@ -154,15 +169,39 @@ std::vector<Volume*> adf::add_adf_volumes(Model& model, const std::string& path,
     } catch (const ArgumentError& e) {
       throw ConfigError(path, b.identifier + ": " + e.what());
     }
+    // `location` is in the parent's frame, which may come in a later file.
+    attach_when_found(model, path, *out.back(), b.identifier, b.parent, ns, own,
+                      Eigen::Isometry3d(b.pose));
   }
   for (std::size_t k = 0; k < drills.size(); ++k) {
-    AdfDrillBlock& d = drills[k];
-    d.spec.volume = out[drilled[k]];
-    try {
-      model.add_drill(d.spec).set_identifier(d.identifier);
-    } catch (const ArgumentError& e) {
-      throw ConfigError(path, d.identifier + ": " + e.what());
-    }
+    const AdfDrillBlock& d = drills[k];
+    auto make = [target = &model, d, path,
+                 volume = drilled[k] == SIZE_MAX ? nullptr : out[drilled[k]]](World& world) {
+      DrillSpec spec = d.spec;
+      spec.volume = volume;
+      if (spec.volume == nullptr) {
+        std::string why;
+        spec.volume =
+            static_cast<Volume*>(find_object(world, d.volume, "", {}, ObjectKind::kVolume, why));
+        if (spec.volume == nullptr) return false;
+      }
+      try {
+        target->add_drill(spec).set_identifier(d.identifier);
+      } catch (const ArgumentError& e) {
+        throw ConfigError(path, d.identifier + ": " + e.what());
+      }
+      return true;
+    };
+    now_or_later(
+        model, path,
+        [&] {
+          std::string why;
+          find_object(model.world(), d.volume, "", {}, ObjectKind::kVolume, why);
+          return d.identifier + ": drill left out: its 'volume' '" + d.volume +
+                 "' is not one of the file's volumes and " + why +
+                 " (made if a later load brings it)";
+        },
+        make);
   }
   return out;
 }
@@ -171,6 +210,19 @@ std::vector<Volume*> load_adf_volumes(World& world, const std::string& path,
                                       const std::string& labels) {
   const std::vector<AdfVolumeBlock> blocks = read_adf_volumes(path);
   std::vector<AdfDrillBlock> drills = read_adf_drills(path);
+  // Without a launch to bring it later, a drill's volume is in the file or already in the world
+  // (checked before any slices load).
+  for (const AdfDrillBlock& d : drills) {
+    const bool in_file = std::any_of(blocks.begin(), blocks.end(), [&](const AdfVolumeBlock& b) {
+      return d.volume == b.identifier || adf::remove_spaces(d.volume) == b.name;
+    });
+    std::string why;
+    if (!in_file &&
+        adf::find_object(world, d.volume, "", {}, ObjectKind::kVolume, why) == nullptr) {
+      throw ConfigError(path, d.identifier + ": 'volume' names '" + d.volume +
+                                  "', which is not one of the file's volumes (" + why + ")");
+    }
+  }
   Model& model = world.add_model(adf::unique_model_name(world, fs::path(path).stem().string()));
   try {
     return adf::add_adf_volumes(model, path, labels, blocks, std::move(drills));

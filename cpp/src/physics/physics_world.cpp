@@ -164,6 +164,10 @@ void PhysicsWorld::object_removed(Object& object) {
         soft->world->removeSoftBody(soft->body.get());
         soft->world = nullptr;
       }
+      for (RigidBody* g : ghosts_) {
+        std::vector<Object*>& o = body_of(*g)->overlaps;
+        o.erase(std::remove(o.begin(), o.end(), &object), o.end());
+      }
       break;
     }
     case ObjectKind::kActuator: {
@@ -249,7 +253,7 @@ void PhysicsWorld::remove(RigidBody& rb) {
   ghosts_.erase(std::remove(ghosts_.begin(), ghosts_.end(), &rb), ghosts_.end());
   // Ghosts forget a body that goes away.
   for (RigidBody* g : ghosts_) {
-    std::vector<RigidBody*>& o = body_of(*g)->overlaps;
+    std::vector<Object*>& o = body_of(*g)->overlaps;
     o.erase(std::remove(o.begin(), o.end(), &rb), o.end());
   }
   // Actuators let go of it (or of the body their parent holds) while it still exists.

@@ -45,10 +45,11 @@ struct Body : ObjectState {
   std::uint32_t groups = 0;
   btDynamicsWorld* world = nullptr;  // while in one
   RigidBody* owner = nullptr;        // the scene body (ray hits name it)
-  /// A ghost's collision object (its body then stays out of Bullet's world) and the bodies
-  /// overlapping it after the last step.
+  /// A ghost's collision object (its body then stays out of Bullet's world) and the rigid and
+  /// soft bodies overlapping it after the last step.
   std::unique_ptr<btCollisionObject> ghost;
-  std::vector<RigidBody*> overlaps;
+  std::vector<Object*> overlaps;
+  bool warned_concave = false;  // that soft bodies cannot be tested against its mesh
 };
 
 /// A soft body's Bullet side (its user pointer is the scene SoftBody).

@@ -417,7 +417,7 @@ int ambfplus_ghost_overlaps(const AmbfplusWorld* world, AmbfplusId ghost, Ambfpl
   return guarded(-1, [&] {
     const auto& body =
         ambfplus::object_as<ambfplus::RigidBody>(world, ghost, ambfplus::ObjectKind::kRigidBody);
-    const std::vector<ambfplus::RigidBody*> found = ambfplus::ghost_overlaps(body);
+    const std::vector<ambfplus::Object*> found = ambfplus::ghost_overlaps(body);
     for (int i = 0; i < capacity && i < static_cast<int>(found.size()); ++i) {
       ids[i] = found[static_cast<std::size_t>(i)]->id();
     }

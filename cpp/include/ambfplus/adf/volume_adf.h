@@ -3,6 +3,7 @@
 #include <string>
 #include <vector>
 
+#include "ambfplus/adf/adf.h"
 #include "ambfplus/export.h"
 #include "ambfplus/haptics/drill.h"
 #include "ambfplus/scene/volume.h"
@@ -23,6 +24,9 @@ struct AMBFPLUS_API AdfVolumeBlock {
   double quality = 0.5;          ///< `quality`
   double optical_density = 1.0;  ///< `optical density`
   bool custom_shaders = false;   ///< `shaders:` is set (AMBF GLSL; our ray caster is used)
+  /// `parent`, as written, or "": the volume rides on that object, `location` in its frame.
+  std::string parent;
+  std::vector<AdfPlugin> plugins;  ///< `plugins`: the volume's object plugins (path absolute)
 };
 
 /// Reads the volumes an AMBF model file lists under `volumes:`. Throws AssetNotFound for a missing
@@ -32,7 +36,8 @@ AMBFPLUS_API std::vector<AdfVolumeBlock> read_adf_volumes(const std::string& pat
 
 /// A `DRILL <identifier>` block of a model file (an ambfplus extension AMBF ignores), listed under
 /// `drills:`; read but not yet created. Keys, all optional but `volume`: name, volume (a VOLUME
-/// block's identifier or name), location, burr diameters (metres), burr, cursors, cursor spacing,
+/// block's identifier or name, in the same file or, for a model file, any file of the world),
+/// location, burr diameters (metres), burr, cursors, cursor spacing,
 /// shaft radii, stiffness, damping, max force, soft start, friction {static, dynamic}, removal
 /// (physical | compatible), cutting rate, voxels per step.
 struct AMBFPLUS_API AdfDrillBlock {

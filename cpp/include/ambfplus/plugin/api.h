@@ -133,10 +133,10 @@ AMBFPLUS_API int ambfplus_object_attach(AmbfplusWorld* world, AmbfplusId object,
 
 /* ---- Ghost objects ------------------------------------------------------------------------ */
 
-/** The bodies overlapping a ghost object after the last step (Bullet's narrow phase), in
- * creation order: writes up to capacity ids and returns how many there are (-1 when ghost is
- * not a ghost object). Added in ABI 2 without changing it: a plugin that calls it needs an
- * engine that has it. */
+/** The bodies overlapping a ghost object after the last step (rigid bodies by Bullet's narrow
+ * phase, soft bodies with a node inside its convex parts), in creation order: writes up to capacity
+ * ids and returns how many there are (-1 when ghost is not a ghost object). Added in ABI 2 without
+ * changing it: a plugin that calls it needs an engine that has it. */
 AMBFPLUS_API int ambfplus_ghost_overlaps(const AmbfplusWorld* world, AmbfplusId ghost,
                                          AmbfplusId* ids, int capacity);
 

@@ -6,6 +6,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from ._core import ArgumentError
+
 
 def rpy_matrix(rpy: Sequence[float]) -> np.ndarray:
     """Rotation from fixed-axis roll, pitch, yaw (radians), as AMBF files give them.
@@ -25,16 +27,36 @@ def make_pose(
     rpy: Sequence[float] | None = None,
     rotation: np.ndarray | None = None,
 ) -> np.ndarray:
-    """A 4x4 pose from a position and either fixed-axis roll-pitch-yaw or a 3x3 rotation."""
+    """A 4x4 pose from a position and either fixed-axis roll-pitch-yaw or a 3x3 rotation.
+
+    Raises ``ArgumentError`` for non-finite values or a 3x3 that is not a rotation."""
     if rpy is not None and rotation is not None:
-        raise ValueError("give rpy or rotation, not both")
+        raise ArgumentError("make_pose: give rpy or rotation, not both")
     pose = np.eye(4)
     if rpy is not None:
-        pose[:3, :3] = rpy_matrix(rpy)
+        pose[:3, :3] = rpy_matrix(_finite("rpy", rpy, (3,)))
     elif rotation is not None:
-        pose[:3, :3] = np.asarray(rotation, dtype=float).reshape(3, 3)
-    pose[:3, 3] = np.asarray(position, dtype=float).reshape(3)
+        r = _finite("rotation", rotation, (3, 3))
+        if not np.allclose(r.T @ r, np.eye(3), atol=1e-6) or np.linalg.det(r) < 0:
+            raise ArgumentError(
+                "make_pose: rotation must be a rotation matrix (orthonormal, det +1)"
+            )
+        pose[:3, :3] = r
+    pose[:3, 3] = _finite("position", position, (3,))
     return pose
+
+
+def _finite(name: str, value, shape: tuple[int, ...]) -> np.ndarray:
+    """value as a float array of the given shape, or ArgumentError naming make_pose's argument."""
+    try:
+        array = np.asarray(value, dtype=float).reshape(shape)
+    except (TypeError, ValueError):
+        raise ArgumentError(
+            f"make_pose: {name} must be {' x '.join(map(str, shape))} numbers, got {value!r}"
+        ) from None
+    if not np.isfinite(array).all():
+        raise ArgumentError(f"make_pose: {name} must be finite, got {array.tolist()}")
+    return array
 
 
 def rotation_between(a: Sequence[float], b: Sequence[float]) -> np.ndarray:

@@ -97,11 +97,30 @@ DeviceState to_state(const py::handle& value, const char* what) {
     if (py::len(t) > 2) buttons = t[2];
   } else {
     throw ArgumentTypeError(std::string(what) +
-                            " must be a dict {position, orientation, buttons} or a tuple");
+                            " must be a dict {position, orientation, buttons} or a tuple "
+                            "(position[, orientation[, buttons]]), got " +
+                            std::string(py::repr(value)).substr(0, 80));
   }
-  s.position = position.cast<Vec3>();
+  // Wrong types (text for a position) are ambfplus errors naming what was given and expected.
+  auto got = [](const py::handle& v) { return std::string(py::repr(v)).substr(0, 80); };
+  try {
+    s.position = position.cast<Vec3>();
+  } catch (const py::cast_error&) {
+    throw ArgumentTypeError(std::string(what) + ": position must be 3 numbers (x, y, z), got " +
+                            got(position));
+  }
   if (!s.position.allFinite()) throw ArgumentError(std::string(what) + ": position not finite");
-  s.orientation = to_quaternion(orientation);
+  try {
+    s.orientation = to_quaternion(orientation);
+  } catch (const ArgumentTypeError& e) {
+    throw ArgumentTypeError(std::string(what) + ": " + e.what() + ", got " + got(orientation));
+  } catch (const ArgumentError& e) {
+    throw ArgumentError(std::string(what) + ": " + e.what());
+  }
+  if (!py::isinstance<py::int_>(buttons) || py::isinstance<py::bool_>(buttons)) {
+    throw ArgumentTypeError(std::string(what) +
+                            ": buttons must be an integer (a bit per button), got " + got(buttons));
+  }
   const long long b = buttons.cast<long long>();
   if (b < 0 || b > 0xffffffffLL) throw ArgumentError(std::string(what) + ": buttons out of range");
   s.buttons = static_cast<std::uint32_t>(b);
@@ -281,6 +300,10 @@ void define_devices(py::module_& m) {
       .def(
           "set_callback",
           [](ScriptedDevice& d, py::function callback, int every) {
+            const std::string what =
+                "the device callback's result (callback " +
+                std::string(py::str(py::getattr(callback, "__qualname__", py::repr(callback)))) +
+                ")";
             // Holds the callable through a shared_ptr whose deleter takes the GIL, since the
             // sampler may be destroyed on a thread without it.
             auto fn = std::shared_ptr<py::function>(new py::function(std::move(callback)),
@@ -289,9 +312,9 @@ void define_devices(py::module_& m) {
                                                       delete f;
                                                     });
             d.set_sampler(
-                [fn](double time) {
+                [fn, what](double time) {
                   py::gil_scoped_acquire gil;
-                  return to_state((*fn)(time), "the device callback's result");
+                  return to_state((*fn)(time), what.c_str());
                 },
                 every);
           },

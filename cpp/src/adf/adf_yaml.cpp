@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 #include <system_error>
@@ -68,12 +70,34 @@ void fail(const Doc& doc, const YAML::Node& node, const std::string& where,
 
 double number(const Doc& doc, const YAML::Node& node, const std::string& where,
               const std::string& key) {
-  return as<double>(doc, node, where, key, "a number");
+  const double value = as<double>(doc, node, where, key, "a number");
+  // yaml-cpp reads .nan and .inf as numbers; no ADF value means either.
+  if (!std::isfinite(value)) {
+    fail(doc, node, where, "'" + key + "' must be a finite number, got " + node.Scalar());
+  }
+  return value;
 }
 
 int integer(const Doc& doc, const YAML::Node& node, const std::string& where,
             const std::string& key) {
   return as<int>(doc, node, where, key, "an integer");
+}
+
+int integer_or(const Doc& doc, const YAML::Node& parent, const char* key, const std::string& where,
+               const std::string& parent_key, int fallback) {
+  const YAML::Node n = parent[key];
+  return n ? integer(doc, n, where, parent_key + "." + key) : fallback;
+}
+
+YAML::Node mapping(const Doc& doc, const YAML::Node& block, const char* key,
+                   const std::string& where, const std::string& prefix) {
+  if (!block.IsMap()) return YAML::Node();
+  const YAML::Node node = block[key];
+  if (node && !node.IsMap() && !node.IsNull()) {
+    const std::string got = node.IsScalar() ? "'" + node.Scalar() + "'" : "a list";
+    fail(doc, node, where, "'" + prefix + key + "' must be a mapping of keys ({...}), got " + got);
+  }
+  return node;
 }
 
 bool boolean(const Doc& doc, const YAML::Node& node, const std::string& where,
@@ -89,6 +113,10 @@ std::string text(const Doc& doc, const YAML::Node& node, const std::string& wher
 
 double number_or(const Doc& doc, const YAML::Node& parent, const char* key,
                  const std::string& where, double fallback) {
+  if (parent && !parent.IsMap() && !parent.IsNull()) {
+    fail(doc, parent, where, std::string("expected a mapping of keys holding '") + key + "'");
+  }
+  if (!parent.IsMap()) return fallback;
   const YAML::Node n = parent[key];
   return n ? number(doc, n, where, key) : fallback;
 }
@@ -117,13 +145,28 @@ Eigen::Matrix4d frame(const Doc& doc, const YAML::Node& node, const std::string&
   Eigen::Matrix4d pose = Eigen::Matrix4d::Identity();
   if (!node) return pose;
   if (!node.IsMap()) fail(doc, node, where, "'" + key + "' must be {position, orientation}");
-  pose.topRightCorner<3, 1>() =
-      xyz(doc, node["position"], where, key + ".position", Eigen::Vector3d::Zero()) * scale;
+  const YAML::Node position = node["position"];
+  const Eigen::Vector3d p = xyz(doc, position, where, key + ".position", Eigen::Vector3d::Zero());
+  const char* axes[3] = {"x", "y", "z"};
+  for (int a = 0; a < 3; ++a) {
+    // Far beyond any scene, where Bullet's and the renderer's precision is gone.
+    if (std::abs(p[a]) > kMaxPosition) {
+      fail(doc, position[axes[a]], where,
+           "'" + key + ".position." + axes[a] + "' is " + position[axes[a]].Scalar() +
+               " m; positions must be within 1e6 m of the origin");
+    }
+  }
+  pose.topRightCorner<3, 1>() = p * scale;
   if (const YAML::Node o = node["orientation"]) {
     if (!o.IsMap()) fail(doc, o, where, "'" + key + ".orientation' must be {r, p, y}");
-    pose.topLeftCorner<3, 3>() =
-        rpy(number_or(doc, o, "r", where, 0.0), number_or(doc, o, "p", where, 0.0),
-            number_or(doc, o, "y", where, 0.0));
+    double rpy_values[3] = {0.0, 0.0, 0.0};
+    const char* names[3] = {"r", "p", "y"};
+    for (int a = 0; a < 3; ++a) {
+      if (o[names[a]]) {
+        rpy_values[a] = number(doc, o[names[a]], where, key + ".orientation." + names[a]);
+      }
+    }
+    pose.topLeftCorner<3, 3>() = rpy(rpy_values[0], rpy_values[1], rpy_values[2]);
   }
   return pose;
 }
@@ -134,8 +177,15 @@ std::vector<std::pair<std::string, YAML::Node>> listed(const Doc& doc,
   const YAML::Node list = doc.root[list_key];
   if (!list || list.IsNull()) return out;
   if (!list.IsSequence()) fail(doc, list, "", "'" + list_key + "' must be a list of block names");
+  std::map<std::string, std::string> first;  // identifier -> where the list names it first
   for (const YAML::Node& entry : list) {
     const std::string id = text(doc, entry, list_key, list_key);
+    if (const auto seen = first.find(id); seen != first.end()) {
+      fail(doc, entry, "",
+           "'" + list_key + "' lists '" + id + "' twice (first " + seen->second +
+               "); a block is made once");
+    }
+    first[id] = at(entry).empty() ? "earlier" : at(entry).substr(0, at(entry).size() - 2);
     const YAML::Node block = doc.root[id];
     if (!block || !block.IsMap()) {
       fail(doc, entry, "",
@@ -161,6 +211,32 @@ std::string resolve(const fs::path& dir, const std::string& path) {
   return (p.is_absolute() ? p : dir / p).lexically_normal().string();
 }
 
+void Diagnostics::repeated_names(const Doc& doc, std::initializer_list<const char*> list_keys) {
+  std::map<std::string, std::pair<std::string, std::string>> first;  // name -> (id, line)
+  for (const char* list_key : list_keys) {
+    for (const auto& [id, block] : listed(doc, list_key)) {
+      const std::string name = block_name(doc, id, block);
+      const std::string line =
+          at(block).empty() ? "" : " (" + at(block).substr(0, at(block).size() - 2) + ")";
+      const auto [seen, fresh] = first.try_emplace(name, id, line);
+      if (fresh) continue;
+      warn(doc.path, at(block) + id + ": its name '" + name + "' is also that of '" +
+                         seen->second.first + "'" + seen->second.second +
+                         "; it is renamed with a number suffix, as AMBF does for repeated names");
+    }
+  }
+}
+
+void yaml_error(const std::string& path, const YAML::Exception& e) {
+  const std::string line = e.mark.is_null() ? "" : "line " + std::to_string(e.mark.line + 1) + ": ";
+  // BadSubscript: yaml-cpp's "operator[] call on a scalar (key: ...)".
+  if (dynamic_cast<const YAML::BadSubscript*>(&e) != nullptr) {
+    throw ConfigError(
+        path, line + "expected a mapping of keys here, found a single value (" + e.msg + ")");
+  }
+  throw ConfigError(path, line + e.msg);
+}
+
 void Diagnostics::warn(const std::string& file, const std::string& message) {
   log(LogLevel::kWarning, file.empty() ? message : file + ": " + message);
   warnings_.push_back({file, message});
@@ -182,6 +258,28 @@ void Diagnostics::unknown_keys(const Doc& doc, const std::string& where, const Y
       warn(doc.path, at(entry.first) + where + ": unknown key '" + key + "' ignored");
     }
   }
+}
+
+std::optional<YAML::Node> non_finite(const YAML::Node& node) {
+  if (node.IsSequence()) {
+    for (const YAML::Node& item : node) {
+      if (auto bad = non_finite(item)) return bad;
+    }
+  } else if (node.IsMap()) {
+    for (const auto& entry : node) {
+      if (auto bad = non_finite(entry.second)) return bad;
+    }
+  } else if (node.IsScalar() && !node.Scalar().empty()) {
+    double value = 0.0;
+    char* end = nullptr;
+    const double parsed = std::strtod(node.Scalar().c_str(), &end);
+    const bool by_strtod = *end == '\0';
+    if ((by_strtod && !std::isfinite(parsed)) ||
+        (YAML::convert<double>::decode(node, value) && !std::isfinite(value))) {
+      return node;
+    }
+  }
+  return std::nullopt;
 }
 
 OptionValue option_value(const YAML::Node& node) {

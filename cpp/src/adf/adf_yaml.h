@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <initializer_list>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -15,6 +16,7 @@
 
 #include "ambfplus/adf/adf.h"
 #include "ambfplus/errors.h"
+#include "ambfplus/scene/object.h"
 #include "ambfplus/scene/options.h"
 
 namespace ambfplus::adf {
@@ -51,6 +53,7 @@ T as(const Doc& doc, const YAML::Node& node, const std::string& where, const std
   }
 }
 
+/// A finite number (ConfigError naming the key and line for text, .nan or .inf).
 double number(const Doc& doc, const YAML::Node& node, const std::string& where,
               const std::string& key);
 int integer(const Doc& doc, const YAML::Node& node, const std::string& where,
@@ -60,7 +63,17 @@ bool boolean(const Doc& doc, const YAML::Node& node, const std::string& where,
 std::string text(const Doc& doc, const YAML::Node& node, const std::string& where,
                  const std::string& key);
 
-/// parent[key] as a number when present, else fallback.
+/// parent[key] as an integer when present (its errors name parent_key.key), else fallback.
+int integer_or(const Doc& doc, const YAML::Node& parent, const char* key, const std::string& where,
+               const std::string& parent_key, int fallback);
+
+/// block[key] when it is a mapping, absent or empty; ConfigError naming prefix + key (and the
+/// line) when it is a scalar or a list. Every block[key] that is then indexed goes through this,
+/// since yaml-cpp's operator[] on a scalar throws an error that names no file.
+YAML::Node mapping(const Doc& doc, const YAML::Node& block, const char* key,
+                   const std::string& where, const std::string& prefix = "");
+
+/// parent[key] as a finite number when present, else fallback.
 double number_or(const Doc& doc, const YAML::Node& parent, const char* key,
                  const std::string& where, double fallback);
 
@@ -72,6 +85,7 @@ Eigen::Vector3d xyz(const Doc& doc, const YAML::Node& node, const std::string& w
 Eigen::Matrix3d rpy(double r, double p, double y);
 
 /// `{position: {x,y,z}, orientation: {r,p,y}}` as a pose; the position is multiplied by scale.
+/// ConfigError for a coordinate beyond kMaxPosition (1e6 m).
 Eigen::Matrix4d frame(const Doc& doc, const YAML::Node& node, const std::string& where,
                       const std::string& key, double scale = 1.0);
 
@@ -90,6 +104,10 @@ std::string resolve(const fs::path& dir, const std::string& path);
 /// A YAML value as an option value: numbers, true/false (yes/no, on/off), text, lists, mappings.
 OptionValue option_value(const YAML::Node& node);
 
+/// The first scalar in node (itself, or inside its lists and mappings) that reads as a
+/// non-finite number (nan, .nan, inf, .inf), if any.
+std::optional<YAML::Node> non_finite(const YAML::Node& node);
+
 /// Sets spec's fields from those of `keys` that block has, through the spec's option table (a
 /// file's key is Python's keyword with spaces for underscores); a bad value fails naming the
 /// file, line and block.
@@ -100,11 +118,29 @@ void set_options(const Doc& doc, const std::string& id, const YAML::Node& block,
   for (const char* key : keys) {
     const YAML::Node value = block[key];
     if (!value) continue;
+    if (const std::optional<YAML::Node> bad = non_finite(value)) {
+      fail(doc, *bad, id,
+           std::string("'") + key + "' must hold finite numbers, got " + bad->Scalar());
+    }
     try {
       table.set(spec, key, option_value(value));
     } catch (const ArgumentError& e) {
       fail(doc, value, id, e.what());
     }
+  }
+}
+
+/// A yaml-cpp error that escaped the readers' checks (such as a key looked up in a single value)
+/// as a ConfigError naming the file and line.
+[[noreturn]] void yaml_error(const std::string& path, const YAML::Exception& e);
+
+/// Runs read, turning a yaml-cpp error into yaml_error's ConfigError.
+template <typename Read>
+decltype(auto) yaml_checked(const std::string& path, Read&& read) {
+  try {
+    return read();
+  } catch (const YAML::Exception& e) {
+    yaml_error(path, e);
   }
 }
 
@@ -116,6 +152,9 @@ class Diagnostics {
   /// One warning per key of block that is not in known ("unknown key 'x' ignored").
   void unknown_keys(const Doc& doc, const std::string& where, const YAML::Node& block,
                     std::initializer_list<const char*> known);
+  /// One warning per block of the lists named that takes a name an earlier block of the file
+  /// has (AMBF renames it with a number suffix), naming both blocks.
+  void repeated_names(const Doc& doc, std::initializer_list<const char*> list_keys);
   std::vector<AdfProblem>& warnings() { return warnings_; }
   std::vector<AdfProblem>& errors() { return errors_; }
 

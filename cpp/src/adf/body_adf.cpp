@@ -68,7 +68,7 @@ BodyPlan plan_body(const Doc& doc, const std::string& model_hr, const std::strin
   } else {
     ctx.diag->warn(doc.path, at(b) + id + ": no 'mass'; 1 kg is used (AMBF's default)");
   }
-  if (const YAML::Node inertia = b["inertia"]) {
+  if (const YAML::Node inertia = mapping(doc, b, "inertia", id)) {
     const Eigen::Vector3d i(number_or(doc, inertia, "ix", id, 0.0),
                             number_or(doc, inertia, "iy", id, 0.0),
                             number_or(doc, inertia, "iz", id, 0.0));
@@ -81,12 +81,12 @@ BodyPlan plan_body(const Doc& doc, const std::string& model_hr, const std::strin
   }
 
   // Contact parameters.
-  if (const YAML::Node f = b["friction"]) {
+  if (const YAML::Node f = mapping(doc, b, "friction", id)) {
     s.dynamics.static_friction = number_or(doc, f, "static", id, s.dynamics.static_friction);
     s.dynamics.rolling_friction = number_or(doc, f, "rolling", id, s.dynamics.rolling_friction);
   }
   s.dynamics.restitution = number_or(doc, b, "restitution", id, s.dynamics.restitution);
-  if (const YAML::Node d = b["damping"]) {
+  if (const YAML::Node d = mapping(doc, b, "damping", id)) {
     s.dynamics.linear_damping = number_or(doc, d, "linear", id, s.dynamics.linear_damping);
     s.dynamics.angular_damping = number_or(doc, d, "angular", id, s.dynamics.angular_damping);
   }
@@ -136,7 +136,8 @@ BodyPlan plan_body(const Doc& doc, const std::string& model_hr, const std::strin
     for (const YAML::Node& g : groups) {
       const int n = integer(doc, g, id, "collision groups");
       if (n < 0 || n > 31) {
-        ctx.diag->warn(doc.path, at(g) + id + ": collision group " + std::to_string(n) +
+        // AMBF, too, ignores a group number outside its range with a warning.
+        ctx.diag->warn(doc.path, at(g) + id + ": 'collision groups' entry " + std::to_string(n) +
                                      " ignored (ambfplus has groups 0 to 31)");
         continue;
       }

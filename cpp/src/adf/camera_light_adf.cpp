@@ -67,15 +67,21 @@ CameraPlan plan_camera(const Doc& doc, const std::string& base_ns, const std::st
   plan.eye = xyz(doc, n["location"], id, "location", plan.eye);
   plan.target = xyz(doc, n["look at"], id, "look at", plan.target);
   plan.up = xyz(doc, n["up"], id, "up", plan.up);
-  if ((plan.target - plan.eye).norm() < 1e-12) plan.target = plan.eye - Eigen::Vector3d::UnitX();
-  if (const YAML::Node clip = n["clipping plane"]) {
+  if ((plan.target - plan.eye).norm() < 1e-12) {
+    // Without 'look at' AMBF's camera looks along -x; given, it must point somewhere.
+    if (n["look at"]) fail(doc, n["look at"], id, "'look at' equals 'location': no view direction");
+    plan.target = plan.eye - Eigen::Vector3d::UnitX();
+  }
+  if (const YAML::Node clip = mapping(doc, n, "clipping plane", id)) {
     plan.spec.near = number_or(doc, clip, "near", id, plan.spec.near);
     plan.spec.far = number_or(doc, clip, "far", id, plan.spec.far);
   }
   plan.spec.fov_y = number_or(doc, n, "field view angle", id, plan.spec.fov_y);
-  if (const YAML::Node res = n["publish image resolution"]) {
-    plan.spec.width = static_cast<int>(number_or(doc, res, "width", id, plan.spec.width));
-    plan.spec.height = static_cast<int>(number_or(doc, res, "height", id, plan.spec.height));
+  if (const YAML::Node res = mapping(doc, n, "publish image resolution", id)) {
+    plan.spec.width =
+        integer_or(doc, res, "width", id, "publish image resolution", plan.spec.width);
+    plan.spec.height =
+        integer_or(doc, res, "height", id, "publish image resolution", plan.spec.height);
   }
   CameraPublish& pub = plan.spec.publish;
   if (n["publish image"]) pub.image = boolean(doc, n["publish image"], id, "publish image");
@@ -86,7 +92,7 @@ CameraPlan plan_camera(const Doc& doc, const std::string& base_ns, const std::st
   if (n["publish depth interval"]) {
     pub.depth_interval = integer(doc, n["publish depth interval"], id, "publish depth interval");
   }
-  if (const YAML::Node noise = n["publish depth noise"]) {
+  if (const YAML::Node noise = mapping(doc, n, "publish depth noise", id)) {
     pub.depth_noise = true;
     pub.noise_mean = number_or(doc, noise, "mean", id, pub.noise_mean);
     const YAML::Node std_dev = noise["std_dev"] ? noise["std_dev"] : noise["std dev"];
@@ -96,7 +102,7 @@ CameraPlan plan_camera(const Doc& doc, const std::string& base_ns, const std::st
   if (pub.image_interval < 1 || pub.depth_interval < 1) {
     fail(doc, n, id, "publish intervals must be >= 1");
   }
-  if (const YAML::Node stereo = n["stereo"]) {
+  if (const YAML::Node stereo = mapping(doc, n, "stereo", id)) {
     plan.eye_separation = number_or(doc, stereo, "eye separation", id, 0.0);
     plan.stereo_focal = number_or(doc, stereo, "focal length", id, 0.0);
     if (!(plan.eye_separation > 0)) fail(doc, stereo, id, "'stereo' needs 'eye separation' > 0");
@@ -141,7 +147,7 @@ LightPlan plan_light(const Doc& doc, const std::string& base_ns, const std::stri
   if (!(s.direction.norm() > 0)) fail(doc, n["direction"], id, "'direction' must not be zero");
   s.spot_exponent = static_cast<float>(number_or(doc, n, "spot exponent", id, s.spot_exponent));
   s.spot_cutoff = static_cast<float>(number_or(doc, n, "cutoff angle", id, s.spot_cutoff));
-  if (const YAML::Node a = n["attenuation"]) {
+  if (const YAML::Node a = mapping(doc, n, "attenuation", id)) {
     s.attenuation = {static_cast<float>(number_or(doc, a, "constant", id, 1.0)),
                      static_cast<float>(number_or(doc, a, "linear", id, 0.0)),
                      static_cast<float>(number_or(doc, a, "quadratic", id, 0.0))};
@@ -164,6 +170,37 @@ Eigen::Isometry3d parent_frame(const Object& parent) {
         -1, 0, 0;
   }
   return frame;
+}
+
+// Cameras and lights of one file riding on one another in a circle (A on B on A) are refused,
+// naming the circle, before any is made: no order of attaching could place them.
+void refuse_parent_cycles(const Doc& doc, const std::vector<CameraPlan>& cameras,
+                          const std::vector<LightPlan>& lights) {
+  struct Node {
+    std::string id, name, parent;
+  };
+  std::vector<Node> nodes;
+  for (const CameraPlan& c : cameras) nodes.push_back({c.id, c.spec.name, c.parent});
+  for (const LightPlan& l : lights) nodes.push_back({l.id, l.spec.name, l.parent});
+  auto parent_of = [&](const Node& n) -> const Node* {
+    for (const Node& m : nodes) {
+      if (!n.parent.empty() && (n.parent == m.id || n.parent == m.name)) return &m;
+    }
+    return nullptr;
+  };
+  for (const Node& start : nodes) {
+    std::string chain = start.name;
+    const Node* p = parent_of(start);
+    for (std::size_t hops = 0; p != nullptr && hops < nodes.size(); ++hops) {
+      chain += " -> " + p->name;
+      if (p == &start) {
+        const YAML::Node block = doc.root[start.id];
+        fail(doc, block["parent"] ? block["parent"] : block, start.id,
+             "'parent' makes a parent cycle " + chain + "; none of them can be placed");
+      }
+      p = parent_of(*p);
+    }
+  }
 }
 
 }  // namespace
@@ -211,6 +248,7 @@ void add_cameras_and_lights(Model& model, const Doc& doc, const std::string& bas
   for (const auto& [id, block] : listed(doc, "lights")) {
     lights.push_back(plan_light(doc, base_ns, id, block, ctx));
   }
+  refuse_parent_cycles(doc, cameras, lights);
   // A parent that is not there yet leaves the object in the world frame until it comes.
   for (CameraPlan& c : cameras) {
     c.spec.name = unique_name(world, c.spec.name);

@@ -78,7 +78,7 @@ JointPlan plan_joint(const Doc& doc, const std::string& model_ns, const std::str
     plan.six_dof = read_six_dof_axes(doc, j, id, s.type, ctx);
   } else {
     double middle = 0.0;
-    if (const YAML::Node limits = j["joint limits"]) {
+    if (const YAML::Node limits = mapping(doc, j, "joint limits", id)) {
       // AMBF turns limits on only when both are given.
       if (limits["low"] && limits["high"]) {
         const double low = number(doc, limits["low"], id, "joint limits.low");
@@ -103,6 +103,13 @@ JointPlan plan_joint(const Doc& doc, const std::string& model_ns, const std::str
   // A declared controller ({P, I, D}) drives efforts unless its output type says otherwise.
   set_options(doc, id, j, joint_options(), s,
               {"max motor impulse", "controller", "ignore inter-collision", "passive"});
+  if (const YAML::Node controller = j["controller"]) {
+    try {
+      s.controller.validate("controller");  // here, so that the error names the line
+    } catch (const ArgumentError& e) {
+      fail(doc, controller, id, e.what());
+    }
+  }
   if (const YAML::Node out = j["controller output type"]) {
     const std::string o = to_lower(text(doc, out, id, "controller output type"));
     if (o == "force" || o == "effort") {

@@ -127,9 +127,20 @@ namespace {
 
 // Static planes around the origin: AMBF's `enclosure` when a world has no environment.
 void add_enclosure(World& world, const Doc& doc, const YAML::Node& node) {
-  const double length = adf::number_or(doc, node, "length", "enclosure", 4.0);
-  const double width = adf::number_or(doc, node, "width", "enclosure", 4.0);
-  const double height = adf::number_or(doc, node, "height", "enclosure", 3.0);
+  if (!node.IsMap() && !node.IsNull()) {
+    adf::fail(doc, node, "enclosure", "'enclosure' must be {length, width, height}");
+  }
+  auto size = [&](const char* key, double fallback) {
+    const double value = adf::number_or(doc, node, key, "enclosure", fallback);
+    if (!(value > 0)) {
+      adf::fail(doc, node[key], "enclosure",
+                std::string("'enclosure.") + key + "' must be > 0 m, got " + node[key].Scalar());
+    }
+    return value;
+  };
+  const double length = size("length", 4.0);
+  const double width = size("width", 4.0);
+  const double height = size("height", 3.0);
   Model& model = world.add_model(adf::unique_model_name(world, "enclosure"));
   struct Wall {
     const char* name;
@@ -197,7 +208,8 @@ void load_world(World& world, const std::string& path, adf::Context& ctx) {
     Model* env = nullptr;
     try {
       ctx.skip_missing_meshes = ctx.report_environment_errors;
-      env = &adf::load_model(world, environment, ctx);
+      env = &adf::yaml_checked(
+          environment, [&]() -> Model& { return adf::load_model(world, environment, ctx); });
       ctx.skip_missing_meshes = false;
     } catch (const Error& e) {
       ctx.skip_missing_meshes = false;
@@ -218,6 +230,7 @@ void load_world(World& world, const std::string& path, adf::Context& ctx) {
   }
   if (shader) world.set_shader(shader);
   std::vector<adf::ObjectPlugins> object_plugins;
+  ctx.diag->repeated_names(doc, {"cameras", "lights"});
   adf::add_cameras_and_lights(world.default_model(), doc, ns, ctx, own, object_plugins);
   // Plugins once the world is built: its objects', then its own.
   adf::load_plugins(object_plugins, doc.path, ctx);
@@ -342,7 +355,7 @@ void load_world_file(World& world, const std::string& path, const AdfColors& col
                      std::vector<AdfProblem>* warnings) {
   adf::Diagnostics diag;
   adf::Context ctx{&colors, &diag, ""};
-  load_world(world, path, ctx);
+  adf::yaml_checked(path, [&] { load_world(world, path, ctx); });
   adf::resolve_deferred(world, ctx);
   if (warnings != nullptr) {
     warnings->insert(warnings->end(), diag.warnings().begin(), diag.warnings().end());
@@ -353,7 +366,8 @@ Model& load_model_file(World& world, const std::string& path, const AdfColors& c
                        std::vector<AdfProblem>* warnings) {
   adf::Diagnostics diag;
   adf::Context ctx{&colors, &diag, ""};
-  Model& model = adf::load_model(world, path, ctx);
+  Model& model =
+      adf::yaml_checked(path, [&]() -> Model& { return adf::load_model(world, path, ctx); });
   adf::resolve_deferred(world, ctx);
   adf::warn_unresolved(world, ctx);
   if (warnings != nullptr) {
@@ -379,13 +393,15 @@ AdfReport load_launch(World& world, const std::string& path, const AdfLoadOption
   ctx.report_plugin_errors = !options.strict;
   ctx.report_environment_errors = !options.strict;
   const std::size_t models_before = world.models().size();
-  if (options.load_world) load_world(world, launch.world, ctx);
+  if (options.load_world) {
+    adf::yaml_checked(launch.world, [&] { load_world(world, launch.world, ctx); });
+  }
 
   // One model failing is reported (or thrown, when strict) and leaves nothing behind. Objects
   // of earlier files waiting for a parent it declares are attached as soon as it is in.
   auto load_one = [&](const std::string& file, const std::string& what) {
     try {
-      adf::load_model(world, file, ctx);
+      adf::yaml_checked(file, [&] { adf::load_model(world, file, ctx); });
     } catch (const Error& e) {
       if (options.strict) throw;
       diag.error(file, what + " not loaded: " + e.what());

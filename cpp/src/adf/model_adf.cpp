@@ -108,6 +108,8 @@ Model& load_model(World& world, const std::string& path, Context& ctx) {
       }
     }
   }
+  ctx.diag->repeated_names(doc, {"bodies", "soft bodies", "ghost objects", "joints", "sensors",
+                                 "actuators", "cameras", "lights", "volumes"});
   const std::string model_ns =
       join_ns(ctx.prefix, world.name_space(),
               root["namespace"] ? text(doc, root["namespace"], where, "namespace") : "");

@@ -63,7 +63,11 @@ std::pair<Shape, Eigen::Matrix4d> primitive(const Doc& doc, const std::string& w
   auto need = [&](const char* key) {
     const YAML::Node n = geometry[key];
     if (!n) fail(doc, geometry, where, "the " + kind + "'s geometry needs '" + key + "'");
-    return number(doc, n, where, std::string("geometry.") + key);
+    const double value = number(doc, n, where, std::string("geometry.") + key);
+    if (!(value > 0)) {
+      fail(doc, n, where, std::string("'geometry.") + key + "' must be > 0, got " + n.Scalar());
+    }
+    return value;
   };
   if (const YAML::Node axis = geometry["axis"]) {
     const std::string a = to_lower(text(doc, axis, where, "geometry.axis"));
@@ -117,14 +121,16 @@ Material material(const Doc& doc, const std::string& where, const YAML::Node& bl
     }
     for (int i = 0; i < 3; ++i) out[i] = static_cast<float>(c[i]);
   };
-  if (const YAML::Node rgba = block["color rgba"]) {
+  if (const YAML::Node rgba = mapping(doc, block, "color rgba", where)) {
     rgb(rgba, "color rgba", m.color.data());
     m.color[3] = static_cast<float>(number_or(doc, rgba, "a", where, 1.0));
-  } else if (const YAML::Node parts = block["color components"]) {
-    if (parts["diffuse"]) rgb(parts["diffuse"], "color components.diffuse", m.color.data());
-    if (parts["specular"]) {
+  } else if (const YAML::Node parts = mapping(doc, block, "color components", where)) {
+    if (const YAML::Node diffuse = mapping(doc, parts, "diffuse", where, "color components.")) {
+      rgb(diffuse, "color components.diffuse", m.color.data());
+    }
+    if (const YAML::Node specular = mapping(doc, parts, "specular", where, "color components.")) {
       float spec[3] = {m.specular, m.specular, m.specular};
-      rgb(parts["specular"], "color components.specular", spec);
+      rgb(specular, "color components.specular", spec);
       // Our Phong term is white light times one factor: AMBF's specular colour, dimmed to the
       // strength CHAI's default material shows it with.
       m.specular = 0.2f * (spec[0] + spec[1] + spec[2]) / 3.0f;
@@ -134,9 +140,9 @@ Material material(const Doc& doc, const std::string& where, const YAML::Node& bl
     }
     m.color[3] = static_cast<float>(number_or(doc, parts, "transparency", where, 1.0));
     // AMBF: ambient = level x diffuse when given, else CHAI3D's grey default.
+    const YAML::Node ambient = mapping(doc, parts, "ambient", where, "color components.");
     const float level =
-        parts["ambient"] ? static_cast<float>(number_or(doc, parts["ambient"], "level", where, 1.0))
-                         : -1.0f;
+        ambient ? static_cast<float>(number_or(doc, ambient, "level", where, 1.0)) : -1.0f;
     m.ambient = level >= 0 ? std::array<float, 3>{level * m.color[0], level * m.color[1],
                                                   level * m.color[2]}
                            : std::array<float, 3>{0.3f, 0.3f, 0.3f};

@@ -26,6 +26,9 @@ Camera::Camera(Model& model, const CameraSpec& spec, int id)
 
 void Camera::look_at(const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
                      const Eigen::Vector3d& up) {
+  if (!eye.allFinite() || !target.allFinite() || !up.allFinite()) {
+    throw ArgumentError("camera '" + name() + "': look_at needs finite eye, target and up");
+  }
   const Eigen::Vector3d forward = target - eye;
   if (!(forward.norm() > 0.0)) {
     throw ArgumentError("camera '" + name() + "': look_at needs target != eye");

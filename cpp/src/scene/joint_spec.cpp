@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -73,8 +74,11 @@ const char* control_output_name(ControlOutput output) {
 }
 
 void JointController::validate(const std::string& who) const {
-  if (!std::isfinite(p) || !std::isfinite(i) || !std::isfinite(d)) {
-    throw ArgumentError(who + ": controller gains must be finite");
+  // A negative gain pushes away from the target: the joint runs off and the scene turns to NaN.
+  if (!std::isfinite(p) || !std::isfinite(i) || !std::isfinite(d) || p < 0 || i < 0 || d < 0) {
+    std::ostringstream got;
+    got << "P " << p << ", I " << i << ", D " << d;
+    throw ArgumentError(who + ": controller gains must be finite and >= 0, got " + got.str());
   }
 }
 

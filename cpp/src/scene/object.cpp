@@ -45,8 +45,13 @@ Object::~Object() = default;
 World& Object::world() const { return model_->world(); }
 
 void Object::attach_to(const Object* parent, const Eigen::Isometry3d& local) {
+  std::string chain = name_;
   for (const Object* p = parent; p != nullptr; p = p->attached_to_) {
-    if (p == this) throw ArgumentError("'" + name_ + "' cannot ride on itself");
+    chain += " -> " + p->name_;
+    if (p == this) {
+      throw ArgumentError("'" + name_ + "' cannot ride on '" + parent->name_ +
+                          "': that makes a parent cycle " + chain);
+    }
   }
   world().attachments().track(this, parent != nullptr);
   attached_to_ = parent;

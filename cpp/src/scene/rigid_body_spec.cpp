@@ -1,6 +1,7 @@
 // RigidBodySpec: the names of its kinds, its checks and its keyword options.
 
 #include <cmath>
+#include <sstream>
 #include <string>
 
 #include "ambfplus/errors.h"
@@ -270,7 +271,17 @@ void RigidBodySpec::validate() const {
     part.validate(who);
     checked_pose(pose);
   }
-  checked_pose(pose);
+  try {
+    checked_pose(pose);
+  } catch (const ArgumentError& e) {
+    throw ArgumentError(who + ": " + e.what());
+  }
+  if (pose.topRightCorner<3, 1>().cwiseAbs().maxCoeff() > kMaxPosition) {
+    std::ostringstream at;
+    at << pose.topRightCorner<3, 1>().transpose();
+    throw ArgumentError(who + ": position (" + at.str() +
+                        ") is beyond 1e+06 m of the origin, where nothing keeps its precision");
+  }
 }
 
 const OptionTable<RigidBodySpec>& rigid_body_options() {

@@ -89,6 +89,10 @@ class AMBFPLUS_API Object {
   std::unique_ptr<ObjectState> physics_state_;
 };
 
+/// The largest |coordinate| (m) of a body's position that a spec or an ADF file may give: beyond
+/// it neither Bullet nor the renderer keeps any precision, so such a value is a mistake.
+constexpr double kMaxPosition = 1e6;
+
 /// Throws ArgumentError unless m is a rigid transform (orthonormal rotation with det +1,
 /// last row 0 0 0 1, finite), tolerating rounding of tol.
 AMBFPLUS_API Eigen::Isometry3d checked_pose(const Eigen::Matrix4d& m, double tol = 1e-6);

@@ -5,6 +5,8 @@ CMake package C++ plugins build against)."""
 from __future__ import annotations
 
 import argparse
+import atexit
+import gc
 import json
 import sys
 from pathlib import Path
@@ -516,6 +518,9 @@ def main(argv: list[str] | None = None) -> int:
     if args.command == "validate":
         return run_validate(args)
     if args.command == "generate":
+        # At exit, everything is written and closed: spare the driver the collection Python
+        # runs then over every object (with Ray's modules loaded it costs about 0.3 CPU-s).
+        atexit.register(gc.freeze)
         return run_generate(args)
     if args.command == "dataset":
         return run_dataset(args)

@@ -1,10 +1,10 @@
 """A real two-node Ray cluster on this machine for the tests: a head and a second node, each
 started with `ray start` on its own loopback address (127.0.0.2, 127.0.0.3), with its own temp
 dir and ports, one CPU and a small object store each, and as the README suggests for
-generating datasets: no dashboard and no log monitor. `ray start` runs in this Python (its
-workers import the ambfplus under test, not another one on PATH). Stopping it kills exactly
-the processes it started (found by their temp dirs) and their children, never anyone else's
-Ray."""
+generating datasets: no dashboard and no log monitor; and without token authentication (see
+below). `ray start` runs in this Python (its workers import the ambfplus under test, not
+another one on PATH). Stopping it kills exactly the processes it started (found by their temp
+dirs) and their children, never anyone else's Ray."""
 
 from __future__ import annotations
 
@@ -64,7 +64,10 @@ class RayCluster:
         self.port, self.dashboard_port = base, base + 1
         self.address = f"{HEAD_IP}:{self.port}"
         self._next = base + 2
-        self.env = {**os.environ, "RAY_USAGE_STATS_ENABLED": "0"}
+        # Without token authentication whatever ~/.ray/auth_token holds: a token there (any
+        # `ray.init()` on this machine writes one) puts a head started by `ray start` in token
+        # mode but not a second node, which then cannot join. Drivers connect either way.
+        self.env = {**os.environ, "RAY_USAGE_STATS_ENABLED": "0", "RAY_AUTH_MODE": "disabled"}
         self.log = ""
 
     def _node_ports(self) -> list[str]:

@@ -8,9 +8,11 @@ from __future__ import annotations
 import json
 import os
 import random
+import shutil
 import signal
 import subprocess
 import sys
+import tempfile
 import threading
 import time
 
@@ -50,6 +52,9 @@ def test_ray_makes_the_same_shards_as_local_workers(
     assert manifest(tmp_path / "ray") == manifest(reference_dataset)
     assert shard_bytes(tmp_path / "ray") == shard_bytes(reference_dataset)
     assert len(nodes_used(tmp_path / "ray")) == 2  # both nodes rendered
+    # one Ray worker process per node made all of its node's episodes: one EGL context each
+    workers = {r["worker"] for r in read_manifest(tmp_path / "ray")[0]}
+    assert len(workers) == 2, workers
     environment = json.loads((tmp_path / "ray" / "environment.json").read_text())
     assert environment["runs"][0]["executor"] == "ray"
     assert environment["runs"][0]["address"] == cluster.address
@@ -123,6 +128,41 @@ def test_a_killed_ray_driver_resumes_to_the_same_dataset(
     assert resumed.skipped >= 3 and resumed.skipped + resumed.generated == 12
     assert manifest(out) == manifest(reference_dataset)
     assert shard_bytes(out) == shard_bytes(reference_dataset)
+
+
+def test_ray_local_is_a_cluster_of_its_own_whose_gpu_workers_keep_their_context(
+    cluster, dataset_spec, reference_dataset, tmp_path, monkeypatch
+):
+    # RAY_ADDRESS names the two-node cluster, which "local" must not join
+    monkeypatch.setenv("RAY_ADDRESS", cluster.address)
+    monkeypatch.setenv("RAY_USAGE_STATS_ENABLED", "0")
+    # Ray would give a new local cluster token authentication and write ~/.ray/auth_token,
+    # which changes every later `ray start` on this machine
+    monkeypatch.setenv("RAY_AUTH_MODE", "disabled")
+    # The run's cluster declares one GPU; the environment chooses the device tasks render on
+    # (llvmpipe's), as it may on a GPU machine, so the GPU's id changes nothing.
+    monkeypatch.setenv("AMBFPLUS_EGL_DEVICE", "0")
+    temp_dir = tempfile.mkdtemp(prefix="rayl", dir="/tmp")  # short: Ray's socket paths
+    try:
+        report = generate(
+            dataset_spec,
+            tmp_path / "local",
+            ray="local",
+            progress=False,
+            ray_options={
+                "gpus": 1,
+                "init_options": {"num_cpus": 1, "num_gpus": 1, "_temp_dir": temp_dir},
+            },
+        )
+    finally:
+        shutil.rmtree(temp_dir, ignore_errors=True)
+    assert (report.executor["nodes"], report.executor["gpus"]) == (1, 1)
+    assert manifest(tmp_path / "local") == manifest(reference_dataset)
+    assert shard_bytes(tmp_path / "local") == shard_bytes(reference_dataset)
+    # Ray gives a function declared with GPUs a new process per task; ours keeps one worker
+    # (and its EGL context) for every episode
+    workers = {r["worker"] for r in read_manifest(tmp_path / "local")[0]}
+    assert len(workers) == 1, workers
 
 
 def test_an_unreachable_ray_address_says_so(tmp_path):

@@ -103,10 +103,11 @@ class RayExecutor(Executor):
         if self.address not in ("auto", "local"):
             check_reachable(self.address)
         options = {"log_to_driver": False, "logging_level": logging.WARNING, **self.init_options}
+        # "local" is said to Ray too: without an address, ray.init joins the cluster named by
+        # RAY_ADDRESS or the last one `ray start` began on this machine.
+        options["address"] = self.address
         if self.address == "local":
             options.setdefault("include_dashboard", False)
-        else:
-            options["address"] = self.address
         # Ray puts the driver's current folder first on its workers' sys.path: from a source
         # checkout, that would shadow the installed package (which has the engine) with the
         # bare sources. Connect from a folder that holds no Python packages.
@@ -137,7 +138,10 @@ class RayExecutor(Executor):
 
     def run(self, spec_data: dict, out, todo: list[int]) -> Iterator:
         ray = self._ray
-        task = ray.remote(ambfplus_episode).options(
+        # A worker runs any number of these tasks in one process (one EGL context for all its
+        # episodes) however the GPUs are asked for: Ray's default for a function declared with
+        # GPUs is a new process per task.
+        task = ray.remote(max_calls=0)(ambfplus_episode).options(
             num_cpus=self.cpus, num_gpus=self.gpus, max_retries=0
         )
         spec_ref = ray.put(spec_data)

@@ -18,7 +18,9 @@ their children's, reaches this process's children's times. Each round runs the f
 rotated order, so that the machine's drift does not always hit the same one. Beside each ratio,
 a breakdown: the CPU-seconds spent outside the episodes themselves (the tree's time minus the
 episodes' own process time as the workers report it, and the baseline's loop outside its
-episodes), and for Ray the cluster's daemons apart.
+episodes), and for Ray the cluster's daemons apart and the number of Ray worker processes
+started (one per node when each keeps its EGL context for all its episodes). Each run notes the
+machine's 1-minute load average as it starts.
 
     python tests/benchmarks/run.py --only datasets [--quick]
 """
@@ -164,20 +166,22 @@ class _ClusterCpu:
         while not self._stop.wait(0.05):
             self.last.update(self._sample())
 
-    def stop(self) -> tuple[float, float]:
-        """Ends sampling; returns the CPU-seconds used since it began: (the workers', the
-        rest's: raylets, GCS, agents)."""
+    def stop(self) -> tuple[float, float, int]:
+        """Ends sampling; returns the CPU-seconds used since it began, the workers' and the
+        rest's (raylets, GCS, agents), and how many worker processes were started."""
         self._stop.set()
         self._thread.join()
         self.last.update(self._sample())
         workers = daemons = 0.0
+        started = 0
         for key, (cpu, worker) in self.last.items():
             used = cpu - self.start.get(key, (0.0, worker))[0]
             if worker and key not in self.start:
                 workers += used
+                started += 1
             else:
                 daemons += used
-        return workers, daemons
+        return workers, daemons, started
 
 
 def _episodes_cpu(folder: Path) -> tuple[int, float]:
@@ -213,11 +217,12 @@ def datasets(args):
                 else:
                     command = generate + [str(out), "--workers", name[-1]]
                 sampler = _ClusterCpu(cluster) if name == "ray" else None
+                load = os.getloadavg()[0]  # the machine is shared: its load goes with each run
                 wall, cpu, stdout = _run(command)
-                run = {"wall": wall, "driver": cpu}
+                run = {"wall": wall, "driver": cpu, "load": load}
                 if sampler is not None:
                     time.sleep(1)  # the job's workers end
-                    run["workers"], run["daemons"] = sampler.stop()
+                    run["workers"], run["daemons"], run["processes"] = sampler.stop()
                 if name == "baseline":
                     run["episodes"] = json.loads(stdout.strip().splitlines()[-1])["episodes_cpu"]
                 else:
@@ -246,6 +251,7 @@ def _figures(results: dict, pairs: int, quick: bool):
         "worst": round(max(base), 4),
         "outside_episodes_cpu_s": [round(v, 2) for v in outside],
         "wall_s": [round(r["wall"], 1) for r in results["baseline"]],
+        "load_1min": [round(r["load"], 1) for r in results["baseline"]],
         "what": "process CPU per stereo pair of one in-process loop of record_episode",
         **common,
     }
@@ -271,6 +277,7 @@ def _figures(results: dict, pairs: int, quick: bool):
             "outside_episodes_cpu_s": [round(r["cpu"] - r["episodes"], 2) for r in runs],
             "episodes_cpu_s": [round(r["episodes"], 2) for r in runs],
             "wall_s": [round(r["wall"], 1) for r in runs],
+            "load_1min": [round(r["load"], 1) for r in runs],
             "what": f"process-tree CPU per stereo pair: {what}; baseline: one in-process loop",
             **common,
         }
@@ -281,6 +288,8 @@ def _figures(results: dict, pairs: int, quick: bool):
             ]
             line["daemons_cpu_s"] = [round(r["daemons"], 2) for r in runs]
             line["daemons_cpu_s_per_wall_s"] = [round(r["daemons"] / r["wall"], 4) for r in runs]
+            # one per node when each worker keeps its process (and EGL context) for all its tasks
+            line["worker_processes"] = [r["processes"] for r in runs]
         yield line
     one = [pairs / r["wall"] for r in results["local1"]]
     for name, what in (("local2", "2 local workers"), ("ray", "Ray (2 nodes x 1 CPU)")):

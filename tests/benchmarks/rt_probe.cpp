@@ -11,6 +11,8 @@
 // Prints "ready" once every thread runs, then probes until its standard input closes, then
 // prints one JSON object: per CPU, the scheduling it got, its wake-ups, the median, 99th
 // percentile and largest lateness (us), and its late wake-ups as [deadline s, lateness s].
+// A line "phase SECONDS" on standard input (a CLOCK_MONOTONIC time the loop woke at) moves the
+// deadlines half a period away from the loop's, so that the witness rarely preempts a step.
 
 #include <pthread.h>
 #include <sched.h>
@@ -34,6 +36,12 @@ constexpr long kPeriodNs = 1000000;
 constexpr int kBuckets = 100001;  // lateness histogram, 1 us buckets up to 100 ms
 
 std::atomic<bool> stopping{false};
+std::atomic<long long> phase_ns{-1};  // the loop's wake-ups, mod the period; -1: unknown
+
+long long nanoseconds(const timespec& t) { return t.tv_sec * 1000000000LL + t.tv_nsec; }
+timespec from_nanoseconds(long long ns) {
+  return timespec{static_cast<time_t>(ns / 1000000000LL), static_cast<long>(ns % 1000000000LL)};
+}
 
 double seconds(const timespec& t) { return static_cast<double>(t.tv_sec) + 1e-9 * t.tv_nsec; }
 
@@ -63,7 +71,17 @@ struct Probe {
     timespec deadline{};
     clock_gettime(CLOCK_MONOTONIC, &deadline);
     ready = true;
+    long long phased = -1;
     while (!stopping) {
+      const long long phase = phase_ns;
+      if (phase != phased) {
+        // Half a period after one of the loop's deadlines, the first still ahead.
+        const long long target = (phase + kPeriodNs / 2) % kPeriodNs;
+        long long next = nanoseconds(deadline) - nanoseconds(deadline) % kPeriodNs + target;
+        while (next <= nanoseconds(deadline)) next += kPeriodNs;
+        deadline = from_nanoseconds(next - kPeriodNs);
+        phased = phase;
+      }
       deadline.tv_nsec += kPeriodNs;
       while (deadline.tv_nsec >= 1000000000L) {
         deadline.tv_nsec -= 1000000000L;
@@ -127,8 +145,12 @@ int main(int argc, char** argv) {
   }
   std::printf("ready\n");
   std::fflush(stdout);
-  char buffer[256];
-  while (read(0, buffer, sizeof buffer) > 0) {
+  char line[256];
+  while (std::fgets(line, sizeof line, stdin) != nullptr) {
+    double seconds = 0.0;
+    if (std::sscanf(line, "phase %lf", &seconds) == 1) {
+      phase_ns = static_cast<long long>(seconds * 1e9) % kPeriodNs;
+    }
   }
   stopping = true;
   for (std::thread& t : threads) t.join();

@@ -19,6 +19,7 @@ import os
 import shutil
 import subprocess
 import tempfile
+import threading
 import time
 from pathlib import Path
 
@@ -29,6 +30,38 @@ PROBE_SOURCE = Path(__file__).with_name("rt_probe.cpp")
 PROBE_PRIORITY = 90
 PROBE_THRESHOLD_US = 50
 TICKS = os.sysconf("SC_CLK_TCK")
+
+
+def rt_threads_elsewhere(exclude: set[int]) -> set[tuple[int, str, int]]:
+    """Real-time threads of other user processes (pid, name, priority): another program's loop
+    at or above ours takes the CPU from it unseen by the probe, which runs higher."""
+    found = set()
+    for proc in Path("/proc").iterdir():
+        if not proc.name.isdigit() or int(proc.name) in exclude:
+            continue
+        try:
+            tasks = list((proc / "task").iterdir())
+        except OSError:
+            continue
+        for task in tasks:
+            try:
+                name, fields = (task / "stat").read_text().rsplit(")", 1)
+            except OSError:
+                continue
+            fields = fields.split()
+            kernel = int(fields[6]) & 0x00200000  # PF_KTHREAD
+            if int(fields[38]) in (1, 2) and not kernel:  # SCHED_FIFO, SCHED_RR
+                found.add((int(proc.name), name.split("(", 1)[1], int(fields[37])))
+    return found
+
+
+def pressure_stall_us(resource: str) -> int:
+    """Microseconds some task of the machine stalled on `resource` (PSI), so far; 0 if absent."""
+    try:
+        line = Path(f"/proc/pressure/{resource}").read_text().splitlines()[0]
+    except OSError:
+        return 0
+    return int(line.rsplit("total=", 1)[1])
 
 
 def probe_binary() -> tuple[Path | None, str]:
@@ -75,19 +108,45 @@ class Witness:
     def __enter__(self) -> Witness:
         self._steal = cpu_steal()
         self._load = os.getloadavg()
+        self._memory_stall = pressure_stall_us("memory")
+        self._competitors: set = set()
         binary, why = probe_binary()
         if binary is None:
             self.report["witness"] = why
-            return self
-        self._process = subprocess.Popen(
-            [str(binary), str(PROBE_PRIORITY), str(PROBE_THRESHOLD_US), *map(str, self.cpus)],
-            stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
-        )  # fmt: skip
-        if self._process.stdout.readline().strip() != "ready":
-            raise RuntimeError("the witness probe did not start")
+        else:
+            self._process = subprocess.Popen(
+                [str(binary), str(PROBE_PRIORITY), str(PROBE_THRESHOLD_US), *map(str, self.cpus)],
+                stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
+            )  # fmt: skip
+            if self._process.stdout.readline().strip() != "ready":
+                raise RuntimeError("the witness probe did not start")
+        self._watching = threading.Event()
+        self._watcher = threading.Thread(target=self._watch, daemon=True)
+        self._watcher.start()
         return self
 
+    def align(self, loop_wakes_at: float) -> None:
+        """Moves the probe's wake-ups half a period away from the loop's (one of which came at
+        `loop_wakes_at`, CLOCK_MONOTONIC s), so that the witness rarely preempts a step."""
+        if self._process is not None:
+            self._process.stdin.write(f"phase {loop_wakes_at:.9f}\n")
+            self._process.stdin.flush()
+
+    def _watch(self) -> None:
+        """Samples other programs' real-time threads every 2 s while the block runs."""
+        exclude = {os.getpid()} | ({self._process.pid} if self._process else set())
+        while True:
+            self._competitors |= rt_threads_elsewhere(exclude)
+            if self._watching.wait(2.0):
+                return
+
     def __exit__(self, *exc) -> None:
+        self._watching.set()
+        self._watcher.join()
+        self.report["rt_threads_elsewhere"] = sorted(self._competitors)
+        self.report["memory_stall_ms"] = round(
+            (pressure_stall_us("memory") - self._memory_stall) / 1e3, 1
+        )
         steal = cpu_steal()
         self.report["steal_ms"] = {c: round(1e3 * (steal[c] - self._steal[c]), 1) for c in steal}
         self.report["load_average"] = [round(v, 2) for v in self._load]
@@ -161,6 +220,12 @@ def step_anchors(world, first_index: int, seconds: float) -> list[tuple[float, i
             return anchors
 
 
+def loop_phase(anchors: list[tuple[float, int]], period: float) -> float:
+    """A CLOCK_MONOTONIC time at which the loop woke for a step, from anchors alone (steps
+    taken as on time): within the lateness of its earliest wake-up."""
+    return min(t - (n - 1) * period for t, n in anchors if n >= 1)
+
+
 def first_step_time(periods: np.ndarray, anchors: list[tuple[float, int]]) -> float:
     """CLOCK_MONOTONIC time of the loop's first step, from the periods and the anchors: each
     anchor (t, n) bounds it from above by t - (start of step n-1 after the first); the
@@ -202,12 +267,29 @@ def late_periods(stats: dict, first: float, period: float) -> list[dict]:
     return rows
 
 
+def held_up(events: np.ndarray, start: float, end: float) -> float:
+    """How long (s) within [start, end] the probe was held up: the union of its late
+    wake-ups' spans [deadline, deadline + lateness] cut to that interval."""
+    spans = sorted(
+        (max(d, start), min(d + late, end)) for d, late in events if d < end and d + late > start
+    )
+    total, reach = 0.0, start
+    for a, b in spans:
+        a = max(a, reach)
+        if b > a:
+            total += b - a
+            reach = b
+    return total
+
+
 def attribute(rows: list[dict], witness: Witness, cpus, tolerance: float) -> None:
     """Marks each late period 'host' or 'ours' (or 'unknown' without a witness), with how much
-    of it the machine took ('machine_s'): the wake-up's lateness when the probe on the loop's
-    CPU (`cpus`: the CPUs the loop may have run on) was due within a period after the loop and
-    woke with it (the CPU ran no real-time thread meanwhile), plus the time the step spent off
-    its CPU (wall - CPU time) when a stall of the probe ended within the step. A period that
+    of it the machine took ('machine'): the whole wake-up's lateness when the probe on the
+    loop's CPU (`cpus`: those the loop may have run on) was due within a period after the loop
+    and woke with it, plus the time within the step during which the probe was held up. While
+    the probe, above the loop's priority, could not run, neither could the loop's own code: the
+    CPU was the host's, an interrupt's, or in kernel code that does not yield (the loop's own
+    page faults could be such code: their count is in the benchmark's line). A period that
     would still be over 2 ms without what the machine took is ours."""
     events = witness.events(cpus)
     deadline, lateness = events[:, 0], events[:, 1]
@@ -218,13 +300,7 @@ def attribute(rows: list[dict], witness: Witness, cpus, tolerance: float) -> Non
             np.abs(woke - r["woke"]) <= 2e-4 + tolerance
         )
         wake_machine = r["wake_late"] if shared.any() else 0.0
-        end = r["start"] + r["step_wall"]
-        inside = (deadline >= r["start"] - 1e-3) & (woke >= r["start"]) & (woke <= end + tolerance)
-        off_cpu = max(0.0, r["step_wall"] - r["step_cpu"])
-        step_machine = min(off_cpu, float(lateness[inside].max())) if inside.any() else 0.0
-        r["witness_late"] = (
-            float(lateness[shared | inside].max()) if (shared | inside).any() else 0.0
-        )
+        step_machine = held_up(events, r["start"], r["start"] + r["step_wall"])
         r["machine"] = wake_machine + step_machine
         if not witness.ok:
             r["verdict"] = "unknown"

@@ -391,10 +391,10 @@ def realtime_session(seconds: float, drilling: bool, witness=None):
     """A real-time session of the scene driven by a simulated hand, a camera capturing
     continuously in another thread: loop statistics, frames, the input log, and what tells a
     stall of the machine from ours (rt_witness: the loop's steps against CLOCK_MONOTONIC, its
-    thread's counters)."""
+    thread's counters; a running witness is put out of the loop's phase)."""
     import threading
 
-    from rt_witness import loop_thread, step_anchors, thread_counters
+    from rt_witness import loop_phase, loop_thread, step_anchors, thread_counters
 
     world, drill, camera, into = realtime_scene()
     hand = ambfplus.SimulatedDevice()
@@ -412,6 +412,8 @@ def realtime_session(seconds: float, drilling: bool, witness=None):
     first_index = world.step_index
     with loop:
         anchors = step_anchors(world, first_index, 0.02)
+        if witness is not None:
+            witness.align(loop_phase(anchors, 1e-3))
         tid = loop_thread()
         before = thread_counters(tid)
         thread.start()
@@ -439,7 +441,7 @@ def realtime_attribution(stats: dict, anchors, witness, scheduling: str) -> dict
     and marked 'host' or 'ours' by the witness (rt_witness), and the figures that go with it."""
     import re
 
-    from rt_witness import attribute, first_step_time, late_periods
+    from rt_witness import attribute, first_step_time, held_up, late_periods
 
     periods = np.asarray(stats["periods"])
     first = first_step_time(periods, anchors)
@@ -450,15 +452,25 @@ def realtime_attribution(stats: dict, anchors, witness, scheduling: str) -> dict
     pinned = re.search(r"pinned to CPU (\d+)", scheduling)
     cpus = [int(pinned.group(1))] if pinned else witness.cpus
     attribute(rows, witness, cpus, tolerance=max(50e-6, abs(drift)))
+    # The longest lock wait is the host's when it lies in the step of a late period during
+    # which the witness, on any CPU (the holder's too), was held up for all of it but the
+    # target; otherwise it is counted ours.
+    wait, everywhere = stats["lock_wait_max"], witness.events(witness.cpus)
+    wait_verdict = "within target" if wait <= 200e-6 else "ours" if witness.ok else "unknown"
+    for r in rows:
+        if wait_verdict == "ours" and r["step_wall"] >= wait:
+            if held_up(everywhere, r["start"], r["start"] + r["step_wall"]) >= wait - 200e-6:
+                wait_verdict = "host"
     us = lambda v: round(v * 1e6, 1)  # noqa: E731
     verdicts = [r["verdict"] for r in rows]
     return {
         "over_2ms_host": verdicts.count("host"),
         "over_2ms_ours": verdicts.count("ours"),
         "over_2ms_unknown": verdicts.count("unknown"),
+        "lock_wait_max_verdict": wait_verdict,
         # Each period over 2 ms: when (s into the run), how long, the step before it (wall,
         # CPU, how far past the next deadline it ran), how late the next step began after it
-        # was due, what the witness on the loop's CPU shared, and whose it is.
+        # was due, how much of it the witness on the loop's CPU shared, and whose it is.
         "late": [
             {
                 "at_s": round(r["start"] - first, 3),
@@ -467,7 +479,7 @@ def realtime_attribution(stats: dict, anchors, witness, scheduling: str) -> dict
                 "step_cpu_us": us(r["step_cpu"]),
                 "overrun_us": us(r["overrun"]),
                 "wake_late_us": us(r["wake_late"]),
-                "witness_late_us": us(r["witness_late"]),
+                "machine_us": us(r["machine"]),
                 "verdict": r["verdict"],
             }
             for r in rows
@@ -490,7 +502,7 @@ def realtime(args) -> Iterator[dict]:
     for drilling in (False, True):
         with Witness() as witness:
             world, drill, binding, loop, frames, anchors, counters = realtime_session(
-                seconds, drilling
+                seconds, drilling, witness
             )
         s = loop.stats
         line = {

@@ -191,8 +191,9 @@ void RealTimeLoop::run_steps() {
     const double cpu = thread_cpu();
     try {
       // The step takes the lock again (it is recursive): this measures the wait alone.
+      const double asked = now();
       auto state = world_.lock_state();
-      r.lock_wait = now() - r.start;
+      r.lock_wait = now() - asked;
       world_.step(1);
     } catch (const std::exception& e) {
       std::lock_guard<std::mutex> lock(mutex_);

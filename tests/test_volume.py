@@ -204,6 +204,26 @@ def test_dirty_box_upload_equals_a_full_upload():
         assert np.array_equal(getattr(edited, name), getattr(full, name)), name
 
 
+def test_many_scattered_edits_upload_as_a_full_upload_would():
+    # Sixty small removals between two captures, near each other and far apart (more edits than
+    # a capture copies boxes, so the renderer merges them): the result is the full upload's.
+    data = ambfplus.phantom(96)
+    world, volume, camera = render_world(data)
+    camera.capture()
+    rng = np.random.default_rng(7)
+    near = rng.uniform(-0.003, 0.003, (50, 3)) + (0.0, 0.0, 0.012)
+    far = rng.uniform(-0.02, 0.02, (10, 3))
+    removed = sum(volume.remove_sphere(tuple(c), 0.0008) for c in np.vstack([near, far]))
+    assert removed > 100
+    edited = camera.capture()
+    assert not volume.last_upload["full"]
+    _, fresh_volume, fresh_camera = render_world(data)
+    full = fresh_camera.capture()
+    assert fresh_volume.last_upload["full"]
+    for name in ("rgb", "depth", "label"):
+        assert np.array_equal(getattr(edited, name), getattr(full, name)), name
+
+
 def test_edit_through_numpy_changes_the_next_render_and_reset_restores_it():
     data = ambfplus.phantom(64)
     _, volume, camera = render_world(data)

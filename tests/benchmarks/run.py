@@ -387,10 +387,14 @@ def realtime_scene():
     return world, drill, camera, into
 
 
-def realtime_session(seconds: float, drilling: bool):
+def realtime_session(seconds: float, drilling: bool, witness=None):
     """A real-time session of the scene driven by a simulated hand, a camera capturing
-    continuously in another thread: loop statistics, frames, and the input log."""
+    continuously in another thread: loop statistics, frames, the input log, and what tells a
+    stall of the machine from ours (rt_witness: the loop's steps against CLOCK_MONOTONIC, its
+    thread's counters; a running witness is put out of the loop's phase)."""
     import threading
+
+    from rt_witness import loop_phase, loop_thread, step_anchors, thread_counters
 
     world, drill, camera, into = realtime_scene()
     hand = ambfplus.SimulatedDevice()
@@ -405,7 +409,13 @@ def realtime_session(seconds: float, drilling: bool):
 
     loop = ambfplus.RealTimeLoop(world)
     thread = threading.Thread(target=capture)
+    first_index = world.step_index
     with loop:
+        anchors = step_anchors(world, first_index, 0.02)
+        if witness is not None:
+            witness.align(loop_phase(anchors, 1e-3))
+        tid = loop_thread()
+        before = thread_counters(tid)
         thread.start()
         if drilling:
             # Into the bone (3 mm past the surface) and along it, burr on.
@@ -419,17 +429,81 @@ def realtime_session(seconds: float, drilling: bool):
             time.sleep(seconds)
         stop.set()
         thread.join()
-    return world, drill, binding, loop, frames[0]
+        after = thread_counters(tid)
+        anchors += step_anchors(world, first_index, 0.02)
+    counters = {k: round(after[k] - before[k], 3) for k in before if k != "timer_slack_ns"}
+    counters["timer_slack_ns"] = before.get("timer_slack_ns")
+    return world, drill, binding, loop, frames[0], anchors, counters
+
+
+def realtime_attribution(stats: dict, anchors, witness, scheduling: str) -> dict:
+    """The late periods of a run, each split into the step's time and the wake-up's lateness
+    and marked 'host' or 'ours' by the witness (rt_witness), and the figures that go with it."""
+    import re
+
+    from rt_witness import attribute, first_step_time, held_up, late_periods
+
+    periods = np.asarray(stats["periods"])
+    first = first_step_time(periods, anchors)
+    # The anchors at the end must agree with those at the start: the periods are then whole.
+    last = max(n for _, n in anchors)
+    drift = min(t - first - float(np.sum(periods[: n - 1])) for t, n in anchors if n >= last - 20)
+    rows = late_periods(stats, first, 1e-3)
+    pinned = re.search(r"pinned to CPU (\d+)", scheduling)
+    cpus = [int(pinned.group(1))] if pinned else witness.cpus
+    attribute(rows, witness, cpus, tolerance=max(50e-6, abs(drift)))
+    # The longest lock wait is the host's when it lies in the step of a late period during
+    # which the witness, on any CPU (the holder's too), was held up for all of it but the
+    # target; otherwise it is counted ours.
+    wait, everywhere = stats["lock_wait_max"], witness.events(witness.cpus)
+    wait_verdict = "within target" if wait <= 200e-6 else "ours" if witness.ok else "unknown"
+    for r in rows:
+        if wait_verdict == "ours" and r["step_wall"] >= wait:
+            if held_up(everywhere, r["start"], r["start"] + r["step_wall"]) >= wait - 200e-6:
+                wait_verdict = "host"
+    us = lambda v: round(v * 1e6, 1)  # noqa: E731
+    verdicts = [r["verdict"] for r in rows]
+    return {
+        "over_2ms_host": verdicts.count("host"),
+        "over_2ms_ours": verdicts.count("ours"),
+        "over_2ms_unknown": verdicts.count("unknown"),
+        "lock_wait_max_verdict": wait_verdict,
+        # Each period over 2 ms: when (s into the run), how long, the step before it (wall,
+        # CPU, how far past the next deadline it ran), how late the next step began after it
+        # was due, how much of it the witness on the loop's CPU shared, and whose it is.
+        "late": [
+            {
+                "at_s": round(r["start"] - first, 3),
+                "period_us": us(r["period"]),
+                "step_wall_us": us(r["step_wall"]),
+                "step_cpu_us": us(r["step_cpu"]),
+                "overrun_us": us(r["overrun"]),
+                "wake_late_us": us(r["wake_late"]),
+                "machine_us": us(r["machine"]),
+                "verdict": r["verdict"],
+            }
+            for r in rows
+        ],  # fmt: skip
+        "clock_alignment_us": us(abs(drift)),
+        **witness.report,
+    }
 
 
 @benchmark
 def realtime(args) -> Iterator[dict]:
     """Real-time mode: the 1 kHz physics/haptics loop while a camera captures continuously in
     another thread, idle and drilling; then the drilling session's logged inputs replayed in
-    scripted mode, which must give the same removal log."""
+    scripted mode, which must give the same removal log. Every period over 2 ms is split into
+    the step's time and the wake-up's lateness and attributed to the host or to us by a witness
+    probe on every CPU (rt_witness.py)."""
+    from rt_witness import Witness
+
     seconds = 3.0 if args.quick else 10.0
     for drilling in (False, True):
-        world, drill, binding, loop, frames = realtime_session(seconds, drilling)
+        with Witness() as witness:
+            world, drill, binding, loop, frames, anchors, counters = realtime_session(
+                seconds, drilling, witness
+            )
         s = loop.stats
         line = {
             "bench": "realtime_loop_drilling" if drilling else "realtime_loop",
@@ -442,14 +516,17 @@ def realtime(args) -> Iterator[dict]:
             "mean_rate_hz": round(s["mean_rate"], 2),
             "rate_target_hz": 995,
             "step_cpu_p99_us": round(s["step_cpu_p99"] * 1e6, 1),
+            "step_cpu_max_us": round(s["step_cpu_max"] * 1e6, 1),
             "step_wall_max_us": round(s["step_wall_max"] * 1e6, 1),
             # The longest the physics thread waited for the world's lock (a capture's copy).
             "lock_wait_max_us": round(s["lock_wait_max"] * 1e6, 1),
             "lock_wait_p99_us": round(s["lock_wait_p99"] * 1e6, 1),
             "lock_wait_target_us": 200,
-            # For each period over 2 ms, the wall time of the step before it: short steps mean
-            # the thread woke late (the host), not that a step ran long.
-            "late_step_wall_us": [round(w * 1e6, 1) for w in s["late_step_wall"]],
+            **realtime_attribution(s, anchors, witness, loop.scheduling),
+            # The loop thread over the run: page faults (its own allocations) and switches
+            # (voluntary: sleeps and lock waits; involuntary: preempted by a higher priority).
+            "loop_thread": counters,
+            "rt_runtime": Path("/proc/sys/kernel/sched_rt_runtime_us").read_text().strip(),
             "frames": frames,
             "frames_per_s": round(frames / s["seconds"], 2),
             "scheduling": loop.scheduling,

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 #include "ambfplus/volume/volume_data.h"
@@ -129,6 +130,54 @@ TEST(VolumeData, RaycastHitsAFlatFaceAtItsPlane) {
   EXPECT_TRUE(hit.normal.isApprox(Eigen::Vector3d::UnitZ(), 1e-3));
   EXPECT_EQ(hit.label, 1);
   EXPECT_FALSE(v.raycast(Eigen::Vector3d(0, 0, 0.05), Eigen::Vector3d(1, 0, 0)).hit);
+}
+
+// Whether every input box lies in one of the merged boxes.
+bool covered(const std::vector<VoxelBox>& inputs, const std::vector<VoxelBox>& merged) {
+  return std::all_of(inputs.begin(), inputs.end(), [&](const VoxelBox& in) {
+    return in.empty() || std::any_of(merged.begin(), merged.end(),
+                                     [&](const VoxelBox& m) { return m.united(in) == m; });
+  });
+}
+
+// A burr's scattered one-voxel removals between two captures become one box to copy; edits
+// far from them stay boxes of their own.
+TEST(CoalesceBoxes, JoinsNearbyEditsAndKeepsFarOnesApart) {
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<int> near(100, 120);
+  std::vector<VoxelBox> boxes;
+  for (int n = 0; n < 50; ++n) {
+    const std::array<int, 3> lo{near(rng), near(rng), near(rng)};
+    boxes.push_back(VoxelBox{lo, {lo[0] + 1, lo[1] + 1, lo[2] + 1}});
+  }
+  boxes.push_back(VoxelBox{{10, 10, 10}, {12, 12, 12}});
+  boxes.push_back(VoxelBox{{200, 10, 10}, {203, 11, 11}});
+  boxes.push_back(VoxelBox{});  // an empty edit
+  boxes.push_back(VoxelBox{{10, 200, 200}, {11, 201, 201}});
+  const std::vector<VoxelBox> inputs = boxes;
+  render::coalesce_boxes(boxes, 2, 8, 4096);
+  EXPECT_TRUE(covered(inputs, boxes));
+  ASSERT_EQ(boxes.size(), 4u);
+  const VoxelBox cluster{{100, 100, 100}, {121, 121, 121}};
+  EXPECT_EQ(std::count_if(boxes.begin(), boxes.end(),
+                          [&](const VoxelBox& b) { return cluster.united(b) == cluster; }),
+            1);
+}
+
+TEST(CoalesceBoxes, MergesFarEditsBeyondTheLimit) {
+  std::vector<VoxelBox> boxes;
+  for (int n = 0; n < 12; ++n) {
+    const int at = 20 * n;
+    boxes.push_back(VoxelBox{{at, 0, 250 - at}, {at + 1, 1, 251 - at}});
+  }
+  const std::vector<VoxelBox> inputs = boxes;
+  render::coalesce_boxes(boxes, 2, 8, 4096);
+  EXPECT_LE(boxes.size(), 8u);
+  EXPECT_GE(boxes.size(), 1u);
+  EXPECT_TRUE(covered(inputs, boxes));
+  std::vector<VoxelBox> none{VoxelBox{}};
+  render::coalesce_boxes(none, 2, 8, 4096);
+  EXPECT_TRUE(none.empty());
 }
 
 }  // namespace

@@ -134,7 +134,7 @@ std::optional<VolumeUpload> SceneRenderer::last_upload(const Volume& volume) con
 
 void SceneRenderer::snapshot(const Camera& camera, unsigned passes, const PoseRequest& poses,
                              Snapshot& snapshot, Frame& frame) {
-  auto lock = world_.lock_state();
+  auto lock = world_.lock_state_for_copy();
   // Names are checked first, so a bad request leaves the frame as it was.
   std::vector<const Object*> posed;
   if (poses.all) {

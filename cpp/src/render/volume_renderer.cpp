@@ -11,6 +11,13 @@
 #include "render/scene_renderer.h"
 
 namespace ambfplus::render {
+namespace {
+
+// Boxes a stage copies at most, and the voxels a merge may add for one box fewer.
+constexpr std::size_t kStagedBoxes = 8;
+constexpr std::int64_t kStagingSlack = 4096;
+
+}  // namespace
 
 std::vector<std::uint8_t> brick_distances(const std::vector<std::uint8_t>& brick_max,
                                           const std::array<int, 3>& n, double level) {
@@ -45,6 +52,49 @@ std::vector<std::uint8_t> brick_distances(const std::vector<std::uint8_t>& brick
     for (int j = n[1] - 1; j >= 0; --j)
       for (int i = n[0] - 1; i >= 0; --i) relax(i, j, k, -1);
   return d;
+}
+
+void coalesce_boxes(std::vector<VoxelBox>& boxes, int margin, std::size_t max_boxes,
+                    std::int64_t slack) {
+  auto grown = [margin](const VoxelBox& b) { return b.grown(margin).count(); };
+  // Voxels the grown copy of a ∪ b holds beyond those of a and b apart.
+  auto extra = [&](const VoxelBox& a, const VoxelBox& b) {
+    return grown(a.united(b)) - grown(a) - grown(b);
+  };
+  std::size_t kept = 0;  // boxes[0, kept) are the merged ones
+  for (std::size_t n = 0; n < boxes.size(); ++n) {
+    const VoxelBox box = boxes[n];
+    if (box.empty()) continue;
+    std::size_t best = kept;
+    std::int64_t best_extra = 0;
+    for (std::size_t m = 0; m < kept; ++m) {
+      const std::int64_t e = extra(boxes[m], box);
+      if (best == kept || e < best_extra) {
+        best = m;
+        best_extra = e;
+      }
+    }
+    if (best == kept || (best_extra > slack && kept < max_boxes)) {
+      boxes[kept++] = box;
+    } else {
+      boxes[best] = boxes[best].united(box);
+    }
+  }
+  boxes.resize(kept);
+  // A box that grew may now overlap another: join pairs that cost little, until none does.
+  for (bool joined = true; joined;) {
+    joined = false;
+    for (std::size_t a = 0; a < boxes.size() && !joined; ++a) {
+      for (std::size_t b = a + 1; b < boxes.size(); ++b) {
+        if (extra(boxes[a], boxes[b]) <= slack) {
+          boxes[a] = boxes[a].united(boxes[b]);
+          boxes.erase(boxes.begin() + static_cast<std::ptrdiff_t>(b));
+          joined = true;
+          break;
+        }
+      }
+    }
+  }
 }
 
 namespace {
@@ -182,6 +232,8 @@ void GpuVolume::stage(double iso) {
   } else if (!data_->dirty_boxes_since(revision_, &boxes_)) {
     boxes_.clear();
   }
+  // Few boxes: each costs allocations and a pass over its rows, under the world's lock.
+  coalesce_boxes(boxes_, VolumeData::kSmoothRadius, kStagedBoxes, kStagingSlack);
   // Bricks that may hold the surface: those whose largest value can reach the level (one step
   // of 8-bit filtering below it, so rounding never hides a surface).
   pending.level = std::max(0.0, iso * 255.0 - 1.0);

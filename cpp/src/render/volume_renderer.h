@@ -20,6 +20,14 @@ namespace ambfplus::render {
 std::vector<std::uint8_t> brick_distances(const std::vector<std::uint8_t>& brick_max,
                                           const std::array<int, 3>& shape, double level);
 
+/// Merges boxes in place into at most max_boxes (max_boxes >= 1), for copying each box grown
+/// by margin voxels: a box joins the kept box whose union with it adds the fewest voxels to
+/// their grown copies, and starts a box of its own while fewer than max_boxes are kept and
+/// joining would add more than `slack` voxels. Many small edits near each other (a burr's
+/// removals between two captures) then cost a few copies, and far-apart ones stay apart.
+void coalesce_boxes(std::vector<VoxelBox>& boxes, int margin, std::size_t max_boxes,
+                    std::int64_t slack);
+
 /// What the last upload of a volume sent to the GPU.
 struct VolumeUpload {
   bool full = false;

@@ -1,5 +1,7 @@
 #include "ambfplus/scene/state_mutex.h"
 
+#include <sched.h>
+
 #include <cerrno>
 #include <cstring>
 #include <string>
@@ -38,5 +40,19 @@ bool StateMutex::try_lock() {
 }
 
 void StateMutex::unlock() noexcept { pthread_mutex_unlock(&mutex_); }
+
+ScopedPriority::ScopedPriority(int priority) {
+  if (priority <= 0) return;
+  const pthread_t self = pthread_self();
+  if (pthread_getschedparam(self, &policy_, &param_) != 0) return;
+  if ((policy_ == SCHED_FIFO || policy_ == SCHED_RR) && param_.sched_priority >= priority) return;
+  sched_param raised{};
+  raised.sched_priority = priority;
+  raised_ = pthread_setschedparam(self, SCHED_FIFO, &raised) == 0;
+}
+
+ScopedPriority::~ScopedPriority() {
+  if (raised_) pthread_setschedparam(pthread_self(), policy_, &param_);
+}
 
 }  // namespace ambfplus

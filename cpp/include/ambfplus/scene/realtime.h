@@ -37,6 +37,7 @@ struct AMBFPLUS_API RealTimeStats {
   static constexpr std::size_t kLateListed = 1024;
   std::int64_t steps = 0;
   double seconds = 0.0;         ///< wall time from the first step to the last
+  double first_start = 0.0;     ///< CLOCK_MONOTONIC time the first step began, s
   std::vector<double> periods;  ///< the last periods (up to kWindow), oldest first
   double mean_rate = 0.0;       ///< steps per second
   double p99 = 0.0, max = 0.0;  ///< s
@@ -47,10 +48,17 @@ struct AMBFPLUS_API RealTimeStats {
   /// s the loop's thread waited for the world's state lock before a step: the longest, and the
   /// 99th percentile (other threads hold it only to copy or change the scene).
   double lock_wait_max = 0.0, lock_wait_p99 = 0.0;
-  /// Periods over 2 ms (the first kLateListed): their index, the wall and CPU time of the step
-  /// that began them.
+  /// s a step began after it was due (its deadline, or the end of the step before it when that
+  /// one ran past the deadline): the time the kernel, or the host of a virtual machine, took to
+  /// run the thread, which no step of ours can cause. The longest, and the 99th percentile.
+  double wake_late_max = 0.0, wake_late_p99 = 0.0;
+  /// Periods over 2 ms (the first kLateListed): their index; the wall time, CPU time and lock
+  /// wait of the step that began them; the CLOCK_MONOTONIC time they began (s, to line them up
+  /// with other clocks); and how late the step that ended them began (as wake_late). A period
+  /// is step wall + the sleep to the deadline + the wake-up's lateness: a long wall time is the
+  /// step's, a large lateness the machine's.
   std::vector<std::int64_t> late;
-  std::vector<double> late_step_wall, late_step_cpu;
+  std::vector<double> late_step_wall, late_step_cpu, late_step_lock_wait, late_start, late_wake;
 };
 
 /// Steps a world in real time on a thread of its own: one world step per period at absolute
@@ -87,36 +95,49 @@ class AMBFPLUS_API RealTimeLoop {
   void set_poll_hook(std::function<void(double dt)> hook);
 
  private:
+  /// What one step measured, s.
+  struct StepRecord {
+    double start = 0.0, cpu = 0.0, wall = 0.0, lock_wait = 0.0, wake_late = 0.0;
+  };
+  /// The last kWindow values of something measured every step, in storage allocated by
+  /// reset() (off the loop's thread) and never reallocated.
+  struct Window {
+    std::vector<double> values;
+    std::size_t size = 0, next = 0;
+    void reset();
+    void push(double v);
+    std::vector<double> in_order() const;  // oldest first
+    std::vector<double> held() const;      // in storage order
+  };
+  /// Steps a loop's thread measured but has not yet added to the statistics: it adds them
+  /// when mutex_ is free, so it never waits for a thread reading them.
+  static constexpr std::size_t kPending = 256;
+
   void run_steps();
   void run_polls();
+  /// Keeps a step's record (the loop's thread only).
+  void record(const StepRecord& r);
+  /// Adds the pending records to the statistics (mutex_ held).
+  void flush_records();
 
   World& world_;
   RealTimeOptions options_;
   std::atomic<bool> running_{false};
   std::atomic<bool> stopping_{false};
   std::thread steps_thread_, polls_thread_;
+  StepRecord pending_[kPending];  // the loop's thread only
+  std::size_t pending_count_ = 0;
   mutable std::mutex mutex_;  // guards what follows
   std::condition_variable wake_;
   std::string scheduling_;
-  /// The last kWindow values of something measured every step.
-  struct Window {
-    std::vector<double> values;
-    std::size_t next = 0;
-    void clear() {
-      values.clear();
-      next = 0;
-    }
-    void push(double v);
-    std::vector<double> in_order() const;  // oldest first
-  };
-  Window periods_, step_cpu_, step_wall_, lock_wait_;
-  double max_period_ = 0.0, max_cpu_ = 0.0, max_wall_ = 0.0, max_wait_ = 0.0;
+  Window periods_, step_cpu_, step_wall_, lock_wait_, wake_late_;
+  double max_period_ = 0.0, max_cpu_ = 0.0, max_wall_ = 0.0, max_wait_ = 0.0, max_wake_ = 0.0;
   std::int64_t over_2ms_ = 0;
   std::vector<std::int64_t> late_;
-  std::vector<double> late_wall_, late_cpu_;
+  std::vector<double> late_wall_, late_cpu_, late_wait_, late_start_, late_wake_;
   std::int64_t steps_ = 0;
   double first_ = 0.0, last_ = 0.0;
-  double last_wall_ = 0.0, last_cpu_ = 0.0;  // the step before the current period
+  StepRecord last_record_;  // the step before the current period
   std::string error_;
   std::function<void(double)> poll_hook_;
 };

@@ -147,6 +147,15 @@ class AMBFPLUS_API World {
   std::unique_lock<StateMutex> lock_state() const {
     return std::unique_lock<StateMutex>(state_mutex_);
   }
+  /// lock_state() for a short copy out of the world by a thread other than a real-time loop's
+  /// (a capture's snapshot, the loop's polling thread): while a loop steps the world at
+  /// SCHED_FIFO, the caller runs one priority below it until it unlocks, so no other thread
+  /// of the machine preempts it while the loop may be waiting (a priority ceiling on top of
+  /// the lock's inheritance, which only boosts a holder once the loop waits).
+  StateCopyLock lock_state_for_copy() const {
+    const int loop = realtime_priority_;
+    return StateCopyLock(state_mutex_, loop > 1 ? loop - 1 : loop);
+  }
   /// The state lock itself, for callers that cannot hold a unique_lock (the plugin C API).
   StateMutex& state_mutex() const { return state_mutex_; }
 
@@ -155,7 +164,14 @@ class AMBFPLUS_API World {
   bool realtime() const { return realtime_; }
   /// Marks the world as stepped by a real-time loop; false if one already is (for RealTimeLoop).
   bool enter_realtime() { return !realtime_.exchange(true); }
-  void leave_realtime() { realtime_ = false; }
+  void leave_realtime() {
+    realtime_priority_ = 0;
+    realtime_ = false;
+  }
+  /// The SCHED_FIFO priority of the real-time loop stepping this world (0: none, or one
+  /// without real-time scheduling); set by the loop's thread once it has its scheduling.
+  int realtime_priority() const { return realtime_priority_; }
+  void set_realtime_priority(int priority) { realtime_priority_ = priority; }
 
   /// The world's renderer (its GPU resources; a capture draws through it).
   render::Renderer& renderer() { return *renderer_; }
@@ -197,6 +213,7 @@ class AMBFPLUS_API World {
   std::optional<ShaderSpec> shader_;
   mutable StateMutex state_mutex_;
   std::atomic<bool> realtime_{false};
+  std::atomic<int> realtime_priority_{0};
 };
 
 template <typename T>

@@ -282,24 +282,22 @@ def held_up(events: np.ndarray, start: float, end: float) -> float:
     return total
 
 
-def attribute(rows: list[dict], witness: Witness, cpus, tolerance: float) -> None:
+def attribute(rows: list[dict], witness: Witness, cpus) -> None:
     """Marks each late period 'host' or 'ours' (or 'unknown' without a witness), with how much
-    of it the machine took ('machine'): the whole wake-up's lateness when the probe on the
-    loop's CPU (`cpus`: those the loop may have run on) was due within a period after the loop
-    and woke with it, plus the time within the step during which the probe was held up. While
-    the probe, above the loop's priority, could not run, neither could the loop's own code: the
-    CPU was the host's, an interrupt's, or in kernel code that does not yield (the loop's own
-    page faults could be such code: their count is in the benchmark's line). A period that
-    would still be over 2 ms without what the machine took is ours."""
+    of it the machine took ('machine'): of the wake-up's lateness, all of it when the probe on
+    the loop's CPU (`cpus`: those the loop may have run on) was held up for at least half of it
+    (a stall may begin up to a period before the probe is due, and a CPU back from one first
+    serves its interrupts), else the part the probe shared; plus the time within the step
+    during which the probe was held up. While the probe, above the loop's priority, could not
+    run, neither could the loop's own code: the CPU was the host's, an interrupt's, or in kernel
+    code that does not yield (the loop's own page faults could be such code: their count is in
+    the benchmark's line). A period that would still be over 2 ms without what the machine took
+    is ours."""
     events = witness.events(cpus)
-    deadline, lateness = events[:, 0], events[:, 1]
-    woke = deadline + lateness
     for r in rows:
         due = r["woke"] - r["wake_late"]
-        shared = (deadline <= due + 1e-3 + tolerance) & (
-            np.abs(woke - r["woke"]) <= 2e-4 + tolerance
-        )
-        wake_machine = r["wake_late"] if shared.any() else 0.0
+        shared = held_up(events, due, r["woke"])
+        wake_machine = r["wake_late"] if shared >= 0.5 * r["wake_late"] else shared
         step_machine = held_up(events, r["start"], r["start"] + r["step_wall"])
         r["machine"] = wake_machine + step_machine
         if not witness.ok:

@@ -451,7 +451,7 @@ def realtime_attribution(stats: dict, anchors, witness, scheduling: str) -> dict
     rows = late_periods(stats, first, 1e-3)
     pinned = re.search(r"pinned to CPU (\d+)", scheduling)
     cpus = [int(pinned.group(1))] if pinned else witness.cpus
-    attribute(rows, witness, cpus, tolerance=max(50e-6, abs(drift)))
+    attribute(rows, witness, cpus)
     # The longest lock wait is the host's when it lies in the step of a late period during
     # which the witness, on any CPU (the holder's too), was held up for all of it but the
     # target; otherwise it is counted ours.
@@ -461,6 +461,11 @@ def realtime_attribution(stats: dict, anchors, witness, scheduling: str) -> dict
         if wait_verdict == "ours" and r["step_wall"] >= wait:
             if held_up(everywhere, r["start"], r["start"] + r["step_wall"]) >= wait - 200e-6:
                 wait_verdict = "host"
+    if os.environ.get("AMBFPLUS_REALTIME_DUMP"):
+        # Everything the attribution used, appended as one JSON line, to look into a verdict.
+        with open(os.environ["AMBFPLUS_REALTIME_DUMP"], "a") as dump:
+            late = {c: v.tolist() for c, v in witness.late.items()}
+            dump.write(json.dumps({"first": first, "rows": rows, "witness": late}) + "\n")
     us = lambda v: round(v * 1e6, 1)  # noqa: E731
     verdicts = [r["verdict"] for r in rows]
     return {
@@ -468,15 +473,17 @@ def realtime_attribution(stats: dict, anchors, witness, scheduling: str) -> dict
         "over_2ms_ours": verdicts.count("ours"),
         "over_2ms_unknown": verdicts.count("unknown"),
         "lock_wait_max_verdict": wait_verdict,
-        # Each period over 2 ms: when (s into the run), how long, the step before it (wall,
-        # CPU, how far past the next deadline it ran), how late the next step began after it
-        # was due, how much of it the witness on the loop's CPU shared, and whose it is.
+        # Each period over 2 ms: when (s into the run), how long, the step before it (wall, CPU,
+        # off its CPU: lock wait or blocked, how far past the next deadline it ran), how late
+        # the next step began after it was due, how much of it the witness on the loop's CPU
+        # shared, and whose it is.
         "late": [
             {
                 "at_s": round(r["start"] - first, 3),
                 "period_us": us(r["period"]),
                 "step_wall_us": us(r["step_wall"]),
                 "step_cpu_us": us(r["step_cpu"]),
+                "step_off_cpu_us": us(r["step_wall"] - r["step_cpu"]),
                 "overrun_us": us(r["overrun"]),
                 "wake_late_us": us(r["wake_late"]),
                 "machine_us": us(r["machine"]),

@@ -166,6 +166,7 @@ void SceneRenderer::snapshot(const Camera& camera, unsigned passes, const PoseRe
 
 void SceneRenderer::render(const Camera& camera, const CaptureBuffers& buffers,
                            const PoseRequest& poses, Frame& frame) {
+  stage_volumes();
   Snapshot s;
   snapshot(camera, buffers.passes() & kRenderedPasses, poses, s, frame);
   Context::Scope scope;
@@ -176,6 +177,7 @@ void SceneRenderer::render(const Camera& camera, const CaptureBuffers& buffers,
 
 const RenderTarget& SceneRenderer::render_to_target(const Camera& camera, unsigned passes,
                                                     Frame& frame) {
+  stage_volumes();
   Snapshot s;
   snapshot(camera, passes, PoseRequest{}, s, frame);
   Context::Scope scope;
@@ -217,19 +219,25 @@ void SceneRenderer::take(const Camera& camera, unsigned passes, Snapshot& s) {
     s.softs.push_back(std::move(soft));
   }
   for (const Volume* volume : world_.objects_of_kind<Volume>()) {
-    GpuVolume* gpu = nullptr;
-    {
-      std::lock_guard<std::mutex> lock(volumes_mutex_);
-      auto& slot = volumes_[volume->id()];
-      // A volume given other data is uploaded afresh.
-      if (!slot || slot->data() != volume->data()) {
-        slot = std::make_unique<GpuVolume>(volume->data());
-      }
-      gpu = slot.get();
-    }
-    gpu->stage(volume->iso());
-    s.volumes.push_back({gpu, volume->pose(), volume->iso(), volume->specular(),
+    GpuVolume& gpu = gpu_volume(*volume);
+    gpu.stage(volume->iso());
+    s.volumes.push_back({&gpu, volume->pose(), volume->iso(), volume->specular(),
                          volume->shininess(), volume->id(), volume->empty_space_skipping()});
+  }
+}
+
+GpuVolume& SceneRenderer::gpu_volume(const Volume& volume) {
+  std::lock_guard<std::mutex> lock(volumes_mutex_);
+  auto& slot = volumes_[volume.id()];
+  // A volume given other data is uploaded afresh.
+  if (!slot || slot->data() != volume.data()) slot = std::make_unique<GpuVolume>(volume.data());
+  return *slot;
+}
+
+void SceneRenderer::stage_volumes() {
+  auto lock = world_.lock_state_for_copy();
+  for (const Volume* volume : world_.objects_of_kind<Volume>()) {
+    gpu_volume(*volume).stage(volume->iso());
   }
 }
 

@@ -129,6 +129,12 @@ class SceneRenderer : public Renderer {
  private:
   /// Copies the camera's view out of the world (the caller holds the world's state lock).
   void take(const Camera& camera, unsigned passes, Snapshot& snapshot);
+  /// The GPU side of a volume, made (or made afresh for other data) on first use.
+  GpuVolume& gpu_volume(const Volume& volume);
+  /// Copies what changed of the world's volumes in a hold of the world's lock of its own, so
+  /// that the snapshot's hold, which must copy the volumes again, copies only what changed in
+  /// between: a real-time loop steps between two short holds rather than waiting for a long one.
+  void stage_volumes();
   /// Draws a snapshot and leaves it in the GPU (needs a Context::Scope).
   void draw(const Snapshot& snapshot);
   /// Reads the last draw of a snapshot's camera into buffers.

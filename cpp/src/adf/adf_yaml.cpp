@@ -227,6 +227,25 @@ void Diagnostics::repeated_names(const Doc& doc, std::initializer_list<const cha
   }
 }
 
+void Diagnostics::not_applied(const Doc& doc, const char* list_key,
+                              std::initializer_list<const char*> keys, const std::string& why) {
+  for (const char* key : keys) {
+    std::vector<std::string> blocks;
+    std::string first_line;
+    for (const auto& [id, block] : listed(doc, list_key)) {
+      if (!block.IsMap() || !block[key]) continue;
+      if (blocks.empty()) first_line = at(block[key]);
+      blocks.push_back(id);
+    }
+    if (blocks.empty()) continue;
+    std::string names;
+    for (std::size_t i = 0; i < blocks.size() && i < 3; ++i) names += (i ? ", " : "") + blocks[i];
+    if (blocks.size() > 3) names += " and " + std::to_string(blocks.size() - 3) + " more";
+    warn(doc.path,
+         first_line + "'" + key + "' of " + names + " is read by AMBF but not applied: " + why);
+  }
+}
+
 void yaml_error(const std::string& path, const YAML::Exception& e) {
   const std::string line = e.mark.is_null() ? "" : "line " + std::to_string(e.mark.line + 1) + ": ";
   // BadSubscript: yaml-cpp's "operator[] call on a scalar (key: ...)".

@@ -155,6 +155,10 @@ class Diagnostics {
   /// One warning per block of the lists named that takes a name an earlier block of the file
   /// has (AMBF renames it with a number suffix), naming both blocks.
   void repeated_names(const Doc& doc, std::initializer_list<const char*> list_keys);
+  /// One warning per key of `keys` that some block of the list `list_key` has: a key AMBF
+  /// reads that ambfplus does not apply, naming the blocks (up to three) that have it.
+  void not_applied(const Doc& doc, const char* list_key, std::initializer_list<const char*> keys,
+                   const std::string& why);
   std::vector<AdfProblem>& warnings() { return warnings_; }
   std::vector<AdfProblem>& errors() { return errors_; }
 

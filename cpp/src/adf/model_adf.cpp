@@ -110,6 +110,16 @@ Model& load_model(World& world, const std::string& path, Context& ctx) {
   }
   ctx.diag->repeated_names(doc, {"bodies", "soft bodies", "ghost objects", "joints", "sensors",
                                  "actuators", "cameras", "lights", "volumes"});
+  // Keys AMBF reads that change nothing here, one warning each per file.
+  ctx.diag->not_applied(doc, "bodies", {"controller", "controller output type"},
+                        "ambfplus has no body pose controller (set poses directly, or use joints)");
+  ctx.diag->not_applied(
+      doc, "bodies", {"use material"},
+      "a mesh takes its block's colour, and its material file's texture where it has one");
+  ctx.diag->not_applied(doc, "joints", {"enable feedback"}, "joint wrenches are not measured");
+  ctx.diag->not_applied(doc, "soft bodies",
+                        {"linear gain", "angular gain", "inertial offset", "collision groups"},
+                        "soft bodies have no controller, offset or collision groups here");
   const std::string model_ns =
       join_ns(ctx.prefix, world.name_space(),
               root["namespace"] ? text(doc, root["namespace"], where, "namespace") : "");

@@ -3,43 +3,36 @@ with the blocks that have them; a file without them gets no such warning."""
 
 from __future__ import annotations
 
-import textwrap
-
 import ambfplus
 
-MODEL = """
-    bodies: [BODY a, BODY b, BODY c, BODY d, BODY e]
-    joints: [JOINT ab]
-    {bodies}
-    JOINT ab:
-      name: ab
-      parent: BODY a
-      child: BODY b
-      type: revolute
-      parent axis: {{x: 0, y: 0, z: 1}}
-      child axis: {{x: 0, y: 0, z: 1}}
-      {joint_extra}
-    """
+JOINT = """
+JOINT ab:
+  name: ab
+  parent: BODY a
+  child: BODY b
+  type: revolute
+  parent axis: {x: 0, y: 0, z: 1}
+  child axis: {x: 0, y: 0, z: 1}
+"""
 
 
 def body(name: str, extra: str) -> str:
-    return textwrap.dedent(f"""
-    BODY {name}:
-      name: {name}
-      mass: 1.0
-      shape: box
-      geometry: {{x: 0.1, y: 0.1, z: 0.1}}
-      {extra}
-    """)
+    text = f"""
+BODY {name}:
+  name: {name}
+  mass: 1.0
+  shape: box
+  geometry: {{x: 0.1, y: 0.1, z: 0.1}}
+"""
+    return text + "".join(f"  {line}\n" for line in extra.splitlines())
 
 
 def load(tmp_path, caplog, body_extra: dict[str, str], joint_extra: str = ""):
-    bodies = "".join(body(n, body_extra.get(n, "")) for n in "abcde")
-    text = textwrap.dedent(MODEL).format(
-        bodies=textwrap.indent(bodies, "    "), joint_extra=joint_extra
-    )
+    text = "bodies: [BODY a, BODY b, BODY c, BODY d, BODY e]\njoints: [JOINT ab]\n"
+    text += "".join(body(n, body_extra.get(n, "")) for n in "abcde")
+    text += JOINT + (f"  {joint_extra}\n" if joint_extra else "")
     path = tmp_path / "model.yaml"
-    path.write_text(textwrap.dedent(text))
+    path.write_text(text)
     world = ambfplus.World()
     with caplog.at_level("WARNING"):
         world.load_adf(path)
@@ -48,7 +41,7 @@ def load(tmp_path, caplog, body_extra: dict[str, str], joint_extra: str = ""):
 
 def test_keys_read_but_not_applied_are_one_warning_each_naming_the_blocks(tmp_path, caplog):
     extra = {n: "use material: false" for n in "abcde"}
-    extra["a"] += "\n      controller: {linear: {P: 10, I: 0, D: 1}}"
+    extra["a"] += "\ncontroller: {linear: {P: 10, I: 0, D: 1}}"
     world, warnings = load(tmp_path, caplog, extra, joint_extra="enable feedback: true")
     assert len([b for b in "abcde" if world.get(b)]) == 5, "the file still loads whole"
     material = [w for w in warnings if "'use material'" in w]

@@ -54,6 +54,69 @@ TEST(SmoothedOccupancy, IncrementalEqualsFromScratch) {
   EXPECT_EQ(fresh.brick_max(), bricks);
 }
 
+// More edits between two reads than the derived fields keep boxes for (they merge): still
+// equal to recomputing from scratch.
+TEST(SmoothedOccupancy, ManyEditsBetweenReadsEqualFromScratch) {
+  std::mt19937 rng(5);
+  VolumeData v({30, 26, 22}, Eigen::Vector3d::Constant(0.03), LabelType::kUInt16, bone());
+  auto* labels = static_cast<std::uint16_t*>(v.label_data());
+  for (std::int64_t n = 0; n < v.voxel_count(); ++n) labels[n] = rng() % 2 ? 1 : 0;
+  v.mark_dirty(VoxelBox{{0, 0, 0}, v.shape()});
+  (void)v.smoothed_occupancy();
+  for (int e = 0; e < 100; ++e) {
+    const std::array<int, 3> at{int(rng() % 30), int(rng() % 26), int(rng() % 22)};
+    v.remove_voxels({at});
+  }
+  VolumeData fresh({30, 26, 22}, Eigen::Vector3d::Constant(0.03), LabelType::kUInt16, bone());
+  std::copy(labels, labels + v.voxel_count(), static_cast<std::uint16_t*>(fresh.label_data()));
+  EXPECT_EQ(fresh.smoothed_occupancy(), v.smoothed_occupancy());
+  EXPECT_EQ(fresh.brick_max(), v.brick_max());
+}
+
+// The derived fields of a box computed from a packed copy of the labels around it (as a
+// renderer does off the world's lock) equal the volume's own, for 1- and 2-byte labels.
+TEST(SmoothedOccupancy, FromAPackedCopyEqualsTheVolumes) {
+  for (const LabelType type : {LabelType::kUInt8, LabelType::kUInt16}) {
+    std::mt19937 rng(11);
+    const std::array<int, 3> shape{21, 19, 17};
+    VolumeData v(shape, Eigen::Vector3d::Constant(0.02), type, bone());
+    const int bytes = type == LabelType::kUInt16 ? 2 : 1;
+    auto* raw = static_cast<std::uint8_t*>(v.label_data());
+    for (std::int64_t n = 0; n < v.voxel_count(); ++n) raw[n * bytes] = rng() % 3 == 0;
+    v.mark_dirty(VoxelBox{{0, 0, 0}, shape});
+    const std::vector<std::uint8_t> whole_smoothed = v.smoothed_occupancy();
+    const std::vector<std::uint8_t> whole_bricks = v.brick_max();
+    // An edited box touching the grid's edge on one side: its bricks, their footprints and
+    // the labels the smoothing of those needs.
+    const VoxelBox edited{{0, 5, 7}, {6, 11, 12}};
+    const VoxelBox bricks =
+        bricks_reaching(edited.grown(VolumeData::kSmoothRadius).clipped(shape), shape);
+    const VoxelBox footprints = brick_footprints(bricks, shape);
+    const VoxelBox frame = footprints.grown(VolumeData::kSmoothRadius).clipped(shape);
+    std::vector<std::uint8_t> copy;
+    for (int k = frame.lo[2]; k < frame.hi[2]; ++k)
+      for (int j = frame.lo[1]; j < frame.hi[1]; ++j)
+        for (int i = frame.lo[0]; i < frame.hi[0]; ++i)
+          for (int b = 0; b < bytes; ++b) copy.push_back(raw[v.linear_index(i, j, k) * bytes + b]);
+    std::vector<std::uint8_t> smoothed(static_cast<std::size_t>(footprints.count()));
+    smooth_occupancy(copy.data(), frame, bytes, shape, footprints, smoothed.data(), footprints);
+    std::size_t at = 0;
+    for (int k = footprints.lo[2]; k < footprints.hi[2]; ++k)
+      for (int j = footprints.lo[1]; j < footprints.hi[1]; ++j)
+        for (int i = footprints.lo[0]; i < footprints.hi[0]; ++i, ++at)
+          ASSERT_EQ(smoothed[at], whole_smoothed[v.linear_index(i, j, k)]) << i << " " << j;
+    std::vector<std::uint8_t> maxima(static_cast<std::size_t>(bricks.count()));
+    brick_maxima(smoothed.data(), footprints, shape, bricks, maxima.data(), bricks);
+    const auto bs = v.brick_shape();
+    at = 0;
+    for (int k = bricks.lo[2]; k < bricks.hi[2]; ++k)
+      for (int j = bricks.lo[1]; j < bricks.hi[1]; ++j)
+        for (int i = bricks.lo[0]; i < bricks.hi[0]; ++i, ++at)
+          ASSERT_EQ(maxima[at],
+                    whole_bricks[i + std::size_t(bs[0]) * (j + std::size_t(bs[1]) * k)]);
+  }
+}
+
 TEST(VolumeData, DirtySinceUnitesLaterEdits) {
   VolumeData v({10, 10, 10}, Eigen::Vector3d::Constant(0.01), LabelType::kUInt8, bone());
   const std::int64_t r0 = v.revision();

@@ -113,18 +113,20 @@ GLuint make_texture_3d(GLenum filter, GLenum wrap) {
   return t;
 }
 
-// Copies box of a grid stored i fastest with `shape` (element size `bytes`), packed.
-std::vector<std::uint8_t> pack_box(const void* grid, const std::array<int, 3>& shape,
-                                   const VoxelBox& box, int bytes) {
+// Copies `box` out of a packed box `frame` of a grid (i fastest, `bytes` per element), packed.
+std::vector<std::uint8_t> pack_box(const void* grid, const VoxelBox& frame, const VoxelBox& box,
+                                   int bytes) {
   const auto* src = static_cast<const std::uint8_t*>(grid);
   const std::size_t row = static_cast<std::size_t>(box.hi[0] - box.lo[0]) * bytes;
+  const std::size_t w = static_cast<std::size_t>(frame.hi[0] - frame.lo[0]);
+  const std::size_t h = static_cast<std::size_t>(frame.hi[1] - frame.lo[1]);
   std::vector<std::uint8_t> out(row * (box.hi[1] - box.lo[1]) * (box.hi[2] - box.lo[2]));
   std::uint8_t* dst = out.data();
   for (int k = box.lo[2]; k < box.hi[2]; ++k) {
     for (int j = box.lo[1]; j < box.hi[1]; ++j, dst += row) {
       const std::size_t at =
-          (static_cast<std::size_t>(box.lo[0]) +
-           static_cast<std::size_t>(shape[0]) * (j + static_cast<std::size_t>(shape[1]) * k)) *
+          (static_cast<std::size_t>(box.lo[0] - frame.lo[0]) +
+           w * (static_cast<std::size_t>(j - frame.lo[1]) + h * (k - frame.lo[2]))) *
           bytes;
       std::memcpy(dst, src + at, row);
     }
@@ -227,8 +229,9 @@ void GpuVolume::stage(double iso) {
   Pending pending;
   stage_colors(pending);
   const bool first = revision_ < 0;
+  const auto& n = data_->shape();
   if (first) {
-    boxes_.assign(1, VoxelBox{{0, 0, 0}, data_->shape()});
+    boxes_.assign(1, VoxelBox{{0, 0, 0}, n});
   } else if (!data_->dirty_boxes_since(revision_, &boxes_)) {
     boxes_.clear();
   }
@@ -237,26 +240,17 @@ void GpuVolume::stage(double iso) {
   // Bricks that may hold the surface: those whose largest value can reach the level (one step
   // of 8-bit filtering below it, so rounding never hides a surface).
   pending.level = std::max(0.0, iso * 255.0 - 1.0);
-  const auto& n = data_->shape();
-  const auto b = data_->brick_shape();
   const int bytes = data_->label_type() == LabelType::kUInt16 ? 2 : 1;
-  // Copies only: the data keeps its smoothed occupancy and brick maxima up to date itself.
-  const std::vector<std::uint8_t>& smoothed = data_->smoothed_occupancy();
-  const std::vector<std::uint8_t>& brick_max = data_->brick_max();
-  constexpr int B = VolumeData::kBrickSize;
+  // Copies only: upload() derives the smoothed occupancy and brick maxima from these labels
+  // off the lock. A label change reaches the smoothed field kSmoothRadius voxels around it,
+  // and the maxima of the bricks whose footprint meets that, which need the smoothed field
+  // over their whole footprints, which needs the labels kSmoothRadius around those.
   for (const VoxelBox& box : boxes_) {
     if (box.empty()) continue;
-    pending.labels.push_back({box, pack_box(data_->label_data(), n, box, bytes)});
-    // The smoothed field changes kSmoothRadius voxels around every changed label, and the
-    // brick maxima of the bricks whose sampling footprint (a voxel beyond) meets that.
-    const VoxelBox grown = box.grown(VolumeData::kSmoothRadius).clipped(n);
-    pending.occupancy.push_back({grown, pack_box(smoothed.data(), n, grown, 1)});
-    VoxelBox bricks;
-    for (int a = 0; a < 3; ++a) {
-      bricks.lo[a] = std::max(0, (grown.lo[a] - 1) / B);
-      bricks.hi[a] = std::min(b[a], (grown.hi[a] + 1) / B + 1);
-    }
-    pending.brick_max.push_back({bricks, pack_box(brick_max.data(), b, bricks, 1)});
+    const VoxelBox bricks = bricks_reaching(box.grown(VolumeData::kSmoothRadius).clipped(n), n);
+    const VoxelBox frame = brick_footprints(bricks, n).grown(VolumeData::kSmoothRadius).clipped(n);
+    pending.regions.push_back(
+        {box, frame, pack_box(data_->label_data(), VoxelBox{{0, 0, 0}, n}, frame, bytes)});
   }
   revision_ = data_->revision();
   const bool level_changed = pending.level != staged_level_;
@@ -268,14 +262,29 @@ void GpuVolume::stage(double iso) {
   pending_.push_back(std::move(pending));
 }
 
-void GpuVolume::update_distances(const Pending& p, bool full) {
+void GpuVolume::derive(const Region& region, int bytes, Derived& out) const {
+  const auto& n = data_->shape();
+  const VoxelBox grown = region.edited.grown(VolumeData::kSmoothRadius).clipped(n);
+  const VoxelBox bricks = bricks_reaching(grown, n);
+  const VoxelBox footprints = brick_footprints(bricks, n);
+  std::vector<std::uint8_t> smoothed(static_cast<std::size_t>(footprints.count()));
+  smooth_occupancy(region.labels.data(), region.frame, bytes, n, footprints, smoothed.data(),
+                   footprints);
+  out.labels.push_back(
+      {region.edited, pack_box(region.labels.data(), region.frame, region.edited, bytes)});
+  out.occupancy.push_back({grown, pack_box(smoothed.data(), footprints, grown, 1)});
+  std::vector<std::uint8_t> maxima(static_cast<std::size_t>(bricks.count()));
+  brick_maxima(smoothed.data(), footprints, n, bricks, maxima.data(), bricks);
+  out.brick_max.push_back({bricks, std::move(maxima)});
+}
+
+void GpuVolume::update_distances(const std::vector<Box>& brick_boxes, double level, bool full) {
   const auto b = data_->brick_shape();
   if (brick_max_.empty()) {
     brick_max_.assign(static_cast<std::size_t>(b[0]) * b[1] * b[2], 0);
     full = true;
   }
-  for (const Box& box : p.brick_max) unpack_box(box.bytes, b, box.box, brick_max_.data());
-  const double level = p.level;
+  for (const Box& box : brick_boxes) unpack_box(box.bytes, b, box.box, brick_max_.data());
   full = full || level != distance_level_ || distances_.size() != brick_max_.size();
   auto at = [&](int i, int j, int k) {
     return static_cast<std::size_t>(i) +
@@ -283,8 +292,8 @@ void GpuVolume::update_distances(const Pending& p, bool full) {
   };
   // Removing material only empties bricks, which leaves every other distance a safe lower
   // bound: mark emptied bricks 1 and keep the rest. A brick that filled needs the full map.
-  for (std::size_t n = 0; n < p.brick_max.size() && !full; ++n) {
-    const VoxelBox& bricks = p.brick_max[n].box;
+  for (std::size_t n = 0; n < brick_boxes.size() && !full; ++n) {
+    const VoxelBox& bricks = brick_boxes[n].box;
     for (int k = bricks.lo[2]; k < bricks.hi[2] && !full; ++k)
       for (int j = bricks.lo[1]; j < bricks.hi[1] && !full; ++j)
         for (int i = bricks.lo[0]; i < bricks.hi[0]; ++i) {
@@ -302,12 +311,12 @@ void GpuVolume::update_distances(const Pending& p, bool full) {
     distances_ = brick_distances(brick_max_, b, level);
     const VoxelBox all{{0, 0, 0}, b};
     upload_box(bricks_, all, GL_RED_INTEGER, GL_UNSIGNED_BYTE,
-               pack_box(distances_.data(), b, all, 1));
+               pack_box(distances_.data(), all, all, 1));
     return;
   }
-  for (const Box& box : p.brick_max) {
+  for (const Box& box : brick_boxes) {
     upload_box(bricks_, box.box, GL_RED_INTEGER, GL_UNSIGNED_BYTE,
-               pack_box(distances_.data(), b, box.box, 1));
+               pack_box(distances_.data(), VoxelBox{{0, 0, 0}, b}, box.box, 1));
   }
 }
 
@@ -330,15 +339,17 @@ void GpuVolume::upload() {
       glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, 256, p.color_rows, 0, GL_RGBA, GL_UNSIGNED_BYTE,
                    p.colors.data());
     }
-    for (const Box& box : p.labels) {
+    Derived derived;
+    for (const Region& region : p.regions) derive(region, wide ? 2 : 1, derived);
+    for (const Box& box : derived.labels) {
       upload_box(labels_, box.box, GL_RED_INTEGER, wide ? GL_UNSIGNED_SHORT : GL_UNSIGNED_BYTE,
                  box.bytes);
       stats.voxels += box.box.count();
     }
-    for (const Box& box : p.occupancy) {
+    for (const Box& box : derived.occupancy) {
       upload_box(occupancy_, box.box, GL_RED, GL_UNSIGNED_BYTE, box.bytes);
     }
-    update_distances(p, p.full || created);
+    update_distances(derived.brick_max, p.level, p.full || created);
     stats.full = stats.full || p.full;
     stats.seconds += p.seconds;
   }

@@ -37,10 +37,11 @@ struct VolumeUpload {
 
 /// The GPU copies of one VolumeData (smoothed occupancy, labels, brick distances, label colours),
 /// brought up to date with only the boxes edited since the last update. Updating has two halves:
-/// stage() only copies what changed out of the data while the world's state lock is held (the
-/// data keeps its derived fields current itself, so nothing is computed there), upload() does
-/// everything else (brick distances, GL calls; needs a current context), so a physics thread
-/// may edit the data while the GPU side works. draw() too needs a current context.
+/// stage() only copies the edited labels (with the margin their derived fields need) out of the
+/// data while the world's state lock is held, upload() does everything else (the smoothed
+/// occupancy and brick maxima of those boxes, brick distances, GL calls; needs a current
+/// context) off the lock, so a physics thread edits the data, and never pays for the derived
+/// fields, while the GPU side works. draw() too needs a current context.
 class GpuVolume {
  public:
   explicit GpuVolume(std::shared_ptr<VolumeData> data);
@@ -64,9 +65,20 @@ class GpuVolume {
     VoxelBox box;
     std::vector<std::uint8_t> bytes;
   };
-  struct Pending {
+  // Labels copied under the lock: the box edited, and the labels of `frame` (a packed box of
+  // the grid) around it from which upload() derives what the edit changed.
+  struct Region {
+    VoxelBox edited;
+    VoxelBox frame;
+    std::vector<std::uint8_t> labels;
+  };
+  // What upload() sends for a staged update.
+  struct Derived {
     std::vector<Box> labels, occupancy;
-    std::vector<Box> brick_max;        // boxes of the brick grid
+    std::vector<Box> brick_max;  // boxes of the brick grid
+  };
+  struct Pending {
+    std::vector<Region> regions;
     std::vector<std::uint8_t> colors;  // RGBA rows of 256 label ids; empty: unchanged
     int color_rows = 0;
     double level = 0.0;  // 0..255 of the smoothed occupancy that counts as surface
@@ -74,9 +86,11 @@ class GpuVolume {
     double seconds = 0.0;  // staging time
   };
   void stage_colors(Pending& pending);
-  /// Brings the brick distances up to date with the staged brick maxima and uploads what
-  /// changed of them.
-  void update_distances(const Pending& pending, bool full);
+  /// The labels, smoothed occupancy and brick maxima a staged region changed.
+  void derive(const Region& region, int bytes, Derived& out) const;
+  /// Brings the brick distances up to date with new brick maxima and uploads what changed of
+  /// them.
+  void update_distances(const std::vector<Box>& brick_boxes, double level, bool full);
   void create_textures();
 
   std::shared_ptr<VolumeData> data_;

@@ -215,8 +215,9 @@ void VolumeData::record(VolumeEdit edit) {
     dirty_floor_ = dirty_.front().first;
     dirty_.pop_front();
   }
-  // The edit's thread pays for what it changed; readers then only copy.
-  if (derived_ready_) update_derived_box(edit.box);
+  // Readers bring the derived fields up to date; the editing thread (a haptic tick) only notes
+  // what changed.
+  mark_derived_stale(edit.box);
   log_edit(std::move(edit));
 }
 
@@ -426,6 +427,129 @@ std::deque<VolumeEdit> VolumeData::take_edit_log() {
 // ---------------------------------------------------------------------------------------------
 // Derived fields
 
+namespace {
+
+// Offset of voxel (i, j, k) in a box `frame` packed i fastest.
+std::size_t packed_index(const VoxelBox& frame, int i, int j, int k) {
+  const std::size_t w = static_cast<std::size_t>(frame.hi[0] - frame.lo[0]);
+  const std::size_t h = static_cast<std::size_t>(frame.hi[1] - frame.lo[1]);
+  return static_cast<std::size_t>(i - frame.lo[0]) +
+         w * (static_cast<std::size_t>(j - frame.lo[1]) + h * (k - frame.lo[2]));
+}
+
+VoxelBox whole(const std::array<int, 3>& shape) { return VoxelBox{{0, 0, 0}, shape}; }
+
+}  // namespace
+
+VoxelBox bricks_reaching(const VoxelBox& voxels, const std::array<int, 3>& shape) {
+  constexpr int B = VolumeData::kBrickSize;
+  VoxelBox bricks;
+  for (int a = 0; a < 3; ++a) {
+    const int count = (shape[a] + B - 1) / B;
+    bricks.lo[a] = std::max(0, (voxels.lo[a] - 1) / B);
+    bricks.hi[a] = std::min(count, (voxels.hi[a] + 1) / B + 1);
+  }
+  return bricks;
+}
+
+VoxelBox brick_footprints(const VoxelBox& bricks, const std::array<int, 3>& shape) {
+  constexpr int B = VolumeData::kBrickSize;
+  VoxelBox voxels;
+  for (int a = 0; a < 3; ++a) {
+    voxels.lo[a] = bricks.lo[a] * B - 1;
+    voxels.hi[a] = bricks.hi[a] * B + 1;
+  }
+  return voxels.clipped(shape);
+}
+
+void smooth_occupancy(const std::uint8_t* labels, const VoxelBox& labels_frame, int bytes,
+                      const std::array<int, 3>& shape, const VoxelBox& box, std::uint8_t* out,
+                      const VoxelBox& out_frame) {
+  if (box.empty()) return;
+  constexpr int R = VolumeData::kSmoothRadius;
+  constexpr int kWeights[2 * R + 1] = {1, 4, 6, 4, 1};  // binomial: sums to 16 per axis
+  const int w = box.hi[0] - box.lo[0], h = box.hi[1] - box.lo[1];
+  // One row of occupancy (0 or 1) with R voxels either side, 0 beyond the grid.
+  std::vector<std::uint8_t> occupied(static_cast<std::size_t>(w) + 2 * R);
+  const int in_lo = std::max(0, box.lo[0] - R), in_hi = std::min(shape[0], box.hi[0] + R);
+  auto read_row = [&](int j, int k) {
+    std::fill(occupied.begin(), occupied.end(), 0);
+    const std::size_t at = packed_index(labels_frame, in_lo, j, k);
+    std::uint8_t* dst = occupied.data() + (in_lo - (box.lo[0] - R));
+    if (bytes == 1) {
+      const std::uint8_t* row = labels + at;
+      for (int i = 0; i < in_hi - in_lo; ++i) dst[i] = row[i] != 0;
+    } else {
+      std::uint16_t value = 0;
+      for (int i = 0; i < in_hi - in_lo; ++i) {
+        std::memcpy(&value, labels + (at + i) * 2, 2);
+        dst[i] = value != 0;
+      }
+    }
+  };
+  // One k-slice of occupancy blurred along i and j, for (i, j) in box: rows of w, h rows.
+  std::vector<std::uint16_t> along_i(static_cast<std::size_t>(w) * (h + 2 * R));
+  auto blurred_slice = [&](int k, std::vector<std::uint16_t>& slice) {
+    slice.assign(static_cast<std::size_t>(w) * h, 0);
+    if (k < 0 || k >= shape[2]) return;
+    std::fill(along_i.begin(), along_i.end(), 0);
+    for (int jj = 0; jj < h + 2 * R; ++jj) {
+      const int j = box.lo[1] - R + jj;
+      if (j < 0 || j >= shape[1]) continue;
+      read_row(j, k);
+      std::uint16_t* dst = &along_i[static_cast<std::size_t>(jj) * w];
+      for (int t = 0; t <= 2 * R; ++t) {
+        const std::uint8_t* src = occupied.data() + t;
+        for (int ii = 0; ii < w; ++ii) dst[ii] = std::uint16_t(dst[ii] + kWeights[t] * src[ii]);
+      }
+    }
+    for (int jj = 0; jj < h; ++jj) {
+      std::uint16_t* dst = &slice[static_cast<std::size_t>(jj) * w];
+      for (int t = 0; t <= 2 * R; ++t) {
+        const std::uint16_t* src = &along_i[static_cast<std::size_t>(jj + t) * w];
+        for (int ii = 0; ii < w; ++ii) dst[ii] = std::uint16_t(dst[ii] + kWeights[t] * src[ii]);
+      }
+    }
+  };
+  // A window of 2R + 1 blurred slices around k.
+  std::vector<std::vector<std::uint16_t>> window(2 * R + 1);
+  for (int t = 0; t < 2 * R; ++t) blurred_slice(box.lo[2] - R + t, window[t + 1]);
+  for (int k = box.lo[2]; k < box.hi[2]; ++k) {
+    std::rotate(window.begin(), window.begin() + 1, window.end());
+    blurred_slice(k + R, window.back());
+    for (int jj = 0; jj < h; ++jj) {
+      std::uint8_t* dst = out + packed_index(out_frame, box.lo[0], box.lo[1] + jj, k);
+      const std::size_t o = static_cast<std::size_t>(jj) * w;
+      for (int ii = 0; ii < w; ++ii) {
+        int sum = 0;  // 0..4096
+        for (int t = 0; t <= 2 * R; ++t) sum += kWeights[t] * window[t][o + ii];
+        dst[ii] = static_cast<std::uint8_t>((sum * 255 + 2048) / 4096);
+      }
+    }
+  }
+}
+
+void brick_maxima(const std::uint8_t* smoothed, const VoxelBox& smoothed_frame,
+                  const std::array<int, 3>& shape, const VoxelBox& bricks, std::uint8_t* out,
+                  const VoxelBox& out_frame) {
+  for (int bk = bricks.lo[2]; bk < bricks.hi[2]; ++bk) {
+    for (int bj = bricks.lo[1]; bj < bricks.hi[1]; ++bj) {
+      for (int bi = bricks.lo[0]; bi < bricks.hi[0]; ++bi) {
+        const VoxelBox foot =
+            brick_footprints(VoxelBox{{bi, bj, bk}, {bi + 1, bj + 1, bk + 1}}, shape);
+        std::uint8_t m = 0;
+        for (int k = foot.lo[2]; k < foot.hi[2] && m < 255; ++k) {
+          for (int j = foot.lo[1]; j < foot.hi[1]; ++j) {
+            const std::uint8_t* row = smoothed + packed_index(smoothed_frame, foot.lo[0], j, k);
+            for (int i = 0; i < foot.hi[0] - foot.lo[0]; ++i) m = std::max(m, row[i]);
+          }
+        }
+        out[packed_index(out_frame, bi, bj, bk)] = m;
+      }
+    }
+  }
+}
+
 std::array<int, 3> VolumeData::brick_shape() const {
   return {(shape_[0] + kBrickSize - 1) / kBrickSize, (shape_[1] + kBrickSize - 1) / kBrickSize,
           (shape_[2] + kBrickSize - 1) / kBrickSize};
@@ -442,104 +566,37 @@ const std::vector<std::uint8_t>& VolumeData::brick_max() {
 }
 
 void VolumeData::update_derived() {
-  if (derived_ready_) return;
-  smoothed_.assign(static_cast<std::size_t>(voxel_count()), 0);
-  const auto b = brick_shape();
-  bricks_.assign(static_cast<std::size_t>(b[0]) * b[1] * b[2], 0);
-  derived_ready_ = true;
-  update_derived_box(VoxelBox{{0, 0, 0}, shape_});
+  if (!derived_ready_) {
+    smoothed_.assign(static_cast<std::size_t>(voxel_count()), 0);
+    bricks_.assign(static_cast<std::size_t>(brick_shape()[0]) * brick_shape()[1] * brick_shape()[2],
+                   0);
+    derived_ready_ = true;
+    derived_stale_.assign(1, whole(shape_));
+  }
+  for (const VoxelBox& box : derived_stale_) update_derived_box(box);
+  derived_stale_.clear();
+}
+
+void VolumeData::mark_derived_stale(const VoxelBox& box) {
+  if (!derived_ready_) return;  // computed in full when first read
+  derived_stale_.push_back(box);
+  if (derived_stale_.size() > kStaleBoxes) {
+    VoxelBox all;
+    for (const VoxelBox& b : derived_stale_) all = all.united(b);
+    derived_stale_.assign(1, all);
+  }
 }
 
 void VolumeData::update_derived_box(const VoxelBox& box) {
-  // A label change reaches the blurred field kSmoothRadius voxels around it.
+  // A label change reaches the blurred field kSmoothRadius voxels around it, and the brick
+  // maxima of the bricks whose footprint meets that.
   const VoxelBox affected = box.grown(kSmoothRadius).clipped(shape_);
-  smooth_box(affected);
-  update_bricks(affected);
-}
-
-void VolumeData::smooth_box(const VoxelBox& r) {
-  if (r.empty()) return;
-  constexpr int R = kSmoothRadius;
-  constexpr int kWeights[2 * R + 1] = {1, 4, 6, 4, 1};  // binomial: sums to 16 per axis
-  const int w = r.hi[0] - r.lo[0], h = r.hi[1] - r.lo[1];
-  // One k-slice of occupancy blurred along i and j, for (i, j) in r: rows of w, h rows.
-  std::vector<std::uint16_t> along_i(static_cast<std::size_t>(w) * (h + 2 * R));
-  auto blurred_slice = [&](int k, std::vector<std::uint16_t>& out) {
-    out.assign(static_cast<std::size_t>(w) * h, 0);
-    if (k < 0 || k >= shape_[2]) return;
-    std::fill(along_i.begin(), along_i.end(), 0);
-    visit_labels(label_type_, labels_.data(), [&](auto* p) {
-      for (int jj = 0; jj < h + 2 * R; ++jj) {
-        const int j = r.lo[1] - R + jj;
-        if (j < 0 || j >= shape_[1]) continue;
-        const auto* row = p + linear_index(0, j, k);
-        std::uint16_t* dst = &along_i[static_cast<std::size_t>(jj) * w];
-        for (int ii = 0; ii < w; ++ii) {
-          const int i = r.lo[0] + ii;
-          int sum = 0;
-          for (int t = -R; t <= R; ++t) {
-            const int x = i + t;
-            if (x >= 0 && x < shape_[0] && row[x] != 0) sum += kWeights[t + R];
-          }
-          dst[ii] = static_cast<std::uint16_t>(sum);
-        }
-      }
-    });
-    for (int jj = 0; jj < h; ++jj) {
-      std::uint16_t* dst = &out[static_cast<std::size_t>(jj) * w];
-      for (int t = 0; t <= 2 * R; ++t) {
-        const std::uint16_t* src = &along_i[static_cast<std::size_t>(jj + t) * w];
-        for (int ii = 0; ii < w; ++ii)
-          dst[ii] = static_cast<std::uint16_t>(dst[ii] + kWeights[t] * src[ii]);
-      }
-    }
-  };
-  // A window of 2R + 1 blurred slices around k.
-  std::vector<std::vector<std::uint16_t>> window(2 * R + 1);
-  for (int t = 0; t < 2 * R; ++t) blurred_slice(r.lo[2] - R + t, window[t + 1]);
-  for (int k = r.lo[2]; k < r.hi[2]; ++k) {
-    std::rotate(window.begin(), window.begin() + 1, window.end());
-    blurred_slice(k + R, window.back());
-    for (int jj = 0; jj < h; ++jj) {
-      std::uint8_t* dst = &smoothed_[linear_index(r.lo[0], r.lo[1] + jj, k)];
-      const std::size_t o = static_cast<std::size_t>(jj) * w;
-      for (int ii = 0; ii < w; ++ii) {
-        int sum = 0;  // 0..4096
-        for (int t = 0; t <= 2 * R; ++t) sum += kWeights[t] * window[t][o + ii];
-        dst[ii] = static_cast<std::uint8_t>((sum * 255 + 2048) / 4096);
-      }
-    }
-  }
-}
-
-void VolumeData::update_bricks(const VoxelBox& changed) {
-  const auto bs = brick_shape();
-  constexpr int B = kBrickSize;
-  // Bricks whose sampling footprint [b*B - 1, (b+1)*B + 1) meets the changed voxels.
-  std::array<int, 3> lo, hi;
-  for (int a = 0; a < 3; ++a) {
-    lo[a] = std::max(0, (changed.lo[a] - 1) / B);
-    hi[a] = std::min(bs[a], (changed.hi[a] + 1) / B + 1);
-  }
-  for (int bk = lo[2]; bk < hi[2]; ++bk) {
-    for (int bj = lo[1]; bj < hi[1]; ++bj) {
-      for (int bi = lo[0]; bi < hi[0]; ++bi) {
-        const VoxelBox foot = VoxelBox{
-            {bi * B - 1, bj * B - 1, bk * B - 1},
-            {(bi + 1) * B + 1, (bj + 1) * B + 1,
-             (bk + 1) * B + 1}}.clipped(shape_);
-        std::uint8_t m = 0;
-        for (int k = foot.lo[2]; k < foot.hi[2] && m < 255; ++k) {
-          for (int j = foot.lo[1]; j < foot.hi[1]; ++j) {
-            const std::uint8_t* row = &smoothed_[linear_index(0, j, k)];
-            for (int i = foot.lo[0]; i < foot.hi[0]; ++i) m = std::max(m, row[i]);
-          }
-        }
-        bricks_[static_cast<std::size_t>(bi) +
-                static_cast<std::size_t>(bs[0]) * (bj + static_cast<std::size_t>(bs[1]) * bk)] = m;
-      }
-    }
-  }
+  if (affected.empty()) return;
+  const int bytes = label_type_ == LabelType::kUInt16 ? 2 : 1;
+  smooth_occupancy(labels_.data(), whole(shape_), bytes, shape_, affected, smoothed_.data(),
+                   whole(shape_));
+  brick_maxima(smoothed_.data(), whole(shape_), shape_, bricks_reaching(affected, shape_),
+               bricks_.data(), whole(brick_shape()));
 }
 
 // ---------------------------------------------------------------------------------------------

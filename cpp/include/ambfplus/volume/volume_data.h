@@ -175,8 +175,10 @@ class AMBFPLUS_API VolumeData {
   /// Edits dropped from the log because it was full, since the volume was made.
   std::int64_t edit_log_dropped() const { return edit_log_dropped_; }
 
-  // --- Derived fields: computed in full on first access, then kept up to date by every edit
-  // (for the edited box only, on the editing thread), so readers such as renderers only copy.
+  // --- Derived fields: computed in full on first access, then brought up to date when read
+  // (the boxes edited since, only), so an edit (a haptic tick's removal) costs nothing for them.
+  // Renderers compute their own from a copy of the edited labels, off the world's lock
+  // (smooth_occupancy and brick_maxima below).
 
   /// Occupancy (label != 0) blurred by a separable binomial kernel [1 4 6 4 1] / 16, 0..255:
   /// trilinear interpolation of it gives a smooth iso-surface at 0.5 that sits on flat voxel
@@ -202,12 +204,15 @@ class AMBFPLUS_API VolumeData {
                     double iso = 0.5, double max_distance = 1e9);
 
  private:
+  // Boxes edited since the derived fields were last brought up to date, at most this many
+  // (beyond, they are merged into one).
+  static constexpr std::size_t kStaleBoxes = 64;
+
   void record(VolumeEdit edit);
   void log_edit(VolumeEdit edit);
   void update_derived();
+  void mark_derived_stale(const VoxelBox& box);
   void update_derived_box(const VoxelBox& box);
-  void smooth_box(const VoxelBox& box);
-  void update_bricks(const VoxelBox& box);
 
   std::array<int, 3> shape_;
   Eigen::Vector3d dimensions_;
@@ -229,7 +234,31 @@ class AMBFPLUS_API VolumeData {
 
   std::vector<std::uint8_t> smoothed_;
   std::vector<std::uint8_t> bricks_;
-  bool derived_ready_ = false;  // smoothed_ and bricks_ computed (then kept up to date)
+  bool derived_ready_ = false;           // smoothed_ and bricks_ computed (then kept up to date)
+  std::vector<VoxelBox> derived_stale_;  // edited since they were
 };
+
+// --- The derived fields of any part of a grid, from packed boxes of it (i fastest, k
+// slowest; `frame` is where a packed box sits in the grid). VolumeData uses them on its whole
+// grid, renderers on copies of the boxes edited.
+
+/// The bricks (VolumeData::kBrickSize^3 voxels) whose sampling footprint (the brick and a
+/// one-voxel margin) meets `voxels`, in a grid of `shape` voxels.
+AMBFPLUS_API VoxelBox bricks_reaching(const VoxelBox& voxels, const std::array<int, 3>& shape);
+/// The voxels the footprints of `bricks` cover, in a grid of `shape` voxels.
+AMBFPLUS_API VoxelBox brick_footprints(const VoxelBox& bricks, const std::array<int, 3>& shape);
+/// Writes the smoothed occupancy (VolumeData::smoothed_occupancy) of `box`, in a grid of
+/// `shape`, into `out`, a packed box `out_frame` holding box. `labels` is a packed box
+/// `labels_frame` of the label grid (`bytes` 1 or 2 per voxel) that holds every voxel of the
+/// grid within VolumeData::kSmoothRadius of box.
+AMBFPLUS_API void smooth_occupancy(const std::uint8_t* labels, const VoxelBox& labels_frame,
+                                   int bytes, const std::array<int, 3>& shape, const VoxelBox& box,
+                                   std::uint8_t* out, const VoxelBox& out_frame);
+/// Writes the brick maxima (VolumeData::brick_max) of `bricks`, in a grid of `shape` voxels,
+/// into `out`, a packed box `out_frame` of the brick grid holding bricks. `smoothed` is a packed
+/// box `smoothed_frame` of the smoothed occupancy that holds brick_footprints(bricks, shape).
+AMBFPLUS_API void brick_maxima(const std::uint8_t* smoothed, const VoxelBox& smoothed_frame,
+                               const std::array<int, 3>& shape, const VoxelBox& bricks,
+                               std::uint8_t* out, const VoxelBox& out_frame);
 
 }  // namespace ambfplus

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import re
 import shutil
 import subprocess
 import sys
@@ -52,6 +53,84 @@ def drilling_session(path: Path, seed: int = 0, seconds: float = 0.8):
     ])  # fmt: skip
     return record_session(scene, path, device, seconds=seconds, capture_every=100,
                           camera_motion=orbit_view)  # fmt: skip
+
+
+# A recording made from plain arrays, no rendering: 8x6 stereo frames at steps 10, 20, 30, a
+# step log of the drill (pose, force, burr) at every step 1..30 and three removed voxels.
+TINY_LEGEND = {
+    1: {"name": "anatomy", "kind": "volume", "model": "ear", "shape": [10, 10, 10],
+        "dimensions": [0.01, 0.01, 0.01], "voxel_size": [0.001, 0.001, 0.001],
+        "pose": np.eye(4).tolist(), "labels": {1: {"name": "Bone", "color": [230, 220, 200]},
+                                              3: {"name": "Facial_Nerve", "color": [250, 5, 9]}}},
+    2: {"name": "ball", "kind": "body", "model": "tools", "color": [10, 20, 30]},
+    3: {"name": "drill", "kind": "drill", "model": "tools", "burr_diameters": [0.006, 0.004]},
+}  # fmt: skip
+TINY_STEPS = np.arange(1, 31)
+
+
+def tiny_frame(camera: str, step: int, focal: float = 6.0, x: float = 0.0) -> dict:
+    rng = np.random.default_rng(step * 7 + len(camera))
+    pose = np.eye(4)
+    pose[0, 3] = x
+    return {
+        "camera": camera, "time": step * 1e-3, "step": step, "pose": pose,
+        "intrinsics": np.array([[focal, 0, 4.0], [0, focal, 3.0], [0, 0, 1]]),
+        "rgb": rng.integers(0, 256, (6, 8, 3), dtype=np.uint8),
+        "depth": rng.uniform(0.2, 0.3, (6, 8)).astype(np.float32),
+        "label": rng.integers(0, 4, (6, 8)).astype(np.uint16),
+        "instance": rng.choice(np.array([0, 1, 2], np.int32), (6, 8)),
+        "segmentation": rng.integers(0, 256, (6, 8, 3), dtype=np.uint8),
+    }  # fmt: skip
+
+
+def tiny_recording(
+    path: Path,
+    *,
+    baselines=(0.065, 0.065, 0.065),
+    focals=(6.0, 6.0, 6.0),
+    passes=None,
+    legend=TINY_LEGEND,
+    burr=None,
+    unpaired_right=False,
+) -> Path:
+    """A small stereo recording written with the Recorder from plain arrays (no rendering):
+    each frame's baseline and left focal length as given; ``burr`` the drill's burr index at
+    each step; ``unpaired_right`` adds a right-camera frame that belongs to no stereo pair."""
+    from types import SimpleNamespace
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with Recorder(path) as recorder:
+        recorder.set_legend(legend)
+        for index, (baseline, focal) in enumerate(zip(baselines, focals)):
+            step = 10 * (index + 1)
+            pair = SimpleNamespace(left=tiny_frame("rig_left", step, focal),
+                                   right=tiny_frame("rig_right", step, 6.0, baseline),
+                                   baseline=baseline, dcx=0.0)  # fmt: skip
+            recorder.add_stereo("rig", pair, passes=passes)
+        if unpaired_right:
+            recorder.add_frame("rig_right", tiny_frame("rig_right", 35), passes=passes)
+        n = len(TINY_STEPS)
+        poses = np.tile(np.eye(4), (n, 1, 1))
+        poses[:, :3, 3] = np.column_stack([TINY_STEPS * 1e-4, -TINY_STEPS * 2e-4, TINY_STEPS * 0])
+        angles = TINY_STEPS * 0.05
+        poses[:, 0, 0], poses[:, 0, 1] = np.cos(angles), -np.sin(angles)
+        poses[:, 1, 0], poses[:, 1, 1] = np.sin(angles), np.cos(angles)
+        recorder.add_steps({
+            "step": TINY_STEPS, "time": TINY_STEPS * 1e-3, "drill.pose": poses,
+            "drill.force": np.column_stack([TINY_STEPS * 0.1, TINY_STEPS * -0.2, TINY_STEPS * 0.3]),
+            "drill.burr": np.zeros(n, np.int64) if burr is None else np.asarray(burr, np.int64),
+        })  # fmt: skip
+        recorder.add_removed({"step": np.array([5, 5, 22]), "label": np.array([1, 1, 3]),
+                              "voxel": np.array([[1, 2, 3], [1, 2, 4], [5, 5, 5]])},
+                             volume="anatomy")  # fmt: skip
+    return path
+
+
+def tree(folder: Path) -> dict:
+    """Every path under a folder with its bytes (None for folders): what 'nothing changed'
+    compares."""
+    return {str(p.relative_to(folder)): (p.read_bytes() if p.is_file() else None)
+            for p in sorted(folder.rglob("*"))}  # fmt: skip
 
 
 @pytest.fixture(scope="module")
@@ -587,6 +666,98 @@ def test_bad_input_gives_a_clear_error_and_writes_nothing(session, tmp_path):
     assert existing.read_bytes()[:5] == b"\x89MCAP"
     # Nothing partial is left beside the outputs.
     assert not [p for p in tmp_path.iterdir() if ".tmp" in p.name]
+
+
+# What a format cannot represent: the options of tiny_recording that make it, the formats that
+# refuse it, one that takes it, and the refusal (after the recording's path).
+NO_GEOMETRY = {**TINY_LEGEND, 1: {k: v for k, v in TINY_LEGEND[1].items()
+                                  if k not in ("dimensions", "shape", "voxel_size")}}  # fmt: skip
+REFUSALS = {
+    "baseline changes": (
+        {"baselines": (0.065, 0.065, 0.03)}, ["original-h5"], "mcap",
+        "rig rig's baseline changes during the recording (0.03 to 0.065 m); the original's "
+        "layout has one baseline",
+    ),
+    "intrinsics change": (
+        {"focals": (6.0, 6.0, 7.0)}, ["original-h5"], "rosbag2",
+        "camera stream rig_left's intrinsics change during the recording; the original's "
+        "layout has one intrinsic matrix",
+    ),
+    "no instance pass": (
+        {"passes": ("rgb", "depth", "label")}, ["coco"], "original-h5",
+        "no camera stream has the 'instance' pass; COCO masks are made from instance images",
+    ),
+    "voxels without a grid": (
+        {"legend": NO_GEOMETRY}, ["mcap", "rosbag2"], "coco",
+        "the removal log's volume 'anatomy' has no dimensions and shape in the legend, so its "
+        "voxels cannot be placed (record with Recorder.set_legend(world))",
+    ),
+    "a right frame out of any pair": (
+        {"unpaired_right": True}, ["mcap", "rosbag2"], "original-h5",
+        "frame 3 of rig_right (the right camera of rig rig) belongs to no stereo pair; its P "
+        "has no baseline",
+    ),
+}  # fmt: skip
+
+
+@pytest.mark.parametrize("case", REFUSALS)
+def test_what_a_format_cannot_represent_is_refused_and_nothing_written(tmp_path, case):
+    options, formats, fine, message = REFUSALS[case]
+    source = tiny_recording(tmp_path / "rec" / "t.h5", **options)
+    out = tmp_path / "out"
+    out.mkdir()
+    for to in formats:
+        target = out / ("x.mcap" if to == "mcap" else "x")
+        with pytest.raises(ExportError) as refused:
+            export(source, target, to, progress=False)
+        assert str(refused.value) == f"{source}: {message}", to
+        assert list(out.iterdir()) == [], to  # not the output, nor a temporary one
+    # The same recording exports to a format that can hold it (MCAP has a CameraInfo per
+    # frame; COCO needs no grid; original-h5 takes the stereo pairs and no instance images).
+    assert export(source, out / ("fine.mcap" if fine == "mcap" else "fine"), fine,
+                  progress=False).frames > 0  # fmt: skip
+
+
+def test_original_layout_writes_voxels_it_cannot_place_with_a_warning(tmp_path):
+    """v3 holds voxel indices, so a removal log whose volume has no grid geometry is written;
+    the warning says that nothing places those voxels (unlike MCAP, which refuses them)."""
+    source = tiny_recording(tmp_path / "rec" / "t.h5", legend=NO_GEOMETRY)
+    result = export(source, tmp_path / "original", "original-h5", progress=False)
+    warning = ("the legend has no dimensions and shape of volume 'anatomy': no voxel_volume, and "
+               "voxel_removed's indices cannot be placed in the world")  # fmt: skip
+    assert warning in result.details["warnings"]
+    (path,) = (tmp_path / "original").glob("*.hdf5")
+    with h5py.File(path, "r") as f:
+        assert warning in json.loads(f["ambfplus"].attrs["warnings"])
+        assert "voxel_volume" not in f["metadata_v3"] and "volume_dimensions" not in f["ambfplus"]
+        rows = f["physics_data/intermittent_data/voxels_removed/voxel_removed"][()]
+    assert rows.tolist() == [[0, 1, 2, 3], [0, 1, 2, 4], [1, 5, 5, 5]]
+
+
+@pytest.mark.parametrize("to", ["rosbag2", "coco", "original-h5"])
+def test_an_existing_output_folder_is_kept_unless_forced(tmp_path, to):
+    """A folder output that exists is refused, from Python and the command line, and left as
+    it was; --force replaces it whole with the export."""
+    source = tiny_recording(tmp_path / "rec" / "t.h5")
+    outputs = tmp_path / "outputs"
+    out = outputs / "existing"
+    (out / "inner").mkdir(parents=True)
+    (out / "keep.txt").write_text("keep me")
+    (out / "inner" / "data.bin").write_bytes(b"\x00\x01")
+    before = tree(outputs)
+    message = f"{out} exists; pass --force (force=True) to replace it"
+    with pytest.raises(ExportError, match=re.escape(message)):
+        export(source, out, to, progress=False)
+    completed = run_cli(tmp_path, str(source), "--to", to, str(out))
+    assert completed.returncode == 1 and message in completed.stderr, completed.stderr
+    assert tree(outputs) == before
+    completed = run_cli(tmp_path, str(source), "--to", to, str(out), "--force", "--quiet")
+    assert completed.returncode == 0, completed.stderr
+    assert json.loads(completed.stdout)["frames"] == (3 if to == "original-h5" else 6)
+    assert [p.name for p in outputs.iterdir()] == ["existing"]  # nothing left beside it
+    assert not (out / "keep.txt").exists() and not (out / "inner").exists()
+    with open_recording(source) as rec:
+        check_export_reads_back(to, out, rec)
 
 
 def test_an_export_that_fails_midway_leaves_nothing(session, tmp_path, monkeypatch):

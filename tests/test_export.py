@@ -876,6 +876,21 @@ def test_an_export_that_fails_midway_leaves_nothing(session, tmp_path, monkeypat
     assert list(tmp_path.iterdir()) == []
 
 
+def test_a_long_export_shows_a_progress_bar_of_frames(session, tmp_path, capsys):
+    """progress=True: a tqdm bar on stderr named after the recording and the format, counting
+    the frames written (every camera's for mcap, stereo pairs for original-h5) to the end;
+    progress=False prints nothing."""
+    pytest.importorskip("tqdm")
+    export(session, tmp_path / "quiet.mcap", "mcap", point_clouds=False, progress=False)
+    assert capsys.readouterr().err == ""
+    for to, out, frames in (("mcap", "s.mcap", 16), ("original-h5", "original", 8)):
+        export(session, tmp_path / out, to, progress=True)
+        lines = capsys.readouterr().err.replace("\r", "\n").split("\n")
+        final = [line for line in lines if line.strip()][-1]
+        assert final.startswith(f"s.h5 -> {to}: 100%"), final
+        assert f" {frames}/{frames} " in final and "frame" in final, final
+
+
 def test_a_missing_extra_says_what_to_install(session, tmp_path, monkeypatch):
     monkeypatch.setitem(sys.modules, "pycocotools.mask", None)
     with pytest.raises(MissingExtra, match=r'pip install "ambfplus\[export\]"'):

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import re
 import shutil
 import subprocess
 import sys
@@ -52,6 +53,84 @@ def drilling_session(path: Path, seed: int = 0, seconds: float = 0.8):
     ])  # fmt: skip
     return record_session(scene, path, device, seconds=seconds, capture_every=100,
                           camera_motion=orbit_view)  # fmt: skip
+
+
+# A recording made from plain arrays, no rendering: 8x6 stereo frames at steps 10, 20, 30, a
+# step log of the drill (pose, force, burr) at every step 1..30 and three removed voxels.
+TINY_LEGEND = {
+    1: {"name": "anatomy", "kind": "volume", "model": "ear", "shape": [10, 10, 10],
+        "dimensions": [0.01, 0.01, 0.01], "voxel_size": [0.001, 0.001, 0.001],
+        "pose": np.eye(4).tolist(), "labels": {1: {"name": "Bone", "color": [230, 220, 200]},
+                                              3: {"name": "Facial_Nerve", "color": [250, 5, 9]}}},
+    2: {"name": "ball", "kind": "body", "model": "tools", "color": [10, 20, 30]},
+    3: {"name": "drill", "kind": "drill", "model": "tools", "burr_diameters": [0.006, 0.004]},
+}  # fmt: skip
+TINY_STEPS = np.arange(1, 31)
+
+
+def tiny_frame(camera: str, step: int, focal: float = 6.0, x: float = 0.0) -> dict:
+    rng = np.random.default_rng(step * 7 + len(camera))
+    pose = np.eye(4)
+    pose[0, 3] = x
+    return {
+        "camera": camera, "time": step * 1e-3, "step": step, "pose": pose,
+        "intrinsics": np.array([[focal, 0, 4.0], [0, focal, 3.0], [0, 0, 1]]),
+        "rgb": rng.integers(0, 256, (6, 8, 3), dtype=np.uint8),
+        "depth": rng.uniform(0.2, 0.3, (6, 8)).astype(np.float32),
+        "label": rng.integers(0, 4, (6, 8)).astype(np.uint16),
+        "instance": rng.choice(np.array([0, 1, 2], np.int32), (6, 8)),
+        "segmentation": rng.integers(0, 256, (6, 8, 3), dtype=np.uint8),
+    }  # fmt: skip
+
+
+def tiny_recording(
+    path: Path,
+    *,
+    baselines=(0.065, 0.065, 0.065),
+    focals=(6.0, 6.0, 6.0),
+    passes=None,
+    legend=TINY_LEGEND,
+    burr=None,
+    unpaired_right=False,
+) -> Path:
+    """A small stereo recording written with the Recorder from plain arrays (no rendering):
+    each frame's baseline and left focal length as given; ``burr`` the drill's burr index at
+    each step; ``unpaired_right`` adds a right-camera frame that belongs to no stereo pair."""
+    from types import SimpleNamespace
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with Recorder(path) as recorder:
+        recorder.set_legend(legend)
+        for index, (baseline, focal) in enumerate(zip(baselines, focals)):
+            step = 10 * (index + 1)
+            pair = SimpleNamespace(left=tiny_frame("rig_left", step, focal),
+                                   right=tiny_frame("rig_right", step, 6.0, baseline),
+                                   baseline=baseline, dcx=0.0)  # fmt: skip
+            recorder.add_stereo("rig", pair, passes=passes)
+        if unpaired_right:
+            recorder.add_frame("rig_right", tiny_frame("rig_right", 35), passes=passes)
+        n = len(TINY_STEPS)
+        poses = np.tile(np.eye(4), (n, 1, 1))
+        poses[:, :3, 3] = np.column_stack([TINY_STEPS * 1e-4, -TINY_STEPS * 2e-4, TINY_STEPS * 0])
+        angles = TINY_STEPS * 0.05
+        poses[:, 0, 0], poses[:, 0, 1] = np.cos(angles), -np.sin(angles)
+        poses[:, 1, 0], poses[:, 1, 1] = np.sin(angles), np.cos(angles)
+        recorder.add_steps({
+            "step": TINY_STEPS, "time": TINY_STEPS * 1e-3, "drill.pose": poses,
+            "drill.force": np.column_stack([TINY_STEPS * 0.1, TINY_STEPS * -0.2, TINY_STEPS * 0.3]),
+            "drill.burr": np.zeros(n, np.int64) if burr is None else np.asarray(burr, np.int64),
+        })  # fmt: skip
+        recorder.add_removed({"step": np.array([5, 5, 22]), "label": np.array([1, 1, 3]),
+                              "voxel": np.array([[1, 2, 3], [1, 2, 4], [5, 5, 5]])},
+                             volume="anatomy")  # fmt: skip
+    return path
+
+
+def tree(folder: Path) -> dict:
+    """Every path under a folder with its bytes (None for folders): what 'nothing changed'
+    compares."""
+    return {str(p.relative_to(folder)): (p.read_bytes() if p.is_file() else None)
+            for p in sorted(folder.rglob("*"))}  # fmt: skip
 
 
 @pytest.fixture(scope="module")
@@ -281,6 +360,22 @@ def check_point_clouds(rec, by_topic) -> None:
     labels = cloud_fields(message, ("label", "instance"))
     assert np.array_equal(labels[:, 0], frame.label.reshape(-1))
     assert np.array_equal(labels[:, 1], frame.instance.reshape(-1))
+    # rgb, PCL's packed 0x00RRGGBB in a float32 field, is the recording's rgb at each point's
+    # pixel, in both eyes and every frame.
+    for name, stream in rec.cameras.items():
+        for index, (_, _, message) in enumerate(by_topic[f"/{name}/points"]):
+            rgb = cloud_rgb(message).reshape(message.height, message.width, 3)
+            assert np.array_equal(rgb, stream.rgb[index]), (name, index)
+
+
+def cloud_rgb(message) -> np.ndarray:
+    """The rgb field of a PointCloud2 unpacked to (N, 3) uint8, through its field table."""
+    field = next(f for f in message.fields if f.name == "rgb")
+    assert field.datatype == 7 and field.count == 1  # FLOAT32, as PCL packs it
+    data = np.frombuffer(bytes(message.data), np.uint8).reshape(-1, message.point_step)
+    packed = np.ascontiguousarray(data[:, field.offset : field.offset + 4]).view("<u4")[:, 0]
+    assert not (packed >> 24).any()
+    return np.stack([(packed >> 16) & 255, (packed >> 8) & 255, packed & 255], 1).astype(np.uint8)
 
 
 def test_ros_exports_state_their_conventions(exported):
@@ -364,7 +459,9 @@ def read_original(folder: Path) -> dict:
     files = sorted(folder.glob("*.hdf5"))
     assert files and all(len(f.stem) == 15 and f.stem[8] == "_" for f in files)
     out = {"depth": [], "l_img": [], "r_img": [], "segm": [], "time": [], "voxels": [],
-           "voxel_time": [], "drill": [], "camera": [], "volume": []}  # fmt: skip
+           "voxel_color": [], "voxel_time": [], "drill": [], "camera": [], "volume": [],
+           "burr_size": [], "burr_time": [], "wrench": [], "wrench_time": []}  # fmt: skip
+    high_frequency: dict[str, list] = {}
     for path in files:
         with h5py.File(path, "r") as f:
             assert "vision_data/intermittent_data" in f
@@ -387,8 +484,18 @@ def read_original(folder: Path) -> dict:
                     assert dataset.compression == "gzip", name
             assert f["metadata_v3/voxel_volume"].attrs["units"].startswith("mm^3")
             assert np.array_equal(f["metadata_v3/camera_extrinsic"][()], T_CV_AMBF)
-            for group in f["physics_data/continuous_data/high_frequency_poses"].values():
+            for name, group in f["physics_data/continuous_data/high_frequency_poses"].items():
                 assert group["pose"].shape == (len(group["time_stamp"]), 7)
+                high_frequency.setdefault(name, []).append(
+                    (group["time_stamp"][()], group["pose"][()])
+                )
+            intermittent = f["physics_data/intermittent_data"]
+            if "burr_change" in intermittent:
+                out["burr_size"].append(intermittent["burr_change/burr_size"][()])
+                out["burr_time"].append(intermittent["burr_change/time_stamp"][()])
+            if "drill_force_feedback" in intermittent:
+                out["wrench"].append(intermittent["drill_force_feedback/wrench"][()])
+                out["wrench_time"].append(intermittent["drill_force_feedback/time_stamp"][()])
             data = f["vision_data/continuous_data"]
             for key in ("depth", "l_img", "r_img", "segm", "time"):
                 out[key].append(data[key][()])
@@ -406,8 +513,15 @@ def read_original(folder: Path) -> dict:
                 offset = sum(len(t) for t in out["voxel_time"])
                 assert rows[0, 0] == 0  # restarts in every file
                 out["voxels"].append(rows + [offset, 0, 0, 0])
+                out["voxel_color"].append(group["voxel_color"][()] + [offset, 0, 0, 0, 0])
                 out["voxel_time"].append(group["voxel_time_stamp"][()])
-    return {k: (np.concatenate(v) if isinstance(v, list) and v else v) for k, v in out.items()}
+    out = {k: (np.concatenate(v) if isinstance(v, list) and v else v) for k, v in out.items()}
+    # <object>_pose -> (time_stamp, pose) over all files.
+    out["high_frequency"] = {
+        name: (np.concatenate([t for t, _ in parts]), np.concatenate([p for _, p in parts]))
+        for name, parts in high_frequency.items()
+    }
+    return out
 
 
 def test_original_layout_is_read_by_an_independent_checker(session, tmp_path):
@@ -455,6 +569,73 @@ def test_original_layout_is_read_by_an_independent_checker(session, tmp_path):
         groups = data["voxels"][:, 0].astype(int)
         assert np.array_equal(np.diff(groups) != 0, np.diff(removed["step"]) != 0)
         assert len(data["voxel_time"]) == len(np.unique(removed["step"]))
+        check_original_physics(data, rec)
+
+
+def pose_matrix(row) -> np.ndarray:
+    """A [x, y, z, qx, qy, qz, qw] row as a 4x4 pose."""
+    matrix = np.eye(4)
+    matrix[:3, :3], matrix[:3, 3] = quaternion_matrix(row[3:]), row[:3]
+    return matrix
+
+
+def check_original_physics(data: dict, rec) -> None:
+    """The physics groups' values against the recording, as the reference note describes them
+    less the defects the export does not reproduce: voxel colours [group, r, g, b, a] from the
+    label table, burr sizes in mm where the burr changed (and the first), the drill's force at
+    every step with a torque of 0, and every logged pose once per step at simulation time."""
+    steps, removed, legend = rec.steps, rec.removed, rec.legend
+    volume = next(e for e in legend.values() if e["name"] == removed["volume"])
+    colour = data["voxel_color"]
+    assert colour.shape == (len(removed["label"]), 5)
+    assert np.array_equal(colour[:, 0], data["voxels"][:, 0])  # the same groups
+    labels = volume["labels"]
+    expected = np.array([labels[int(label)]["color"] for label in removed["label"]], float)
+    assert np.array_equal(colour[:, 1:4], expected)
+    assert (colour[:, 4] == 255).all()
+    drill = next(e["name"] for e in legend.values() if e["kind"] == "drill")
+    assert np.array_equal(data["wrench_time"], steps["time"])
+    assert np.array_equal(data["wrench"][:, :3], steps[f"{drill}.force"])
+    assert not data["wrench"][:, 3:].any()
+    burr = steps[f"{drill}.burr"]
+    changed = np.r_[True, burr[1:] != burr[:-1]]
+    diameters = np.asarray(next(e for e in legend.values() if e["kind"] == "drill")[
+        "burr_diameters"])  # fmt: skip
+    assert data["burr_size"].dtype == np.int64
+    assert np.array_equal(data["burr_size"], np.round(diameters[burr[changed]] * 1000))
+    assert np.array_equal(data["burr_time"], steps["time"][changed])
+    # High-frequency poses: the drill and the left camera under the original's names, the
+    # camera as AMBF's camera body (the file's extrinsic applies), other bodies as they are.
+    left = next(iter(rec.rigs.values())).left.camera
+    names = {drill: "mastoidectomy_drill", left: "main_camera"}
+    logged = [c.removesuffix(".pose") for c in steps if c.endswith(".pose")]
+    assert set(data["high_frequency"]) == {f"{names.get(n, n)}_pose" for n in logged}
+    for name in logged:
+        times, rows = data["high_frequency"][f"{names.get(name, name)}_pose"]
+        assert np.array_equal(times, steps["time"])  # once per step, simulation time
+        to_ours = np.linalg.inv(T_CV_AMBF) if name == left else np.eye(4)
+        got = np.array([pose_matrix(row) @ to_ours for row in rows])
+        assert np.abs(got - steps[f"{name}.pose"]).max() <= 1e-9, name
+
+
+def test_original_layout_burr_changes_forces_and_poses_across_files(tmp_path):
+    """A burr that changes twice, once as a file begins: each file writes the changes inside
+    it (the first file the starting burr too); colours, forces and poses split over the files
+    and concatenate back to the recording's."""
+    # 4 mm from step 13, 6 mm again from step 20: the first step of the second file (its
+    # samples start at step 20), where the change is seen only against the file before.
+    burr = [0] * 12 + [1] * 7 + [0] * 11
+    source = tiny_recording(tmp_path / "rec" / "t.h5", burr=burr)
+    result = export(source, tmp_path / "original", "original-h5", chunk_size=1, progress=False)
+    assert len(result.details["files"]) == 3
+    data = read_original(tmp_path / "original")
+    with open_recording(source) as rec:
+        check_original_physics(data, rec)
+    assert data["burr_size"].tolist() == [6, 4, 6]
+    assert data["burr_time"].tolist() == (TINY_STEPS[[0, 12, 19]] * 1e-3).tolist()
+    assert data["voxel_color"].tolist() == [[0, 230, 220, 200, 255], [0, 230, 220, 200, 255],
+                                            [1, 250, 5, 9, 255]]  # fmt: skip
+    assert len(data["wrench"]) == len(data["high_frequency"]["mastoidectomy_drill_pose"][0]) == 30
 
 
 # COCO ------------------------------------------------------------------------------------------
@@ -589,6 +770,98 @@ def test_bad_input_gives_a_clear_error_and_writes_nothing(session, tmp_path):
     assert not [p for p in tmp_path.iterdir() if ".tmp" in p.name]
 
 
+# What a format cannot represent: the options of tiny_recording that make it, the formats that
+# refuse it, one that takes it, and the refusal (after the recording's path).
+NO_GEOMETRY = {**TINY_LEGEND, 1: {k: v for k, v in TINY_LEGEND[1].items()
+                                  if k not in ("dimensions", "shape", "voxel_size")}}  # fmt: skip
+REFUSALS = {
+    "baseline changes": (
+        {"baselines": (0.065, 0.065, 0.03)}, ["original-h5"], "mcap",
+        "rig rig's baseline changes during the recording (0.03 to 0.065 m); the original's "
+        "layout has one baseline",
+    ),
+    "intrinsics change": (
+        {"focals": (6.0, 6.0, 7.0)}, ["original-h5"], "rosbag2",
+        "camera stream rig_left's intrinsics change during the recording; the original's "
+        "layout has one intrinsic matrix",
+    ),
+    "no instance pass": (
+        {"passes": ("rgb", "depth", "label")}, ["coco"], "original-h5",
+        "no camera stream has the 'instance' pass; COCO masks are made from instance images",
+    ),
+    "voxels without a grid": (
+        {"legend": NO_GEOMETRY}, ["mcap", "rosbag2"], "coco",
+        "the removal log's volume 'anatomy' has no dimensions and shape in the legend, so its "
+        "voxels cannot be placed (record with Recorder.set_legend(world))",
+    ),
+    "a right frame out of any pair": (
+        {"unpaired_right": True}, ["mcap", "rosbag2"], "original-h5",
+        "frame 3 of rig_right (the right camera of rig rig) belongs to no stereo pair; its P "
+        "has no baseline",
+    ),
+}  # fmt: skip
+
+
+@pytest.mark.parametrize("case", REFUSALS)
+def test_what_a_format_cannot_represent_is_refused_and_nothing_written(tmp_path, case):
+    options, formats, fine, message = REFUSALS[case]
+    source = tiny_recording(tmp_path / "rec" / "t.h5", **options)
+    out = tmp_path / "out"
+    out.mkdir()
+    for to in formats:
+        target = out / ("x.mcap" if to == "mcap" else "x")
+        with pytest.raises(ExportError) as refused:
+            export(source, target, to, progress=False)
+        assert str(refused.value) == f"{source}: {message}", to
+        assert list(out.iterdir()) == [], to  # not the output, nor a temporary one
+    # The same recording exports to a format that can hold it (MCAP has a CameraInfo per
+    # frame; COCO needs no grid; original-h5 takes the stereo pairs and no instance images).
+    assert export(source, out / ("fine.mcap" if fine == "mcap" else "fine"), fine,
+                  progress=False).frames > 0  # fmt: skip
+
+
+def test_original_layout_writes_voxels_it_cannot_place_with_a_warning(tmp_path):
+    """v3 holds voxel indices, so a removal log whose volume has no grid geometry is written;
+    the warning says that nothing places those voxels (unlike MCAP, which refuses them)."""
+    source = tiny_recording(tmp_path / "rec" / "t.h5", legend=NO_GEOMETRY)
+    result = export(source, tmp_path / "original", "original-h5", progress=False)
+    warning = ("the legend has no dimensions and shape of volume 'anatomy': no voxel_volume, and "
+               "voxel_removed's indices cannot be placed in the world")  # fmt: skip
+    assert warning in result.details["warnings"]
+    (path,) = (tmp_path / "original").glob("*.hdf5")
+    with h5py.File(path, "r") as f:
+        assert warning in json.loads(f["ambfplus"].attrs["warnings"])
+        assert "voxel_volume" not in f["metadata_v3"] and "volume_dimensions" not in f["ambfplus"]
+        rows = f["physics_data/intermittent_data/voxels_removed/voxel_removed"][()]
+    assert rows.tolist() == [[0, 1, 2, 3], [0, 1, 2, 4], [1, 5, 5, 5]]
+
+
+@pytest.mark.parametrize("to", ["rosbag2", "coco", "original-h5"])
+def test_an_existing_output_folder_is_kept_unless_forced(tmp_path, to):
+    """A folder output that exists is refused, from Python and the command line, and left as
+    it was; --force replaces it whole with the export."""
+    source = tiny_recording(tmp_path / "rec" / "t.h5")
+    outputs = tmp_path / "outputs"
+    out = outputs / "existing"
+    (out / "inner").mkdir(parents=True)
+    (out / "keep.txt").write_text("keep me")
+    (out / "inner" / "data.bin").write_bytes(b"\x00\x01")
+    before = tree(outputs)
+    message = f"{out} exists; pass --force (force=True) to replace it"
+    with pytest.raises(ExportError, match=re.escape(message)):
+        export(source, out, to, progress=False)
+    completed = run_cli(tmp_path, str(source), "--to", to, str(out))
+    assert completed.returncode == 1 and message in completed.stderr, completed.stderr
+    assert tree(outputs) == before
+    completed = run_cli(tmp_path, str(source), "--to", to, str(out), "--force", "--quiet")
+    assert completed.returncode == 0, completed.stderr
+    assert json.loads(completed.stdout)["frames"] == (3 if to == "original-h5" else 6)
+    assert [p.name for p in outputs.iterdir()] == ["existing"]  # nothing left beside it
+    assert not (out / "keep.txt").exists() and not (out / "inner").exists()
+    with open_recording(source) as rec:
+        check_export_reads_back(to, out, rec)
+
+
 def test_an_export_that_fails_midway_leaves_nothing(session, tmp_path, monkeypatch):
     from ambfplus.export import ros
 
@@ -601,6 +874,21 @@ def test_an_export_that_fails_midway_leaves_nothing(session, tmp_path, monkeypat
     with pytest.raises(OSError, match="disk full"):
         export(session, tmp_path / "bag", "rosbag2", progress=False)
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_long_export_shows_a_progress_bar_of_frames(session, tmp_path, capsys):
+    """progress=True: a tqdm bar on stderr named after the recording and the format, counting
+    the frames written (every camera's for mcap, stereo pairs for original-h5) to the end;
+    progress=False prints nothing."""
+    pytest.importorskip("tqdm")
+    export(session, tmp_path / "quiet.mcap", "mcap", point_clouds=False, progress=False)
+    assert capsys.readouterr().err == ""
+    for to, out, frames in (("mcap", "s.mcap", 16), ("original-h5", "original", 8)):
+        export(session, tmp_path / out, to, progress=True)
+        lines = capsys.readouterr().err.replace("\r", "\n").split("\n")
+        final = [line for line in lines if line.strip()][-1]
+        assert final.startswith(f"s.h5 -> {to}: 100%"), final
+        assert f" {frames}/{frames} " in final and "frame" in final, final
 
 
 def test_a_missing_extra_says_what_to_install(session, tmp_path, monkeypatch):

@@ -95,6 +95,13 @@ class OriginalLayout:
         self.names = self._names(names or {})
         self.steps = recording.steps
         self._voxel_steps = None
+        if len(recording.removed["step"]) and self._volume_geometry() is None:
+            # v3 holds voxel indices, as the original's plugin publishes them, so they are
+            # written; without the grid's geometry nothing places them in the world.
+            self.warnings.append(
+                f"the legend has no dimensions and shape of volume {self.volume_name()!r}: no "
+                "voxel_volume, and voxel_removed's indices cannot be placed in the world"
+            )
 
     # Planning --------------------------------------------------------------------------------
 

@@ -1,4 +1,4 @@
-"""What tells a stall of the machine from one of ours in the real-time benchmark.
+"""What tells a stall of the machine from one of ours in the real-time benchmarks.
 
 A period of the 1 kHz loop is the step's wall time, the sleep to the next deadline and the
 lateness of the wake-up after it. A step that runs long is ours. A wake-up that comes late is
@@ -9,6 +9,9 @@ wake-up of the loop that the probe on its CPU shares is the host's (the virtual 
 running: steal) or the kernel's, one it does not share is ours. Around a run, the steal time of
 each CPU (/proc/stat), the load average, and the loop thread's page faults and context switches
 (/proc/self/task) say more.
+
+``realtime_attribution`` puts it together for one run of a ``RealTimeLoop``; the ``realtime``
+benchmark (run.py) and the ``foxglove_live`` one (bench_export.py) both call it.
 """
 
 from __future__ import annotations
@@ -16,6 +19,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import re
 import shutil
 import subprocess
 import tempfile
@@ -304,3 +308,61 @@ def attribute(rows: list[dict], witness: Witness, cpus) -> None:
             r["verdict"] = "unknown"
         else:
             r["verdict"] = "host" if r["period"] - r["machine"] <= 2e-3 else "ours"
+
+
+def realtime_attribution(stats: dict, anchors, witness, scheduling: str) -> dict:
+    """The late periods of a run, each split into the step's time and the wake-up's lateness
+    and marked 'host' or 'ours' by the witness, and the figures that go with it. `anchors`
+    are the loop's steps seen against CLOCK_MONOTONIC at its start and end (step_anchors),
+    `scheduling` the loop's own account of it (RealTimeLoop.scheduling)."""
+    periods = np.asarray(stats["periods"])
+    first = first_step_time(periods, anchors)
+    # The anchors at the end must agree with those at the start: the periods are then whole.
+    last = max(n for _, n in anchors)
+    drift = min(t - first - float(np.sum(periods[: n - 1])) for t, n in anchors if n >= last - 20)
+    rows = late_periods(stats, first, 1e-3)
+    pinned = re.search(r"pinned to CPU (\d+)", scheduling)
+    cpus = [int(pinned.group(1))] if pinned else witness.cpus
+    attribute(rows, witness, cpus)
+    # The longest lock wait is the host's when it lies in the step of a late period during
+    # which the witness, on any CPU (the holder's too), was held up for all of it but the
+    # target; otherwise it is counted ours.
+    wait, everywhere = stats["lock_wait_max"], witness.events(witness.cpus)
+    wait_verdict = "within target" if wait <= 200e-6 else "ours" if witness.ok else "unknown"
+    for r in rows:
+        if wait_verdict == "ours" and r["step_wall"] >= wait:
+            if held_up(everywhere, r["start"], r["start"] + r["step_wall"]) >= wait - 200e-6:
+                wait_verdict = "host"
+    if os.environ.get("AMBFPLUS_REALTIME_DUMP"):
+        # Everything the attribution used, appended as one JSON line, to look into a verdict.
+        with open(os.environ["AMBFPLUS_REALTIME_DUMP"], "a") as dump:
+            late = {c: v.tolist() for c, v in witness.late.items()}
+            dump.write(json.dumps({"first": first, "rows": rows, "witness": late}) + "\n")
+    us = lambda v: round(v * 1e6, 1)  # noqa: E731
+    verdicts = [r["verdict"] for r in rows]
+    return {
+        "over_2ms_host": verdicts.count("host"),
+        "over_2ms_ours": verdicts.count("ours"),
+        "over_2ms_unknown": verdicts.count("unknown"),
+        "lock_wait_max_verdict": wait_verdict,
+        # Each period over 2 ms: when (s into the run), how long, the step before it (wall, CPU,
+        # off its CPU: lock wait or blocked, how far past the next deadline it ran), how late
+        # the next step began after it was due, how much of it the witness on the loop's CPU
+        # shared, and whose it is.
+        "late": [
+            {
+                "at_s": round(r["start"] - first, 3),
+                "period_us": us(r["period"]),
+                "step_wall_us": us(r["step_wall"]),
+                "step_cpu_us": us(r["step_cpu"]),
+                "step_off_cpu_us": us(r["step_wall"] - r["step_cpu"]),
+                "overrun_us": us(r["overrun"]),
+                "wake_late_us": us(r["wake_late"]),
+                "machine_us": us(r["machine"]),
+                "verdict": r["verdict"],
+            }
+            for r in rows
+        ],  # fmt: skip
+        "clock_alignment_us": us(abs(drift)),
+        **witness.report,
+    }

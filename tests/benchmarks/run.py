@@ -436,66 +436,6 @@ def realtime_session(seconds: float, drilling: bool, witness=None):
     return world, drill, binding, loop, frames[0], anchors, counters
 
 
-def realtime_attribution(stats: dict, anchors, witness, scheduling: str) -> dict:
-    """The late periods of a run, each split into the step's time and the wake-up's lateness
-    and marked 'host' or 'ours' by the witness (rt_witness), and the figures that go with it."""
-    import re
-
-    from rt_witness import attribute, first_step_time, held_up, late_periods
-
-    periods = np.asarray(stats["periods"])
-    first = first_step_time(periods, anchors)
-    # The anchors at the end must agree with those at the start: the periods are then whole.
-    last = max(n for _, n in anchors)
-    drift = min(t - first - float(np.sum(periods[: n - 1])) for t, n in anchors if n >= last - 20)
-    rows = late_periods(stats, first, 1e-3)
-    pinned = re.search(r"pinned to CPU (\d+)", scheduling)
-    cpus = [int(pinned.group(1))] if pinned else witness.cpus
-    attribute(rows, witness, cpus)
-    # The longest lock wait is the host's when it lies in the step of a late period during
-    # which the witness, on any CPU (the holder's too), was held up for all of it but the
-    # target; otherwise it is counted ours.
-    wait, everywhere = stats["lock_wait_max"], witness.events(witness.cpus)
-    wait_verdict = "within target" if wait <= 200e-6 else "ours" if witness.ok else "unknown"
-    for r in rows:
-        if wait_verdict == "ours" and r["step_wall"] >= wait:
-            if held_up(everywhere, r["start"], r["start"] + r["step_wall"]) >= wait - 200e-6:
-                wait_verdict = "host"
-    if os.environ.get("AMBFPLUS_REALTIME_DUMP"):
-        # Everything the attribution used, appended as one JSON line, to look into a verdict.
-        with open(os.environ["AMBFPLUS_REALTIME_DUMP"], "a") as dump:
-            late = {c: v.tolist() for c, v in witness.late.items()}
-            dump.write(json.dumps({"first": first, "rows": rows, "witness": late}) + "\n")
-    us = lambda v: round(v * 1e6, 1)  # noqa: E731
-    verdicts = [r["verdict"] for r in rows]
-    return {
-        "over_2ms_host": verdicts.count("host"),
-        "over_2ms_ours": verdicts.count("ours"),
-        "over_2ms_unknown": verdicts.count("unknown"),
-        "lock_wait_max_verdict": wait_verdict,
-        # Each period over 2 ms: when (s into the run), how long, the step before it (wall, CPU,
-        # off its CPU: lock wait or blocked, how far past the next deadline it ran), how late
-        # the next step began after it was due, how much of it the witness on the loop's CPU
-        # shared, and whose it is.
-        "late": [
-            {
-                "at_s": round(r["start"] - first, 3),
-                "period_us": us(r["period"]),
-                "step_wall_us": us(r["step_wall"]),
-                "step_cpu_us": us(r["step_cpu"]),
-                "step_off_cpu_us": us(r["step_wall"] - r["step_cpu"]),
-                "overrun_us": us(r["overrun"]),
-                "wake_late_us": us(r["wake_late"]),
-                "machine_us": us(r["machine"]),
-                "verdict": r["verdict"],
-            }
-            for r in rows
-        ],  # fmt: skip
-        "clock_alignment_us": us(abs(drift)),
-        **witness.report,
-    }
-
-
 @benchmark
 def realtime(args) -> Iterator[dict]:
     """Real-time mode: the 1 kHz physics/haptics loop while a camera captures continuously in
@@ -503,7 +443,7 @@ def realtime(args) -> Iterator[dict]:
     scripted mode, which must give the same removal log. Every period over 2 ms is split into
     the step's time and the wake-up's lateness and attributed to the host or to us by a witness
     probe on every CPU (rt_witness.py)."""
-    from rt_witness import Witness
+    from rt_witness import Witness, realtime_attribution
 
     seconds = 3.0 if args.quick else 10.0
     for drilling in (False, True):

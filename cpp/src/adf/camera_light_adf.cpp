@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <functional>
 #include <optional>
 #include <string>
@@ -29,6 +30,25 @@ struct CameraPlan {
   double stereo_focal = 0.0;    // where the eyes' views converge (off-axis), m
   std::optional<ShaderSpec> preprocessing;
 };
+
+// `clipping plane` and `field view angle`, checked here so that an error names the key and line.
+void read_view(const Doc& doc, const std::string& id, const YAML::Node& n, CameraSpec& spec) {
+  if (const YAML::Node clip = mapping(doc, n, "clipping plane", id)) {
+    spec.near = number_or(doc, clip, "near", id, spec.near);
+    spec.far = number_or(doc, clip, "far", id, spec.far);
+    if (!(spec.near > 0 && spec.far > spec.near)) {
+      fail(doc, clip, id,
+           "'clipping plane' needs 0 < near < far, got near " + std::to_string(spec.near) +
+               ", far " + std::to_string(spec.far));
+    }
+  }
+  spec.fov_y = number_or(doc, n, "field view angle", id, spec.fov_y);
+  if (!(spec.fov_y > 0 && spec.fov_y < M_PI)) {
+    fail(doc, n["field view angle"], id,
+         "'field view angle' must be in (0, pi) radians (a vertical field of view), got " +
+             std::to_string(spec.fov_y));
+  }
+}
 
 CameraPlan plan_camera(const Doc& doc, const std::string& base_ns, const std::string& id,
                        const YAML::Node& n, Context& ctx) {
@@ -72,11 +92,7 @@ CameraPlan plan_camera(const Doc& doc, const std::string& base_ns, const std::st
     if (n["look at"]) fail(doc, n["look at"], id, "'look at' equals 'location': no view direction");
     plan.target = plan.eye - Eigen::Vector3d::UnitX();
   }
-  if (const YAML::Node clip = mapping(doc, n, "clipping plane", id)) {
-    plan.spec.near = number_or(doc, clip, "near", id, plan.spec.near);
-    plan.spec.far = number_or(doc, clip, "far", id, plan.spec.far);
-  }
-  plan.spec.fov_y = number_or(doc, n, "field view angle", id, plan.spec.fov_y);
+  read_view(doc, id, n, plan.spec);
   if (const YAML::Node res = mapping(doc, n, "publish image resolution", id)) {
     plan.spec.width =
         integer_or(doc, res, "width", id, "publish image resolution", plan.spec.width);

@@ -76,6 +76,7 @@ CameraPlan plan_camera(const Doc& doc, const std::string& base_ns, const std::st
                           "depth compute shaders",
                           "multipass",
                           "visible",
+                          "mouse control multipliers",
                           "publish frequency",
                           "passive",
                           "plugins"});
@@ -219,6 +220,20 @@ void refuse_parent_cycles(const Doc& doc, const std::vector<CameraPlan>& cameras
   }
 }
 
+// Camera and light keys AMBF reads that change nothing here, one warning each per file.
+void warn_not_applied(const Doc& doc, Context& ctx) {
+  Diagnostics& d = *ctx.diag;
+  d.not_applied(doc, "cameras", {"publish depth resolution"},
+                "depth is rendered at the camera's 'publish image resolution'");
+  d.not_applied(doc, "cameras", {"monitor"}, "a camera opens no window of its own here");
+  d.not_applied(doc, "cameras", {"controlling devices"}, "input devices do not move cameras here");
+  d.not_applied(doc, "cameras", {"mouse control multipliers"},
+                "the launcher's mouse controls keep their own scales");
+  d.not_applied(doc, "cameras", {"multipass"}, "cameras render every object in one pass here");
+  d.not_applied(doc, "cameras", {"visible"}, "cameras are not drawn as objects here");
+  d.not_applied(doc, "lights", {"shadow quality"}, "the engine draws no shadows");
+}
+
 }  // namespace
 
 void now_or_later(Model& model, const std::string& file,
@@ -265,6 +280,7 @@ void add_cameras_and_lights(Model& model, const Doc& doc, const std::string& bas
     lights.push_back(plan_light(doc, base_ns, id, block, ctx));
   }
   refuse_parent_cycles(doc, cameras, lights);
+  warn_not_applied(doc, ctx);
   // A parent that is not there yet leaves the object in the world frame until it comes.
   for (CameraPlan& c : cameras) {
     c.spec.name = unique_name(world, c.spec.name);

@@ -319,8 +319,9 @@ void def_adders(Class& cls, GetModel get_model) {
          "height includes its caps), plane (z = 0, infinite) or mesh (mesh = file, scale; the "
          "default when mesh is given); pose is a 4x4 world-from-body matrix. Physics (mass > 0 "
          "moves under gravity; 0 is static): inertia, inertial_offset (4x4), friction, "
-         "rolling_friction, restitution, linear_damping, angular_damping, kinematic, collision "
-         "(False: none), collision_mesh, collision_type (concave, convex_mesh, convex_hull, "
+         "rolling_friction, restitution, linear_damping, angular_damping, kinematic, gravity "
+         "((x, y, z) m/s^2: its own instead of the world's), collision (False: none), "
+         "collision_mesh, collision_type (concave, convex_mesh, convex_hull, "
          "point_cloud), collision_shapes ([{shape, size/radius/height/axis, pose}]), margin, "
          "groups ([0..31]), axis.")
       .def(

@@ -133,6 +133,20 @@ def test_camera_resolution_must_be_whole_pixels(tmp_path, resolution):
     refused(tmp_path, text, "CAM c", "publish image resolution.", "integer")
 
 
+@pytest.mark.parametrize("angle", ["3.1416", "0", "-0.5", "4"])
+def test_camera_field_view_angle_outside_0_pi_is_refused_where_read(tmp_path, angle):
+    text = camera_file(f"look at: {{x: 0, y: 0, z: 0}}\nfield view angle: {angle}")
+    message = refused(tmp_path, text, "CAM c", "'field view angle'", "(0, pi)")
+    assert "line 6:" in message, message
+
+
+@pytest.mark.parametrize("planes", ["{near: 0, far: 10}", "{near: 2, far: 1}", "{near: -1}"])
+def test_camera_clipping_planes_out_of_order_are_refused_where_read(tmp_path, planes):
+    text = camera_file(f"look at: {{x: 0, y: 0, z: 0}}\nclipping plane: {planes}")
+    message = refused(tmp_path, text, "CAM c", "'clipping plane'", "0 < near < far")
+    assert "line 6:" in message, message
+
+
 def test_camera_looking_at_its_own_location_is_refused(tmp_path):
     text = camera_file("look at: {x: 1, y: 0, z: 0}")
     refused(tmp_path, text, "CAM c", "'look at'", "'location'")

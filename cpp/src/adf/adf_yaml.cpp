@@ -211,6 +211,28 @@ std::string resolve(const fs::path& dir, const std::string& path) {
   return (p.is_absolute() ? p : dir / p).lexically_normal().string();
 }
 
+void Diagnostics::unknown_top_level(const Doc& doc, const std::set<std::string>& known,
+                                    std::initializer_list<const char*> list_keys) {
+  std::set<std::string> blocks;  // identifiers some list names
+  std::string lists;
+  for (const char* list_key : list_keys) {
+    lists += (lists.empty() ? "" : ", ") + std::string(list_key);
+    const YAML::Node list = doc.root[list_key];
+    if (!list || !list.IsSequence()) continue;  // listed() reports it where it is read
+    for (const YAML::Node& entry : list) {
+      if (entry.IsScalar()) blocks.insert(entry.Scalar());
+    }
+  }
+  for (const auto& entry : doc.root) {
+    const std::string key = entry.first.IsScalar() ? entry.first.Scalar() : "?";
+    if (known.count(key) != 0 || blocks.count(key) != 0) continue;
+    // A mapping may be a block that its list forgot: say which lists were searched.
+    const std::string block =
+        entry.second.IsMap() ? " (a block that none of " + lists + " names)" : "";
+    warn(doc.path, at(entry.first) + "unknown key '" + key + "' ignored" + block);
+  }
+}
+
 void Diagnostics::repeated_names(const Doc& doc, std::initializer_list<const char*> list_keys) {
   std::map<std::string, std::pair<std::string, std::string>> first;  // name -> (id, line)
   for (const char* list_key : list_keys) {

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <initializer_list>
 #include <optional>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -152,6 +153,10 @@ class Diagnostics {
   /// One warning per key of block that is not in known ("unknown key 'x' ignored").
   void unknown_keys(const Doc& doc, const std::string& where, const YAML::Node& block,
                     std::initializer_list<const char*> known);
+  /// One warning per top-level key of doc that is neither in known nor a block one of the lists
+  /// under list_keys names ("unknown key 'x' ignored"), whatever its value.
+  void unknown_top_level(const Doc& doc, const std::set<std::string>& known,
+                         std::initializer_list<const char*> list_keys);
   /// One warning per block of the lists named that takes a name an earlier block of the file
   /// has (AMBF renames it with a number suffix), naming both blocks.
   void repeated_names(const Doc& doc, std::initializer_list<const char*> list_keys);

@@ -17,12 +17,14 @@ BodyPlan plan_body(const Doc& doc, const std::string& model_hr, const std::strin
                          {"name",
                           "namespace",
                           "mesh",
+                          "mesh remove duplicates",
                           "shape",
                           "geometry",
                           "compound shape",
                           "mass",
                           "inertia",
                           "inertial offset",
+                          "gravity",
                           "scale",
                           "location",
                           "high resolution path",
@@ -78,6 +80,9 @@ BodyPlan plan_body(const Doc& doc, const std::string& model_hr, const std::strin
   }
   if (b["inertial offset"]) {
     s.dynamics.inertial_offset = frame(doc, b["inertial offset"], id, "inertial offset", scale);
+  }
+  if (b["gravity"]) {
+    s.dynamics.gravity = xyz(doc, b["gravity"], id, "gravity", Eigen::Vector3d::Zero());
   }
 
   // Contact parameters.

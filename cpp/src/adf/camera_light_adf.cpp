@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <functional>
 #include <optional>
 #include <string>
@@ -30,6 +31,25 @@ struct CameraPlan {
   std::optional<ShaderSpec> preprocessing;
 };
 
+// `clipping plane` and `field view angle`, checked here so that an error names the key and line.
+void read_view(const Doc& doc, const std::string& id, const YAML::Node& n, CameraSpec& spec) {
+  if (const YAML::Node clip = mapping(doc, n, "clipping plane", id)) {
+    spec.near = number_or(doc, clip, "near", id, spec.near);
+    spec.far = number_or(doc, clip, "far", id, spec.far);
+    if (!(spec.near > 0 && spec.far > spec.near)) {
+      fail(doc, clip, id,
+           "'clipping plane' needs 0 < near < far, got near " + std::to_string(spec.near) +
+               ", far " + std::to_string(spec.far));
+    }
+  }
+  spec.fov_y = number_or(doc, n, "field view angle", id, spec.fov_y);
+  if (!(spec.fov_y > 0 && spec.fov_y < M_PI)) {
+    fail(doc, n["field view angle"], id,
+         "'field view angle' must be in (0, pi) radians (a vertical field of view), got " +
+             std::to_string(spec.fov_y));
+  }
+}
+
 CameraPlan plan_camera(const Doc& doc, const std::string& base_ns, const std::string& id,
                        const YAML::Node& n, Context& ctx) {
   ctx.diag->unknown_keys(doc, id, n,
@@ -56,6 +76,7 @@ CameraPlan plan_camera(const Doc& doc, const std::string& base_ns, const std::st
                           "depth compute shaders",
                           "multipass",
                           "visible",
+                          "mouse control multipliers",
                           "publish frequency",
                           "passive",
                           "plugins"});
@@ -72,11 +93,7 @@ CameraPlan plan_camera(const Doc& doc, const std::string& base_ns, const std::st
     if (n["look at"]) fail(doc, n["look at"], id, "'look at' equals 'location': no view direction");
     plan.target = plan.eye - Eigen::Vector3d::UnitX();
   }
-  if (const YAML::Node clip = mapping(doc, n, "clipping plane", id)) {
-    plan.spec.near = number_or(doc, clip, "near", id, plan.spec.near);
-    plan.spec.far = number_or(doc, clip, "far", id, plan.spec.far);
-  }
-  plan.spec.fov_y = number_or(doc, n, "field view angle", id, plan.spec.fov_y);
+  read_view(doc, id, n, plan.spec);
   if (const YAML::Node res = mapping(doc, n, "publish image resolution", id)) {
     plan.spec.width =
         integer_or(doc, res, "width", id, "publish image resolution", plan.spec.width);
@@ -203,6 +220,20 @@ void refuse_parent_cycles(const Doc& doc, const std::vector<CameraPlan>& cameras
   }
 }
 
+// Camera and light keys AMBF reads that change nothing here, one warning each per file.
+void warn_not_applied(const Doc& doc, Context& ctx) {
+  Diagnostics& d = *ctx.diag;
+  d.not_applied(doc, "cameras", {"publish depth resolution"},
+                "depth is rendered at the camera's 'publish image resolution'");
+  d.not_applied(doc, "cameras", {"monitor"}, "a camera opens no window of its own here");
+  d.not_applied(doc, "cameras", {"controlling devices"}, "input devices do not move cameras here");
+  d.not_applied(doc, "cameras", {"mouse control multipliers"},
+                "the launcher's mouse controls keep their own scales");
+  d.not_applied(doc, "cameras", {"multipass"}, "cameras render every object in one pass here");
+  d.not_applied(doc, "cameras", {"visible"}, "cameras are not drawn as objects here");
+  d.not_applied(doc, "lights", {"shadow quality"}, "the engine draws no shadows");
+}
+
 }  // namespace
 
 void now_or_later(Model& model, const std::string& file,
@@ -249,6 +280,7 @@ void add_cameras_and_lights(Model& model, const Doc& doc, const std::string& bas
     lights.push_back(plan_light(doc, base_ns, id, block, ctx));
   }
   refuse_parent_cycles(doc, cameras, lights);
+  warn_not_applied(doc, ctx);
   // A parent that is not there yet leaves the object in the world frame until it comes.
   for (CameraPlan& c : cameras) {
     c.spec.name = unique_name(world, c.spec.name);

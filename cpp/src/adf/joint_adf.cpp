@@ -10,6 +10,26 @@
 
 namespace ambfplus::adf {
 
+namespace {
+
+// `controller output type`: FORCE or EFFORT, VELOCITY; POSITION and values AMBF does not know
+// drive efforts (AMBF's fallback for the latter), with a warning.
+ControlOutput controller_output(const Doc& doc, const std::string& id, const YAML::Node& out,
+                                Context& ctx) {
+  const std::string value = text(doc, out, id, "controller output type");
+  const std::string o = to_lower(value);
+  if (o == "force" || o == "effort") return ControlOutput::kEffort;
+  if (o == "velocity") return ControlOutput::kVelocity;
+  const std::string why =
+      o == "position" ? "ambfplus's joint controller has no position output"
+                      : "AMBF knows FORCE, EFFORT, VELOCITY and POSITION, and falls back to FORCE";
+  ctx.diag->warn(doc.path, at(out) + id + ": 'controller output type' " + value + ": " + why +
+                               "; the controller drives efforts (FORCE) instead");
+  return ControlOutput::kEffort;
+}
+
+}  // namespace
+
 JointPlan plan_joint(const Doc& doc, const std::string& model_ns, const std::string& id,
                      const YAML::Node& j, Context& ctx) {
   ctx.diag->unknown_keys(doc, id, j,
@@ -111,14 +131,7 @@ JointPlan plan_joint(const Doc& doc, const std::string& model_ns, const std::str
     }
   }
   if (const YAML::Node out = j["controller output type"]) {
-    const std::string o = to_lower(text(doc, out, id, "controller output type"));
-    if (o == "force" || o == "effort") {
-      s.controller.output = ControlOutput::kEffort;
-    } else if (o == "velocity") {
-      s.controller.output = ControlOutput::kVelocity;
-    } else {
-      fail(doc, out, id, "'controller output type' must be FORCE, EFFORT or VELOCITY");
-    }
+    s.controller.output = controller_output(doc, id, out, ctx);
   }
   plan.plugins = read_plugins(doc, j["plugins"], id);
   return plan;

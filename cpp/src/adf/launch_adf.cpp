@@ -168,15 +168,10 @@ void load_world(World& world, const std::string& path, adf::Context& ctx) {
   const Doc doc = adf::load(path, "world file");
   const YAML::Node& root = doc.root;
   const std::string where = "world";
-  for (const auto& entry : root) {
-    static const std::set<std::string> known = {
-        "namespace",      "enclosure", "lights",  "cameras", "environment", "skybox",
-        "max iterations", "gravity",   "shaders", "plugins", "adf version"};
-    const std::string key = entry.first.as<std::string>();
-    if (known.count(key) == 0 && !entry.second.IsMap()) {
-      ctx.diag->warn(doc.path, adf::at(entry.first) + "unknown key '" + key + "' ignored");
-    }
-  }
+  static const std::set<std::string> known = {
+      "namespace",      "enclosure", "lights",  "cameras", "environment", "skybox",
+      "max iterations", "gravity",   "shaders", "plugins", "adf version"};
+  ctx.diag->unknown_top_level(doc, known, {"lights", "cameras"});
   // Read everything first: a bad key fails before the world changes.
   const std::string ns =
       adf::join_ns(ctx.prefix, "/ambf/env/",
@@ -345,6 +340,9 @@ std::vector<AdfInputDevice> read_input_devices(const std::string& path,
     }
     out.push_back(std::move(d));
   }
+  diag.not_applied(doc, "input devices", {"controller gain"},
+                   "ambfplus has no controller from a device to a simulated multibody");
+  diag.not_applied(doc, "input devices", {"visible color"}, "ambfplus draws no device marker");
   if (warnings != nullptr) {
     warnings->insert(warnings->end(), diag.warnings().begin(), diag.warnings().end());
   }

@@ -75,51 +75,87 @@ std::string unique_name(const World& world, const std::string& name) {
   }
 }
 
+namespace {
+
+// The warnings a model file's keys give before anything is read: unknown keys, repeated names,
+// and keys AMBF reads that change nothing here (one warning each per file).
+void warn_model_keys(const Doc& doc, Context& ctx) {
+  // Top-level keys that are not AMBF's, nor blocks a list names, are reported.
+  static const std::set<std::string> known = {"bodies",
+                                              "soft bodies",
+                                              "ghost objects",
+                                              "joints",
+                                              "sensors",
+                                              "actuators",
+                                              "cameras",
+                                              "lights",
+                                              "volumes",
+                                              "vehicles",
+                                              "drills",
+                                              "high resolution path",
+                                              "low resolution path",
+                                              "namespace",
+                                              "ignore inter-collision",
+                                              "joint erp",
+                                              "joint cfm",
+                                              "plugins",
+                                              "shaders",
+                                              "gravity",
+                                              "adf version"};
+  ctx.diag->unknown_top_level(doc, known,
+                              {"bodies", "soft bodies", "ghost objects", "joints", "sensors",
+                               "actuators", "cameras", "lights", "volumes", "vehicles", "drills"});
+  ctx.diag->repeated_names(doc, {"bodies", "soft bodies", "ghost objects", "joints", "sensors",
+                                 "actuators", "cameras", "lights", "volumes"});
+  for (const char* list : {"bodies", "ghost objects"}) {
+    ctx.diag->not_applied(
+        doc, list, {"controller", "controller output type"},
+        "ambfplus has no body pose controller (set poses directly, or use joints)");
+    ctx.diag->not_applied(
+        doc, list, {"use material"},
+        "a mesh takes its block's colour, and its material file's texture where it has one");
+    ctx.diag->not_applied(doc, list, {"mesh remove duplicates"},
+                          "a mesh's identical vertices are always merged");
+  }
+  ctx.diag->not_applied(doc, "joints", {"enable feedback"}, "joint wrenches are not measured");
+  ctx.diag->not_applied(doc, "joints", {"enable motor"},
+                        "a joint's motor is driven by its controller's commands");
+  ctx.diag->not_applied(doc, "soft bodies",
+                        {"linear gain", "angular gain", "inertial offset", "collision groups"},
+                        "soft bodies have no controller, offset or collision groups here");
+  ctx.diag->not_applied(doc, "soft bodies", {"gravity"},
+                        "soft bodies fall with the world's gravity here");
+  ctx.diag->not_applied(doc, "soft bodies", {"inertia", "controller", "controller output type"},
+                        "a soft body's mass is spread over its nodes, and it has no controller");
+  ctx.diag->not_applied(
+      doc, "soft bodies",
+      {"mesh remove duplicates", "shape", "compound shape", "geometry", "collision shape",
+       "collision geometry", "collision offset", "compound collision shape", "collision mesh type"},
+      "a soft body is built from its mesh alone");
+}
+
+// A model's `gravity` (AMBF): the gravity of each of its rigid bodies that has none of its own.
+void apply_model_gravity(const Doc& doc, std::vector<BodyPlan>& bodies, Context& ctx) {
+  const YAML::Node node = doc.root["gravity"];
+  if (!node) return;
+  const Eigen::Vector3d g = xyz(doc, node, "model", "gravity", Eigen::Vector3d::Zero());
+  for (BodyPlan& body : bodies) {
+    if (!body.spec.dynamics.gravity) body.spec.dynamics.gravity = g;
+  }
+  if (!listed(doc, "soft bodies").empty()) {
+    ctx.diag->warn(doc.path, at(node) +
+                                 "the model's 'gravity' is applied to its rigid bodies only; "
+                                 "its soft bodies fall with the world's gravity");
+  }
+}
+
+}  // namespace
+
 Model& load_model(World& world, const std::string& path, Context& ctx) {
   const Doc doc = load(path, "model file");
   const YAML::Node& root = doc.root;
   const std::string where = "model";
-  // Top-level keys that are not blocks (mappings) and not AMBF's are reported.
-  {
-    static const std::set<std::string> known = {"bodies",
-                                                "soft bodies",
-                                                "ghost objects",
-                                                "joints",
-                                                "sensors",
-                                                "actuators",
-                                                "cameras",
-                                                "lights",
-                                                "volumes",
-                                                "vehicles",
-                                                "drills",
-                                                "high resolution path",
-                                                "low resolution path",
-                                                "namespace",
-                                                "ignore inter-collision",
-                                                "joint erp",
-                                                "joint cfm",
-                                                "plugins",
-                                                "shaders",
-                                                "adf version"};
-    for (const auto& entry : root) {
-      const std::string key = entry.first.as<std::string>();
-      if (known.count(key) == 0 && !entry.second.IsMap()) {
-        ctx.diag->warn(doc.path, at(entry.first) + "unknown key '" + key + "' ignored");
-      }
-    }
-  }
-  ctx.diag->repeated_names(doc, {"bodies", "soft bodies", "ghost objects", "joints", "sensors",
-                                 "actuators", "cameras", "lights", "volumes"});
-  // Keys AMBF reads that change nothing here, one warning each per file.
-  ctx.diag->not_applied(doc, "bodies", {"controller", "controller output type"},
-                        "ambfplus has no body pose controller (set poses directly, or use joints)");
-  ctx.diag->not_applied(
-      doc, "bodies", {"use material"},
-      "a mesh takes its block's colour, and its material file's texture where it has one");
-  ctx.diag->not_applied(doc, "joints", {"enable feedback"}, "joint wrenches are not measured");
-  ctx.diag->not_applied(doc, "soft bodies",
-                        {"linear gain", "angular gain", "inertial offset", "collision groups"},
-                        "soft bodies have no controller, offset or collision groups here");
+  warn_model_keys(doc, ctx);
   const std::string model_ns =
       join_ns(ctx.prefix, world.name_space(),
               root["namespace"] ? text(doc, root["namespace"], where, "namespace") : "");
@@ -144,6 +180,7 @@ Model& load_model(World& world, const std::string& path, Context& ctx) {
       ctx.diag->error(doc.path, at(block) + id + ": left out: " + e.what());
     }
   }
+  apply_model_gravity(doc, bodies, ctx);
   // Ghost objects: a body's keys (no mass) and a `parent` they ride on.
   struct GhostPlan {
     BodyPlan body;

@@ -13,31 +13,17 @@ namespace ambfplus::adf {
 SoftBodySpec plan_soft_body(const Doc& doc, const std::string& model_lr,
                             const std::string& model_hr, const std::string& id, const YAML::Node& b,
                             Context& ctx) {
-  ctx.diag->unknown_keys(doc, id, b,
-                         {"name",
-                          "namespace",
-                          "mesh",
-                          "collision mesh",
-                          "high resolution path",
-                          "low resolution path",
-                          "scale",
-                          "location",
-                          "mass",
-                          "inertial offset",
-                          "linear gain",
-                          "angular gain",
-                          "color",
-                          "color rgba",
-                          "color components",
-                          "config",
-                          "randomize constraints",
-                          "collision margin",
-                          "collision groups",
-                          "publish frequency",
-                          "passive",
-                          "shaders",
-                          "visible",
-                          "plugins"});
+  ctx.diag->unknown_keys(
+      doc, id, b,
+      {"name", "namespace", "mesh", "collision mesh", "high resolution path", "low resolution path",
+       "scale", "location", "mass", "inertial offset", "gravity", "linear gain", "angular gain",
+       "color", "color rgba", "color components", "config", "randomize constraints",
+       "collision margin", "collision groups", "publish frequency", "passive", "shaders", "visible",
+       "plugins",
+       // A body's keys AMBF reads for soft bodies too; warned as not applied.
+       "inertia", "controller", "controller output type", "mesh remove duplicates", "shape",
+       "compound shape", "geometry", "collision shape", "collision geometry", "collision offset",
+       "compound collision shape", "collision mesh type"});
   SoftBodySpec s;
   s.name = block_name(doc, id, b);
   s.scale = number_or(doc, b, "scale", id, 1.0);

@@ -351,6 +351,11 @@ void PhysicsWorld::add(RigidBody& rb) {
     b->body->setCollisionFlags(b->body->getCollisionFlags() |
                                btCollisionObject::CF_NO_CONTACT_RESPONSE);
   }
+  if (d.gravity) {
+    // Its own gravity, which the world's (now and when it changes) leaves alone.
+    b->body->setFlags(b->body->getFlags() | BT_DISABLE_WORLD_GRAVITY);
+    b->body->setGravity(to_bullet(*d.gravity));
+  }
   b->groups = c.groups;
   b->owner = &rb;
   world_->addRigidBody(b->body.get());

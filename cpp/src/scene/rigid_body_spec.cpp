@@ -252,6 +252,7 @@ void RigidBodySpec::validate() const {
     }
   }
   if (d.inertial_offset) checked_pose(*d.inertial_offset);
+  if (d.gravity && !d.gravity->allFinite()) throw ArgumentError(who + ": gravity must be finite");
   require_non_negative(collision.margin, "collision margin", who);
   shape.validate(who);
   const bool movable = mass > 0 && !d.kinematic;
@@ -328,6 +329,8 @@ const OptionTable<RigidBodySpec>& rigid_body_options() {
             [](S& s, V v, K k) { s.dynamics.angular_damping = v.number(k); }},
           O{"kinematic", "bool", "moved only by setting its pose",
             [](S& s, V v, K k) { s.dynamics.kinematic = v.boolean(k); }},
+          O{"gravity", "tuple[float, float, float]", "m/s^2: its own, instead of the world's",
+            [](S& s, V v, K k) { s.dynamics.gravity = v.vector3(k); }},
           O{"collision", "bool", "False: collides with nothing",
             [](S& s, V v, K k) { s.collision.enabled = v.boolean(k); }},
           O{"collision_mesh", "str | os.PathLike[str]", "a separate collision mesh file",

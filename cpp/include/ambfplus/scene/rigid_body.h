@@ -89,6 +89,8 @@ struct AMBFPLUS_API Dynamics {
   double angular_damping = 0.1;
   /// Moved only by set_pose (and drills it is attached to), pushing dynamic bodies aside.
   bool kinematic = false;
+  /// This body's own gravity, m/s^2 (AMBF's body or model `gravity`); absent: the world's.
+  std::optional<Eigen::Vector3d> gravity;
 };
 
 /// Parses "box", "sphere", "cylinder", "capsule", "cone", "plane", "mesh", "none" (any case).

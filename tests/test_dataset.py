@@ -21,11 +21,13 @@ import pytest
 from ambfplus.dataset import (
     GenerateError,
     SpecError,
+    StaleRunError,
     dataset_info,
     generate,
     load_spec,
     read_manifest,
     record_episode,
+    run_episode,
     sample_episode,
     validate_dataset,
     without_run_fields,
@@ -332,6 +334,122 @@ def test_a_folder_holds_one_spec_and_one_generation_at_a_time(dataset_spec, tmp_
         fcntl.flock(lock, fcntl.LOCK_EX)
         with pytest.raises(GenerateError, match="another generation is writing"):
             generate(BASE_SPEC, out, progress=False)
+
+
+# A task of a run whose driver died, as Ray may leave one running: it checks the folder's run,
+# then waits (while the new run takes the folder over and cleans it) and records episode 1 as
+# the new run makes it too, then waits again until the new run has listed it.
+LATE_TASK = """
+import json, sys, time
+from pathlib import Path
+import ambfplus.dataset.episode as episode
+
+out, run, signals = Path(sys.argv[1]), sys.argv[2], Path(sys.argv[3])
+spec_data = json.loads(Path(sys.argv[4]).read_text())
+record = episode.record_episode
+
+def wait_for(name):
+    deadline = time.monotonic() + 300
+    while not (signals / name).exists():
+        assert time.monotonic() < deadline, name
+        time.sleep(0.02)
+
+def late_record(spec_data, index, path, plan=None):
+    print(path.parent.name, flush=True)
+    wait_for("resumed")
+    summary = record(spec_data, index, path, plan)
+    wait_for("listed")
+    return summary
+
+episode.record_episode = late_record
+try:
+    episode.run_episode(spec_data, out, 1, 0, worker="late", run=run)
+except episode.StaleRunError as error:
+    print("stale:", error, flush=True)
+    sys.exit(3)
+"""
+
+
+def test_a_dead_runs_late_task_cannot_touch_the_resumed_runs_shard(tmp_path, monkeypatch):
+    import ambfplus.dataset.driver as driver_module
+
+    spec = load_spec({**BASE_SPEC, "capture": {"every": 50, "frames": 3}})
+    out, signals = tmp_path / "data", tmp_path / "signals"
+    signals.mkdir()
+    generate(spec, out, progress=False)
+    dead_run = (out / ".run").read_text().strip()
+    # as if its driver had died before listing episode 1, whose task still runs somewhere
+    first = read_manifest(out)[0][0]
+    (out / "manifest.jsonl").write_text(json.dumps(first) + "\n")
+    spec_file = tmp_path / "spec.json"
+    spec_file.write_text(json.dumps(spec.data))
+    late = subprocess.Popen(
+        [sys.executable, "-c", LATE_TASK, str(out), dead_run, str(signals), str(spec_file)],
+        cwd="/",
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        late_partial = late.stdout.readline().strip()  # past its check of the folder's run
+        assert late_partial == f"episode_000001.{dead_run}.attempt0", late.stderr.read()
+        resume = driver_module._resume
+
+        def resume_then_signal(*args):
+            records = resume(*args)
+            (signals / "resumed").touch()
+            return records
+
+        class Writer(driver_module.ManifestWriter):
+            def append(self, record):  # the late task tries to move its shard in now
+                super().append(record)
+                before.append((head.stat().st_ino, head.read_bytes()))
+                (signals / "listed").touch()
+                late.wait(timeout=300)
+                left.append((out / ".partial" / late_partial).exists())
+
+        head, before, left = out / "shards" / "episode_000001.h5", [], []
+        monkeypatch.setattr(driver_module, "_resume", resume_then_signal)
+        monkeypatch.setattr(driver_module, "ManifestWriter", Writer)
+        report = generate(spec, out, progress=False)
+        stdout, stderr = late.communicate(timeout=300)
+    finally:
+        (signals / "listed").touch()
+        if late.poll() is None:
+            late.kill()
+    assert late.returncode == 3 and "is no longer this folder's current run" in stdout, stderr
+    assert (report.generated, report.skipped) == (1, 1)
+    runs = json.loads((out / "environment.json").read_text())["runs"]
+    assert runs[0]["run_id"] == dead_run and runs[1]["run_id"] not in (dead_run, "")
+    assert [(head.stat().st_ino, head.read_bytes())] == before  # not replaced
+    assert [r["episode"] for r in read_manifest(out)[0]] == [0, 1]
+    assert left == [False]  # the late task deleted its own partial shard
+    check = validate_dataset(out, match_images=False)
+    assert check.ok and not check.warnings, str(check)
+
+
+def test_an_attempt_keeps_a_complete_shard_and_a_stale_one_makes_nothing(tmp_path):
+    from ambfplus.dataset.episode import take_over
+
+    spec = load_spec(BASE_SPEC)
+    out = tmp_path / "data"
+    out.mkdir()
+    take_over(out, "run-a")
+    record = run_episode(spec.data, out, 0, 0, run="run-a")
+    head = out / record["file"]
+    inode = head.stat().st_ino
+    # a second attempt of the same run (its first was thought lost) keeps the shard in place
+    again = run_episode(spec.data, out, 0, 1, run="run-a")
+    assert without_run_fields(again) == without_run_fields(record)
+    assert head.stat().st_ino == inode
+    take_over(out, "run-b")
+    with pytest.raises(StaleRunError, match="run-a is no longer this folder's current run"):
+        run_episode(spec.data, out, 1, 0, run="run-a")
+    assert sorted(p.name for p in (out / "shards").iterdir()) == [
+        Path(record["file"]).name,
+        *(Path(p).name for p in record["parts"]),
+    ]
+    assert not any((out / ".partial").iterdir())
 
 
 def test_an_episode_that_keeps_failing_stops_the_run_with_its_error(tmp_path, monkeypatch):

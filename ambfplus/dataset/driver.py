@@ -5,10 +5,13 @@
                            (executor, workers, renderers, start and end, retries)
     DIR/manifest.jsonl     one line per complete shard (ambfplus.dataset.manifest)
     DIR/shards/episode_000012.h5 (+ .part0001)   one recording per episode
+    DIR/.partial/, DIR/.run, DIR/.lock   shards being made, the current run's id, the lock
 
 Running it again resumes: shards listed in the manifest (whose files are there, of the listed
 size) are kept; anything else in ``shards/`` and everything under ``.partial/`` is deleted and
-its episodes are made again. One generation at a time writes a folder (a lock file says so).
+its episodes are made again. One generation at a time writes a folder (a lock file says so),
+and each run takes the folder over (``.run``) before it cleans it, so tasks a killed driver left
+running on a cluster cannot put anything into ``shards/`` afterwards (see ``episode``).
 """
 
 from __future__ import annotations
@@ -27,7 +30,7 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 from .. import __version__
-from .episode import PARTIAL, SHARDS
+from .episode import PARTIAL, RUN_FILE, SHARDS, new_run_id, take_over
 from .executor import Done, Executor, Failed, Retry
 from .manifest import MANIFEST, ManifestWriter, read_manifest, rewrite_manifest
 from .spec import DatasetSpec, SpecError, load_spec
@@ -115,12 +118,14 @@ def _generate(spec: DatasetSpec, out: Path, executor: Executor, progress: bool) 
     out.mkdir(parents=True, exist_ok=True)
     with _FolderLock(out):
         environment = _prepare(out, spec)
-        records = _resume(out, spec)
+        run_id = new_run_id()
+        records = _resume(out, spec, run_id)
         todo = [i for i in range(spec.episodes) if i not in records]
         run = {
             **executor.describe(),
             "host": socket.gethostname(),
             "pid": os.getpid(),
+            "run_id": run_id,
             "started": _now(),
             "finished": None,
             "status": "running",
@@ -134,7 +139,7 @@ def _generate(spec: DatasetSpec, out: Path, executor: Executor, progress: bool) 
         writer = ManifestWriter(out)
         made = frames = retries = 0
         renderers: set[str] = set()
-        events = executor.run(spec.data, out, todo)
+        events = executor.run(spec.data, out, todo, run_id)
         try:
             for event in events:
                 if isinstance(event, Done):
@@ -155,7 +160,8 @@ def _generate(spec: DatasetSpec, out: Path, executor: Executor, progress: bool) 
                         f"last time: {event.reason.strip()}"
                     )
             run["status"] = "complete"
-            shutil.rmtree(out / PARTIAL, ignore_errors=True)  # every worker has stopped
+            # this run's workers are done, and earlier runs' tasks cannot move their shards
+            shutil.rmtree(out / PARTIAL, ignore_errors=True)
         except BaseException as error:
             run["status"] = "interrupted" if isinstance(error, KeyboardInterrupt) else "failed"
             raise
@@ -200,7 +206,7 @@ def _prepare(out: Path, spec: DatasetSpec) -> dict:
                 "another folder, or delete it first"
             )
         return environment
-    ours = {SPEC_FILE, ENVIRONMENT, MANIFEST, SHARDS, PARTIAL, LOCK, MANIFEST + ".tmp"}
+    ours = {SPEC_FILE, ENVIRONMENT, MANIFEST, SHARDS, PARTIAL, LOCK, RUN_FILE, MANIFEST + ".tmp"}
     strangers = sorted(p.name for p in out.iterdir() if p.name not in ours)
     if strangers:
         raise GenerateError(
@@ -224,9 +230,10 @@ def _prepare(out: Path, spec: DatasetSpec) -> dict:
     return environment
 
 
-def _resume(out: Path, spec: DatasetSpec) -> dict[int, dict]:
-    """The complete shards of an earlier run, by episode; deletes everything else (partial
-    shards, shards a killed driver did not list) and rewrites the manifest clean."""
+def _resume(out: Path, spec: DatasetSpec, run_id: str) -> dict[int, dict]:
+    """The complete shards of an earlier run, by episode; makes `run_id` the folder's run, then
+    deletes everything else (partial shards, shards a killed driver did not list) and rewrites
+    the manifest clean."""
     records: dict[int, dict] = {}
     for record in read_manifest(out)[0]:
         index = record["episode"]
@@ -240,6 +247,7 @@ def _resume(out: Path, spec: DatasetSpec) -> dict[int, dict]:
             records[index] = record
     shutil.rmtree(out / PARTIAL, ignore_errors=True)
     kept = {Path(r["file"]).name for r in records.values()}
+    take_over(out, run_id)  # before cleaning: an earlier run's late task could move a shard in
     kept |= {Path(p).name for r in records.values() for p in r["parts"]}
     shards = out / SHARDS
     if shards.is_dir():

@@ -8,6 +8,7 @@ from __future__ import annotations
 import json
 import os
 import random
+import re
 import shutil
 import signal
 import subprocess
@@ -477,6 +478,44 @@ def test_an_episode_that_keeps_failing_stops_the_run_with_its_error(tmp_path, mo
     ):
         generate(spec, tmp_path / "out", retries=1, progress=False)
     assert read_manifest(tmp_path / "out")[0] == []
+
+
+def test_the_progress_bar_reports_episodes_and_retries(tmp_path, monkeypatch):
+    import io
+
+    import ambfplus
+    import ambfplus.dataset.driver as module
+
+    stream = io.StringIO()
+    report = generate(BASE_SPEC, tmp_path / "fine", progress=stream)
+    final = _last_line(stream.getvalue())
+    assert report.generated == 2
+    assert final.startswith("generate: 100%") and "2/2" in final and "0 retries" in final, final
+    assert re.search(r"\d+\.\d pairs/s", final), final
+    # every attempt fails (the volume goes bad after the spec was checked): 2 retries, then
+    # the run stops
+    ear = tmp_path / "ear.nrrd"
+    ambfplus.phantom(24).save_nrrd(ear)
+    spec = {**BASE_SPEC, "anatomies": [{"file": str(ear)}]}
+    checked = module.check_anatomies
+
+    def check_then_spoil(data):
+        checked(data)
+        ear.write_text("NRRD0004\ntype: nonsense\n\n")
+
+    monkeypatch.setattr(module, "check_anatomies", check_then_spoil)
+    stream = io.StringIO()
+    with pytest.raises(GenerateError):
+        generate(spec, tmp_path / "failing", retries=1, progress=stream)
+    text = stream.getvalue()
+    assert "0/2" in _last_line(text) and "2 retries" in _last_line(text), text
+    for episode in (0, 1):
+        assert f"episode {episode}: retrying (attempt 2): " in text  # counted from 1
+
+
+def _last_line(text: str) -> str:
+    """What a terminal would show last of a tqdm bar's output."""
+    return [line for line in re.split(r"[\r\n]", text) if line.strip()][-1]
 
 
 # Randomisation -----------------------------------------------------------------------------

@@ -28,6 +28,7 @@ import time
 from dataclasses import dataclass, field
 from datetime import datetime, timezone
 from pathlib import Path
+from typing import TextIO
 
 from .. import __version__
 from .episode import PARTIAL, RUN_FILE, SHARDS, new_run_id, take_over
@@ -69,13 +70,14 @@ def generate(
     ray: str | None = None,
     retries: int = 3,
     timeout: float | None = None,
-    progress: bool = True,
+    progress: bool | TextIO = True,
     ray_options: dict | None = None,
 ) -> GenerateReport:
     """Generates the dataset of `spec` (a path, a dict or a DatasetSpec) into folder `out`, with
     `workers` local processes or on the Ray cluster at `ray` ("auto", "local" or an address;
     needs ``ambfplus[ray]``). Each episode is tried at most `retries` + 1 times, and at most
-    `timeout` seconds each. Call it under ``if __name__ == "__main__":`` (local workers import
+    `timeout` seconds each. `progress`: a live bar on stderr (True), on a text stream, or
+    none (False). Call it under ``if __name__ == "__main__":`` (local workers import
     the main module again)."""
     spec = spec if isinstance(spec, DatasetSpec) else load_spec(spec)
     check_anatomies(spec)
@@ -114,7 +116,7 @@ def check_anatomies(spec: DatasetSpec) -> None:
             ) from None
 
 
-def _generate(spec: DatasetSpec, out: Path, executor: Executor, progress: bool) -> GenerateReport:
+def _generate(spec: DatasetSpec, out: Path, executor: Executor, progress) -> GenerateReport:
     out.mkdir(parents=True, exist_ok=True)
     with _FolderLock(out):
         environment = _prepare(out, spec)
@@ -123,9 +125,9 @@ def _generate(spec: DatasetSpec, out: Path, executor: Executor, progress: bool) 
         todo = [i for i in range(spec.episodes) if i not in records]
         run = {
             **executor.describe(),
+            "run_id": run_id,
             "host": socket.gethostname(),
             "pid": os.getpid(),
-            "run_id": run_id,
             "started": _now(),
             "finished": None,
             "status": "running",
@@ -245,9 +247,9 @@ def _resume(out: Path, spec: DatasetSpec, run_id: str) -> dict[int, dict]:
             and sum(f.stat().st_size for f in files) == record["bytes"]
         ):
             records[index] = record
+    take_over(out, run_id)  # before cleaning: an earlier run's late task could move a shard in
     shutil.rmtree(out / PARTIAL, ignore_errors=True)
     kept = {Path(r["file"]).name for r in records.values()}
-    take_over(out, run_id)  # before cleaning: an earlier run's late task could move a shard in
     kept |= {Path(p).name for r in records.values() for p in r["parts"]}
     shards = out / SHARDS
     if shards.is_dir():
@@ -308,17 +310,20 @@ class _FolderLock:
 
 
 class _Progress:
-    """A live bar (tqdm): episodes, stereo pairs per second, ETA, retries."""
+    """A live bar (tqdm): episodes, stereo pairs per second, ETA, retries; on stderr (`output`
+    True), on a text stream, or nowhere (False)."""
 
-    def __init__(self, total: int, initial: int, enabled: bool) -> None:
+    def __init__(self, total: int, initial: int, output) -> None:
         self.bar = None
         self.frames = self.retries = 0
         self.started = time.perf_counter()
-        if enabled:
+        if output is not False and output is not None:
             from tqdm import tqdm
 
+            self.file = sys.stderr if output is True else output
             self.bar = tqdm(
                 total=total,
+                file=self.file,
                 initial=initial,
                 unit="episode",
                 dynamic_ncols=True,
@@ -336,9 +341,10 @@ class _Progress:
     def retry(self, event: Retry) -> None:
         self.retries += 1
         if self.bar is not None:
-            self.bar.write(
+            self.bar.write(  # beside the bar (tqdm's default is stdout)
                 f"episode {event.episode}: retrying (attempt {event.attempt + 1}): "
-                f"{event.reason.strip().splitlines()[-1]}"
+                f"{event.reason.strip().splitlines()[-1]}",
+                file=self.file,
             )
             self._postfix()
 

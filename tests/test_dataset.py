@@ -33,6 +33,7 @@ from ambfplus.dataset import (
     validate_dataset,
     without_run_fields,
 )
+from ambfplus.dataset.sampling import HANDLE_COLOR, METAL_COLOR
 from ambfplus.recording import open_recording
 from ambfplus.scenes import anatomy_data
 
@@ -528,7 +529,16 @@ def test_randomisation_is_real_recorded_and_within_the_ranges(reference_dataset)
         label.id: label.color
         for label in anatomy_data({"phantom": {"resolution": 40, "seed": 0}}).label_table
     }
+    appearance = spec.data["appearance"]
+    light_low, light_high = appearance["lights"]["color"]["uniform"]
+    drill = appearance["drill"]
     seen = {"lights": set(), "intensity": [], "background": [], "fov": [], "cx": [], "sigma": []}
+    seen.update(light_color=[], metal=[], handle=[], label_colors={})
+    for key in appearance["material"]:
+        seen[f"material.{key}"] = []
+    for key in ("specular", "shininess"):
+        if key in drill:
+            seen[f"drill.{key}"] = []
     for record in read_manifest(reference_dataset)[0]:
         with open_recording(reference_dataset / record["file"]) as rec:
             sampled = rec.metadata["sampled"]
@@ -538,11 +548,34 @@ def test_randomisation_is_real_recorded_and_within_the_ranges(reference_dataset)
             seen["lights"].add(len(lights))
             for light in lights:
                 assert 0.3 <= light["intensity"] <= 1.0
-                assert all(0.8 <= c <= 1.0 for c in light["color"])
+                assert np.all(
+                    (light_low <= np.array(light["color"]))
+                    & (light["color"] <= np.array(light_high))
+                )
                 assert light["type"] in ("directional", "point", "spot")
                 seen["intensity"].append(light["intensity"])
-            for label_id, color in (sampled["label_colors"] or {}).items():
-                assert np.all(np.abs(np.subtract(color, table[int(label_id)])) <= 25)
+                seen["light_color"].append(light["color"])
+            jitter = appearance["labels"]["color_jitter"]
+            assert sampled["label_colors"]
+            for label_id, color in sampled["label_colors"].items():
+                assert np.all(np.abs(np.subtract(color, table[int(label_id)])) <= jitter)
+                seen["label_colors"].setdefault(label_id, set()).add(tuple(color))
+            # the anatomy's and the drill's materials
+            for key, value in appearance["material"].items():
+                low, high = value["uniform"]
+                assert low <= scene["volume_material"][key] <= high, key
+                seen[f"material.{key}"].append(scene["volume_material"][key])
+            for key in ("specular", "shininess"):
+                if key in drill:
+                    low, high = drill[key]["uniform"]
+                    assert low <= scene["drill_metal"][key] <= high, key
+                    seen[f"drill.{key}"].append(scene["drill_metal"][key])
+            for name, color, base in (
+                ("metal", scene["drill_metal"]["color"], METAL_COLOR),
+                ("handle", scene["drill_handle"]["color"], HANDLE_COLOR),
+            ):
+                assert np.all(np.abs(np.subtract(color, base)) <= drill["color_jitter"] + 1e-12)
+                seen[name].append(color)
             # the legend the shard carries has the jittered colours
             volume = next(e for e in rec.legend.values() if e["kind"] == "volume")
             assert {str(i): list(v["color"]) for i, v in volume["labels"].items()} == sampled[
@@ -574,9 +607,17 @@ def test_randomisation_is_real_recorded_and_within_the_ranges(reference_dataset)
             seen["fov"].append(fov)
             seen["cx"].append(offset[0])
     assert len(seen["lights"]) >= 2
-    for key in ("intensity", "fov", "cx", "sigma"):
+    scalars = ["intensity", "fov", "cx", "sigma"] + [k for k in seen if "." in k]
+    assert (
+        len(scalars) == 7
+    )  # the spec samples the anatomy's specular and shininess, the drill's specular
+    for key in scalars:
         assert np.std(seen[key]) > 0, key
-    assert np.std(np.array(seen["background"]), axis=0).min() > 0
+    for key in ("background", "light_color", "metal", "handle"):
+        assert np.std(np.array(seen[key]), axis=0).min() > 0, key  # every channel varies
+    # every label's colour differs between episodes
+    assert set(seen["label_colors"]) == {str(i) for i in table}
+    assert all(len(colors) > 1 for colors in seen["label_colors"].values()), seen["label_colors"]
 
 
 def test_other_looks_leave_the_ground_truth_exact(dataset_spec, tmp_path):

@@ -144,6 +144,25 @@ def test_ray_without_the_extra_says_what_to_install(monkeypatch, tmp_path):
     assert not (tmp_path / "out").exists()
 
 
+def test_the_ray_tests_fail_rather_than_skip_under_ci_without_ray(tmp_path):
+    ray_tests = Path(__file__).with_name("test_dataset_ray.py")
+    without_ray = "import sys; sys.modules['ray'] = None; import pytest; sys.exit(pytest.main())"
+    command = [sys.executable, "-c", without_ray, str(ray_tests), "-q", "-p", "no:cacheprovider"]
+    results = {}
+    for ci in ("true", None):
+        env = {k: v for k, v in os.environ.items() if k != "CI"}
+        env.update({"CI": ci} if ci else {})
+        results[ci] = subprocess.run(
+            command, cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300
+        )
+    failed, skipped = results["true"], results[None]
+    # a collection error (pytest's 2) under CI; elsewhere the module is skipped (no test runs: 5)
+    assert failed.returncode == pytest.ExitCode.INTERRUPTED, failed.stdout + failed.stderr
+    assert 'pip install "ambfplus[ray]"' in failed.stdout, failed.stdout
+    assert skipped.returncode == pytest.ExitCode.NO_TESTS_COLLECTED, skipped.stdout
+    assert "1 skipped" in skipped.stdout, skipped.stdout
+
+
 def test_ray_gpu_ids_choose_the_engines_cuda_device():
     from ambfplus.dataset.ray_executor import select_gpu
 

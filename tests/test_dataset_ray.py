@@ -36,6 +36,7 @@ def _need(module: str) -> None:
 _need("ray")
 _need("psutil")
 
+import psutil  # noqa: E402
 from ray_cluster import RayCluster  # noqa: E402
 from test_dataset import manifest, shard_bytes  # noqa: E402
 
@@ -113,36 +114,65 @@ def test_ray_workers_killed_on_both_nodes_are_retried(
 def test_a_killed_ray_driver_resumes_to_the_same_dataset(
     cluster, dataset_spec, reference_dataset, tmp_path
 ):
-    out = tmp_path / "ray"
-    driver = subprocess.Popen(
-        [
-            sys.executable,
-            "-m",
-            "ambfplus",
-            "generate",
-            str(dataset_spec),
-            "--out",
-            str(out),
-            "--ray",
-            cluster.address,
-            "--quiet",
-        ],
-        cwd="/",
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-    )
-    deadline = time.monotonic() + 180
-    while time.monotonic() < deadline and len(read_manifest(out)[0]) < 3:
-        if driver.poll() is not None:
-            pytest.fail(f"the driver ended early: {driver.communicate()[1].decode()}")
-        time.sleep(0.05)
-    driver.kill()
-    driver.wait(timeout=30)
+    out, log = tmp_path / "ray", tmp_path / "driver.log"
+    with open(log, "wb") as stderr:
+        driver = subprocess.Popen(
+            [sys.executable, "-m", "ambfplus", "generate", str(dataset_spec), "--out", str(out),
+             "--ray", cluster.address, "--quiet"],
+            cwd="/", env=cluster.env, stdout=subprocess.DEVNULL, stderr=stderr,
+        )  # fmt: skip
+    try:
+        listed = wait_for_listed(out, 3, driver, log)
+        # the processes that ran (or run) the driver's tasks
+        job_workers = {int(r["worker"].rsplit(":", 1)[1]) for r in listed}
+        job_workers |= {pid for pids in cluster.workers_running(TASK).values() for pid in pids}
+    finally:
+        driver.kill()
+        driver.wait(timeout=30)
     assert 3 <= len(read_manifest(out)[0]) < 12
+    # Ray ends a dead driver's workers (its tasks too) when it notices; a task that outlived it
+    # could not move a shard in anyway (the resumed run takes the folder over), but the
+    # comparison below is of a run with no other job on the cluster
+    alive = set(job_workers)
+    for _ in range(600):
+        alive = {pid for pid in alive if _running(pid)}
+        if not alive:
+            break
+        time.sleep(0.1)
+    else:
+        pytest.fail(f"the killed driver's Ray workers {sorted(alive)} outlived it by 60 s")
     resumed = generate(dataset_spec, out, ray=cluster.address, progress=False)
     assert resumed.skipped >= 3 and resumed.skipped + resumed.generated == 12
     assert manifest(out) == manifest(reference_dataset)
     assert shard_bytes(out) == shard_bytes(reference_dataset)
+
+
+# How long a driver may go without listing an episode before a test gives up on it (the first
+# one includes connecting to the cluster and starting its workers).
+STALL_S = 150
+
+
+def wait_for_listed(out, count: int, driver: subprocess.Popen, log) -> list[dict]:
+    """Waits while the driver lists episodes until `count` are listed; fails if it ends or goes
+    STALL_S seconds without listing one."""
+    listed, progress = [], time.monotonic()
+    while len(listed) < count:
+        if driver.poll() is not None:
+            pytest.fail(f"the driver ended early: {log.read_text()}")
+        records = read_manifest(out)[0]
+        if len(records) > len(listed):
+            listed, progress = records, time.monotonic()
+        elif time.monotonic() - progress > STALL_S:
+            pytest.fail(f"the driver listed no episode for {STALL_S} s: {log.read_text()}")
+        time.sleep(0.05)
+    return listed
+
+
+def _running(pid: int) -> bool:
+    try:
+        return psutil.Process(pid).status() != psutil.STATUS_ZOMBIE
+    except psutil.Error:
+        return False
 
 
 def test_ray_local_is_a_cluster_of_its_own_whose_gpu_workers_keep_their_context(

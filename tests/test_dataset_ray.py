@@ -1,8 +1,9 @@
 """Datasets on a real Ray cluster: a head and a second node started with `ray start` on this
 machine (tests/ray_cluster.py). The same spec gives the same shards as the local executor, Ray
-workers killed on either node are replaced and their episodes redone, and a killed driver
-resumes. Skipped without the ray extra (pip install "ambfplus[ray]"), except under CI (the
-environment variable CI set), which installs it: there its absence fails."""
+workers killed on either node are replaced and their episodes redone, a lost node's episodes
+are redone on the other, and a killed driver resumes. Skipped without the ray extra (pip
+install "ambfplus[ray]"), except under CI (the environment variable CI set), which installs
+it: there its absence fails."""
 
 from __future__ import annotations
 
@@ -37,7 +38,7 @@ _need("ray")
 _need("psutil")
 
 import psutil  # noqa: E402
-from ray_cluster import RayCluster  # noqa: E402
+from ray_cluster import NODE_IP, RayCluster  # noqa: E402
 from test_dataset import manifest, shard_bytes  # noqa: E402
 
 from ambfplus.dataset import generate, read_manifest, validate_dataset  # noqa: E402
@@ -221,3 +222,53 @@ def test_an_unreachable_ray_address_says_so(tmp_path):
     assert not (tmp_path / "out").exists()
     with pytest.raises(ConnectionError, match="expected host:port"):
         check_reachable("nowhere")
+
+
+# A few short episodes that a lost node's share of is redone on the other node.
+LOST_NODE_SPEC = """\
+version: 1
+episodes: 6
+seed: 11
+capture: {every: 250, frames: 4, passes: [rgb, depth, label]}
+anatomies: [{phantom: {resolution: 40}}]
+scenarios: [{kind: camera}]
+rigs: [{resolution: [160, 120]}]
+"""
+
+
+def test_a_lost_ray_node_has_its_episodes_redone(tmp_path):
+    spec, out = tmp_path / "spec.yaml", tmp_path / "ray"
+    spec.write_text(LOST_NODE_SPEC)
+    # a cluster of its own (this one loses a node), whose head notices a lost node in seconds
+    lost = RayCluster(
+        cpus_per_node=1,
+        env={"RAY_health_check_period_ms": "1000", "RAY_health_check_failure_threshold": "3"},
+    )
+    killed: list[int] = []
+    stop = threading.Event()
+
+    def lose_the_second_node():  # as soon as it runs an episode
+        while not stop.is_set():
+            if lost.workers_running(TASK).get(NODE_IP):
+                killed.extend(lost.kill_node(NODE_IP))
+                return
+            time.sleep(0.05)
+
+    thread = threading.Thread(target=lose_the_second_node)
+    try:
+        lost.start()
+        thread.start()
+        report = generate(spec, out, ray=lost.address, retries=3, timeout=120, progress=False)
+    finally:
+        stop.set()
+        if thread.is_alive():
+            thread.join()
+        lost.stop()
+    assert killed, "the second node never ran an episode"
+    assert report.retries >= 1 and report.generated == 6
+    records = read_manifest(out)[0]
+    assert sorted(r["episode"] for r in records) == list(range(6))  # none missing, none twice
+    check = validate_dataset(out, match_images=False)
+    assert check.ok and not check.warnings, str(check)
+    environment = json.loads((out / "environment.json").read_text())
+    assert environment["runs"][0]["retries"] == report.retries

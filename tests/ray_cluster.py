@@ -53,7 +53,7 @@ def _port_block(count: int) -> int:
 class RayCluster:
     """`ray start` a head and a second node; ``address`` is the head's; ``stop()`` ends them."""
 
-    def __init__(self, cpus_per_node: int = 1) -> None:
+    def __init__(self, cpus_per_node: int = 1, env: dict | None = None) -> None:
         self.cpus = cpus_per_node
         self.dirs = [
             tempfile.mkdtemp(prefix="rayh", dir="/tmp"),
@@ -68,6 +68,7 @@ class RayCluster:
         # `ray.init()` on this machine writes one) puts a head started by `ray start` in token
         # mode but not a second node, which then cannot join. Drivers connect either way.
         self.env = {**os.environ, "RAY_USAGE_STATS_ENABLED": "0", "RAY_AUTH_MODE": "disabled"}
+        self.env.update(env or {})  # Ray's settings (RAY_<name>) for every process it starts
         self.log = ""
 
     def _node_ports(self) -> list[str]:
@@ -160,12 +161,14 @@ class RayCluster:
                     pass
         return out
 
-    def processes(self) -> list[psutil.Process]:
-        """Every process this cluster started: those naming its temp dirs, and their children."""
+    def processes(self, ip: str | None = None) -> list[psutil.Process]:
+        """Every process this cluster started (or those of the node at `ip`): those naming its
+        temp dirs, and their children."""
+        dirs = self.dirs if ip is None else [self.dirs[0 if ip == HEAD_IP else 1]]
         roots = []
         for process in psutil.process_iter(["cmdline"]):
             cmdline = " ".join(process.info["cmdline"] or [])
-            if any(d in cmdline for d in self.dirs):
+            if any(d in cmdline for d in dirs):
                 roots.append(process)
         found = {p.pid: p for p in roots}
         for root in roots:
@@ -174,6 +177,17 @@ class RayCluster:
             except psutil.Error:
                 pass
         return list(found.values())
+
+    def kill_node(self, ip: str) -> list[int]:
+        """Loses the node at `ip` as a machine would: SIGKILLs its raylet, its workers and its
+        agents at once. Returns their PIDs."""
+        processes = self.processes(ip)
+        for process in processes:
+            try:
+                process.kill()
+            except psutil.Error:
+                pass
+        return [process.pid for process in processes]
 
     def stop(self) -> None:
         """Ends this cluster's processes (SIGTERM, then SIGKILL) and removes its temp dirs."""

@@ -8,6 +8,7 @@ from __future__ import annotations
 import json
 import os
 import random
+import re
 import shutil
 import signal
 import subprocess
@@ -21,15 +22,18 @@ import pytest
 from ambfplus.dataset import (
     GenerateError,
     SpecError,
+    StaleRunError,
     dataset_info,
     generate,
     load_spec,
     read_manifest,
     record_episode,
+    run_episode,
     sample_episode,
     validate_dataset,
     without_run_fields,
 )
+from ambfplus.dataset.sampling import HANDLE_COLOR, METAL_COLOR
 from ambfplus.recording import open_recording
 from ambfplus.scenes import anatomy_data
 
@@ -138,6 +142,25 @@ def test_ray_without_the_extra_says_what_to_install(monkeypatch, tmp_path):
     with pytest.raises(ImportError, match=r'pip install "ambfplus\[ray\]"'):
         generate(BASE_SPEC, tmp_path / "out", ray="auto", progress=False)
     assert not (tmp_path / "out").exists()
+
+
+def test_the_ray_tests_fail_rather_than_skip_under_ci_without_ray(tmp_path):
+    ray_tests = Path(__file__).with_name("test_dataset_ray.py")
+    without_ray = "import sys; sys.modules['ray'] = None; import pytest; sys.exit(pytest.main())"
+    command = [sys.executable, "-c", without_ray, str(ray_tests), "-q", "-p", "no:cacheprovider"]
+    results = {}
+    for ci in ("true", None):
+        env = {k: v for k, v in os.environ.items() if k != "CI"}
+        env.update({"CI": ci} if ci else {})
+        results[ci] = subprocess.run(
+            command, cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300
+        )
+    failed, skipped = results["true"], results[None]
+    # a collection error (pytest's 2) under CI; elsewhere the module is skipped (no test runs: 5)
+    assert failed.returncode == pytest.ExitCode.INTERRUPTED, failed.stdout + failed.stderr
+    assert 'pip install "ambfplus[ray]"' in failed.stdout, failed.stdout
+    assert skipped.returncode == pytest.ExitCode.NO_TESTS_COLLECTED, skipped.stdout
+    assert "1 skipped" in skipped.stdout, skipped.stdout
 
 
 def test_ray_gpu_ids_choose_the_engines_cuda_device():
@@ -334,6 +357,122 @@ def test_a_folder_holds_one_spec_and_one_generation_at_a_time(dataset_spec, tmp_
             generate(BASE_SPEC, out, progress=False)
 
 
+# A task of a run whose driver died, as Ray may leave one running: it checks the folder's run,
+# then waits (while the new run takes the folder over and cleans it) and records episode 1 as
+# the new run makes it too, then waits again until the new run has listed it.
+LATE_TASK = """
+import json, sys, time
+from pathlib import Path
+import ambfplus.dataset.episode as episode
+
+out, run, signals = Path(sys.argv[1]), sys.argv[2], Path(sys.argv[3])
+spec_data = json.loads(Path(sys.argv[4]).read_text())
+record = episode.record_episode
+
+def wait_for(name):
+    deadline = time.monotonic() + 300
+    while not (signals / name).exists():
+        assert time.monotonic() < deadline, name
+        time.sleep(0.02)
+
+def late_record(spec_data, index, path, plan=None):
+    print(path.parent.name, flush=True)
+    wait_for("resumed")
+    summary = record(spec_data, index, path, plan)
+    wait_for("listed")
+    return summary
+
+episode.record_episode = late_record
+try:
+    episode.run_episode(spec_data, out, 1, 0, worker="late", run=run)
+except episode.StaleRunError as error:
+    print("stale:", error, flush=True)
+    sys.exit(3)
+"""
+
+
+def test_a_dead_runs_late_task_cannot_touch_the_resumed_runs_shard(tmp_path, monkeypatch):
+    import ambfplus.dataset.driver as driver_module
+
+    spec = load_spec({**BASE_SPEC, "capture": {"every": 50, "frames": 3}})
+    out, signals = tmp_path / "data", tmp_path / "signals"
+    signals.mkdir()
+    generate(spec, out, progress=False)
+    dead_run = (out / ".run").read_text().strip()
+    # as if its driver had died before listing episode 1, whose task still runs somewhere
+    first = read_manifest(out)[0][0]
+    (out / "manifest.jsonl").write_text(json.dumps(first) + "\n")
+    spec_file = tmp_path / "spec.json"
+    spec_file.write_text(json.dumps(spec.data))
+    late = subprocess.Popen(
+        [sys.executable, "-c", LATE_TASK, str(out), dead_run, str(signals), str(spec_file)],
+        cwd="/",
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        late_partial = late.stdout.readline().strip()  # past its check of the folder's run
+        assert late_partial == f"episode_000001.{dead_run}.attempt0", late.stderr.read()
+        resume = driver_module._resume
+
+        def resume_then_signal(*args):
+            records = resume(*args)
+            (signals / "resumed").touch()
+            return records
+
+        class Writer(driver_module.ManifestWriter):
+            def append(self, record):  # the late task tries to move its shard in now
+                super().append(record)
+                before.append((head.stat().st_ino, head.read_bytes()))
+                (signals / "listed").touch()
+                late.wait(timeout=300)
+                left.append((out / ".partial" / late_partial).exists())
+
+        head, before, left = out / "shards" / "episode_000001.h5", [], []
+        monkeypatch.setattr(driver_module, "_resume", resume_then_signal)
+        monkeypatch.setattr(driver_module, "ManifestWriter", Writer)
+        report = generate(spec, out, progress=False)
+        stdout, stderr = late.communicate(timeout=300)
+    finally:
+        (signals / "listed").touch()
+        if late.poll() is None:
+            late.kill()
+    assert late.returncode == 3 and "is no longer this folder's current run" in stdout, stderr
+    assert (report.generated, report.skipped) == (1, 1)
+    runs = json.loads((out / "environment.json").read_text())["runs"]
+    assert runs[0]["run_id"] == dead_run and runs[1]["run_id"] not in (dead_run, "")
+    assert [(head.stat().st_ino, head.read_bytes())] == before  # not replaced
+    assert [r["episode"] for r in read_manifest(out)[0]] == [0, 1]
+    assert left == [False]  # the late task deleted its own partial shard
+    check = validate_dataset(out, match_images=False)
+    assert check.ok and not check.warnings, str(check)
+
+
+def test_an_attempt_keeps_a_complete_shard_and_a_stale_one_makes_nothing(tmp_path):
+    from ambfplus.dataset.episode import take_over
+
+    spec = load_spec(BASE_SPEC)
+    out = tmp_path / "data"
+    out.mkdir()
+    take_over(out, "run-a")
+    record = run_episode(spec.data, out, 0, 0, run="run-a")
+    head = out / record["file"]
+    inode = head.stat().st_ino
+    # a second attempt of the same run (its first was thought lost) keeps the shard in place
+    again = run_episode(spec.data, out, 0, 1, run="run-a")
+    assert without_run_fields(again) == without_run_fields(record)
+    assert head.stat().st_ino == inode
+    take_over(out, "run-b")
+    with pytest.raises(StaleRunError, match="run-a is no longer this folder's current run"):
+        run_episode(spec.data, out, 1, 0, run="run-a")
+    assert sorted(p.name for p in (out / "shards").iterdir()) == [
+        Path(record["file"]).name,
+        *(Path(p).name for p in record["parts"]),
+    ]
+    assert not any((out / ".partial").iterdir())
+
+
 def test_an_episode_that_keeps_failing_stops_the_run_with_its_error(tmp_path, monkeypatch):
     import ambfplus
     import ambfplus.dataset.driver as module
@@ -361,6 +500,44 @@ def test_an_episode_that_keeps_failing_stops_the_run_with_its_error(tmp_path, mo
     assert read_manifest(tmp_path / "out")[0] == []
 
 
+def test_the_progress_bar_reports_episodes_and_retries(tmp_path, monkeypatch):
+    import io
+
+    import ambfplus
+    import ambfplus.dataset.driver as module
+
+    stream = io.StringIO()
+    report = generate(BASE_SPEC, tmp_path / "fine", progress=stream)
+    final = _last_line(stream.getvalue())
+    assert report.generated == 2
+    assert final.startswith("generate: 100%") and "2/2" in final and "0 retries" in final, final
+    assert re.search(r"\d+\.\d pairs/s", final), final
+    # every attempt fails (the volume goes bad after the spec was checked): 2 retries, then
+    # the run stops
+    ear = tmp_path / "ear.nrrd"
+    ambfplus.phantom(24).save_nrrd(ear)
+    spec = {**BASE_SPEC, "anatomies": [{"file": str(ear)}]}
+    checked = module.check_anatomies
+
+    def check_then_spoil(data):
+        checked(data)
+        ear.write_text("NRRD0004\ntype: nonsense\n\n")
+
+    monkeypatch.setattr(module, "check_anatomies", check_then_spoil)
+    stream = io.StringIO()
+    with pytest.raises(GenerateError):
+        generate(spec, tmp_path / "failing", retries=1, progress=stream)
+    text = stream.getvalue()
+    assert "0/2" in _last_line(text) and "2 retries" in _last_line(text), text
+    for episode in (0, 1):
+        assert f"episode {episode}: retrying (attempt 2): " in text  # counted from 1
+
+
+def _last_line(text: str) -> str:
+    """What a terminal would show last of a tqdm bar's output."""
+    return [line for line in re.split(r"[\r\n]", text) if line.strip()][-1]
+
+
 # Randomisation -----------------------------------------------------------------------------
 
 
@@ -371,7 +548,16 @@ def test_randomisation_is_real_recorded_and_within_the_ranges(reference_dataset)
         label.id: label.color
         for label in anatomy_data({"phantom": {"resolution": 40, "seed": 0}}).label_table
     }
+    appearance = spec.data["appearance"]
+    light_low, light_high = appearance["lights"]["color"]["uniform"]
+    drill = appearance["drill"]
     seen = {"lights": set(), "intensity": [], "background": [], "fov": [], "cx": [], "sigma": []}
+    seen.update(light_color=[], metal=[], handle=[], label_colors={})
+    for key in appearance["material"]:
+        seen[f"material.{key}"] = []
+    for key in ("specular", "shininess"):
+        if key in drill:
+            seen[f"drill.{key}"] = []
     for record in read_manifest(reference_dataset)[0]:
         with open_recording(reference_dataset / record["file"]) as rec:
             sampled = rec.metadata["sampled"]
@@ -381,11 +567,34 @@ def test_randomisation_is_real_recorded_and_within_the_ranges(reference_dataset)
             seen["lights"].add(len(lights))
             for light in lights:
                 assert 0.3 <= light["intensity"] <= 1.0
-                assert all(0.8 <= c <= 1.0 for c in light["color"])
+                assert np.all(
+                    (light_low <= np.array(light["color"]))
+                    & (light["color"] <= np.array(light_high))
+                )
                 assert light["type"] in ("directional", "point", "spot")
                 seen["intensity"].append(light["intensity"])
-            for label_id, color in (sampled["label_colors"] or {}).items():
-                assert np.all(np.abs(np.subtract(color, table[int(label_id)])) <= 25)
+                seen["light_color"].append(light["color"])
+            jitter = appearance["labels"]["color_jitter"]
+            assert sampled["label_colors"]
+            for label_id, color in sampled["label_colors"].items():
+                assert np.all(np.abs(np.subtract(color, table[int(label_id)])) <= jitter)
+                seen["label_colors"].setdefault(label_id, set()).add(tuple(color))
+            # the anatomy's and the drill's materials
+            for key, value in appearance["material"].items():
+                low, high = value["uniform"]
+                assert low <= scene["volume_material"][key] <= high, key
+                seen[f"material.{key}"].append(scene["volume_material"][key])
+            for key in ("specular", "shininess"):
+                if key in drill:
+                    low, high = drill[key]["uniform"]
+                    assert low <= scene["drill_metal"][key] <= high, key
+                    seen[f"drill.{key}"].append(scene["drill_metal"][key])
+            for name, color, base in (
+                ("metal", scene["drill_metal"]["color"], METAL_COLOR),
+                ("handle", scene["drill_handle"]["color"], HANDLE_COLOR),
+            ):
+                assert np.all(np.abs(np.subtract(color, base)) <= drill["color_jitter"] + 1e-12)
+                seen[name].append(color)
             # the legend the shard carries has the jittered colours
             volume = next(e for e in rec.legend.values() if e["kind"] == "volume")
             assert {str(i): list(v["color"]) for i, v in volume["labels"].items()} == sampled[
@@ -417,9 +626,17 @@ def test_randomisation_is_real_recorded_and_within_the_ranges(reference_dataset)
             seen["fov"].append(fov)
             seen["cx"].append(offset[0])
     assert len(seen["lights"]) >= 2
-    for key in ("intensity", "fov", "cx", "sigma"):
+    scalars = ["intensity", "fov", "cx", "sigma"] + [k for k in seen if "." in k]
+    assert (
+        len(scalars) == 7
+    )  # the spec samples the anatomy's specular and shininess, the drill's specular
+    for key in scalars:
         assert np.std(seen[key]) > 0, key
-    assert np.std(np.array(seen["background"]), axis=0).min() > 0
+    for key in ("background", "light_color", "metal", "handle"):
+        assert np.std(np.array(seen[key]), axis=0).min() > 0, key  # every channel varies
+    # every label's colour differs between episodes
+    assert set(seen["label_colors"]) == {str(i) for i in table}
+    assert all(len(colors) > 1 for colors in seen["label_colors"].values()), seen["label_colors"]
 
 
 def test_other_looks_leave_the_ground_truth_exact(dataset_spec, tmp_path):

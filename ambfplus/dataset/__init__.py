@@ -16,7 +16,7 @@ spec's keys: see ``generate``, ``manifest`` and ``spec``.
 
 from .check import DatasetReport, dataset_info, format_info, is_dataset, validate_dataset
 from .driver import GenerateError, GenerateReport, check_anatomies, generate
-from .episode import EpisodeError, record_episode, run_episode, shard_name
+from .episode import EpisodeError, StaleRunError, record_episode, run_episode, shard_name
 from .manifest import RUN_FIELDS, read_manifest, without_run_fields
 from .sampling import EpisodePlan, episode_seed, sample_episode
 from .spec import SCHEMA_TEXT, SCHEMA_VERSION, DatasetSpec, SpecError, load_spec, parse_spec
@@ -45,6 +45,7 @@ __all__ = [
     "SCHEMA_VERSION",
     "shard_name",
     "SpecError",
+    "StaleRunError",
     "validate_dataset",
     "without_run_fields",
 ]

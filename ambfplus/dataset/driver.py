@@ -5,10 +5,13 @@
                            (executor, workers, renderers, start and end, retries)
     DIR/manifest.jsonl     one line per complete shard (ambfplus.dataset.manifest)
     DIR/shards/episode_000012.h5 (+ .part0001)   one recording per episode
+    DIR/.partial/, DIR/.run, DIR/.lock   shards being made, the current run's id, the lock
 
 Running it again resumes: shards listed in the manifest (whose files are there, of the listed
 size) are kept; anything else in ``shards/`` and everything under ``.partial/`` is deleted and
-its episodes are made again. One generation at a time writes a folder (a lock file says so).
+its episodes are made again. One generation at a time writes a folder (a lock file says so),
+and each run takes the folder over (``.run``) before it cleans it, so tasks a killed driver left
+running on a cluster cannot put anything into ``shards/`` afterwards (see ``episode``).
 """
 
 from __future__ import annotations
@@ -25,9 +28,10 @@ import time
 from dataclasses import dataclass, field
 from datetime import datetime, timezone
 from pathlib import Path
+from typing import TextIO
 
 from .. import __version__
-from .episode import PARTIAL, SHARDS
+from .episode import PARTIAL, RUN_FILE, SHARDS, new_run_id, take_over
 from .executor import Done, Executor, Failed, Retry
 from .manifest import MANIFEST, ManifestWriter, read_manifest, rewrite_manifest
 from .spec import DatasetSpec, SpecError, load_spec
@@ -66,13 +70,14 @@ def generate(
     ray: str | None = None,
     retries: int = 3,
     timeout: float | None = None,
-    progress: bool = True,
+    progress: bool | TextIO = True,
     ray_options: dict | None = None,
 ) -> GenerateReport:
     """Generates the dataset of `spec` (a path, a dict or a DatasetSpec) into folder `out`, with
     `workers` local processes or on the Ray cluster at `ray` ("auto", "local" or an address;
     needs ``ambfplus[ray]``). Each episode is tried at most `retries` + 1 times, and at most
-    `timeout` seconds each. Call it under ``if __name__ == "__main__":`` (local workers import
+    `timeout` seconds each. `progress`: a live bar on stderr (True), on a text stream, or
+    none (False). Call it under ``if __name__ == "__main__":`` (local workers import
     the main module again)."""
     spec = spec if isinstance(spec, DatasetSpec) else load_spec(spec)
     check_anatomies(spec)
@@ -111,14 +116,16 @@ def check_anatomies(spec: DatasetSpec) -> None:
             ) from None
 
 
-def _generate(spec: DatasetSpec, out: Path, executor: Executor, progress: bool) -> GenerateReport:
+def _generate(spec: DatasetSpec, out: Path, executor: Executor, progress) -> GenerateReport:
     out.mkdir(parents=True, exist_ok=True)
     with _FolderLock(out):
         environment = _prepare(out, spec)
-        records = _resume(out, spec)
+        run_id = new_run_id()
+        records = _resume(out, spec, run_id)
         todo = [i for i in range(spec.episodes) if i not in records]
         run = {
             **executor.describe(),
+            "run_id": run_id,
             "host": socket.gethostname(),
             "pid": os.getpid(),
             "started": _now(),
@@ -134,7 +141,7 @@ def _generate(spec: DatasetSpec, out: Path, executor: Executor, progress: bool) 
         writer = ManifestWriter(out)
         made = frames = retries = 0
         renderers: set[str] = set()
-        events = executor.run(spec.data, out, todo)
+        events = executor.run(spec.data, out, todo, run_id)
         try:
             for event in events:
                 if isinstance(event, Done):
@@ -155,7 +162,8 @@ def _generate(spec: DatasetSpec, out: Path, executor: Executor, progress: bool) 
                         f"last time: {event.reason.strip()}"
                     )
             run["status"] = "complete"
-            shutil.rmtree(out / PARTIAL, ignore_errors=True)  # every worker has stopped
+            # this run's workers are done, and earlier runs' tasks cannot move their shards
+            shutil.rmtree(out / PARTIAL, ignore_errors=True)
         except BaseException as error:
             run["status"] = "interrupted" if isinstance(error, KeyboardInterrupt) else "failed"
             raise
@@ -200,7 +208,7 @@ def _prepare(out: Path, spec: DatasetSpec) -> dict:
                 "another folder, or delete it first"
             )
         return environment
-    ours = {SPEC_FILE, ENVIRONMENT, MANIFEST, SHARDS, PARTIAL, LOCK, MANIFEST + ".tmp"}
+    ours = {SPEC_FILE, ENVIRONMENT, MANIFEST, SHARDS, PARTIAL, LOCK, RUN_FILE, MANIFEST + ".tmp"}
     strangers = sorted(p.name for p in out.iterdir() if p.name not in ours)
     if strangers:
         raise GenerateError(
@@ -224,9 +232,10 @@ def _prepare(out: Path, spec: DatasetSpec) -> dict:
     return environment
 
 
-def _resume(out: Path, spec: DatasetSpec) -> dict[int, dict]:
-    """The complete shards of an earlier run, by episode; deletes everything else (partial
-    shards, shards a killed driver did not list) and rewrites the manifest clean."""
+def _resume(out: Path, spec: DatasetSpec, run_id: str) -> dict[int, dict]:
+    """The complete shards of an earlier run, by episode; makes `run_id` the folder's run, then
+    deletes everything else (partial shards, shards a killed driver did not list) and rewrites
+    the manifest clean."""
     records: dict[int, dict] = {}
     for record in read_manifest(out)[0]:
         index = record["episode"]
@@ -238,6 +247,7 @@ def _resume(out: Path, spec: DatasetSpec) -> dict[int, dict]:
             and sum(f.stat().st_size for f in files) == record["bytes"]
         ):
             records[index] = record
+    take_over(out, run_id)  # before cleaning: an earlier run's late task could move a shard in
     shutil.rmtree(out / PARTIAL, ignore_errors=True)
     kept = {Path(r["file"]).name for r in records.values()}
     kept |= {Path(p).name for r in records.values() for p in r["parts"]}
@@ -300,17 +310,20 @@ class _FolderLock:
 
 
 class _Progress:
-    """A live bar (tqdm): episodes, stereo pairs per second, ETA, retries."""
+    """A live bar (tqdm): episodes, stereo pairs per second, ETA, retries; on stderr (`output`
+    True), on a text stream, or nowhere (False)."""
 
-    def __init__(self, total: int, initial: int, enabled: bool) -> None:
+    def __init__(self, total: int, initial: int, output) -> None:
         self.bar = None
         self.frames = self.retries = 0
         self.started = time.perf_counter()
-        if enabled:
+        if output is not False and output is not None:
             from tqdm import tqdm
 
+            self.file = sys.stderr if output is True else output
             self.bar = tqdm(
                 total=total,
+                file=self.file,
                 initial=initial,
                 unit="episode",
                 dynamic_ncols=True,
@@ -328,9 +341,10 @@ class _Progress:
     def retry(self, event: Retry) -> None:
         self.retries += 1
         if self.bar is not None:
-            self.bar.write(
+            self.bar.write(  # beside the bar (tqdm's default is stdout)
                 f"episode {event.episode}: retrying (attempt {event.attempt + 1}): "
-                f"{event.reason.strip().splitlines()[-1]}"
+                f"{event.reason.strip().splitlines()[-1]}",
+                file=self.file,
             )
             self._postfix()
 

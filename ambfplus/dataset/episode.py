@@ -1,13 +1,25 @@
 """Running one episode: its scene built from its plan, filmed and recorded into a shard, the
 shard checked and moved into the dataset. Runs in a worker (a local worker process or a Ray
 worker), which creates its EGL context on its first render and keeps it for its next
-episodes."""
+episodes.
+
+Each run of ``generate`` has an id, and the folder's ``.run`` file names the current one. A
+worker records under a folder of its own (``.partial/episode_000012.<run>.attempt0``) and moves
+the shard into ``shards/`` only while holding a lock on ``.run`` that names its run, and only
+when no complete shard of its episode is there. A new run takes ``.run`` over (under the same
+lock) before it cleans the folder, so that a task its killed predecessor left running on a
+cluster can neither touch the new run's partial shards nor replace or delete a shard in
+``shards/``; only the driver writes the manifest.
+"""
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
+import fcntl
 import hashlib
 import os
+import secrets
 import shutil
 import socket
 import time
@@ -27,6 +39,8 @@ from .spec import SCHEMA_VERSION, spec_hash
 
 SHARDS = "shards"
 PARTIAL = ".partial"
+# The current run's id; its lock serialises moves into shards/ against a run taking over.
+RUN_FILE = ".run"
 # Shards are reproducible files: their recording id comes from the spec and the episode, and
 # their creation time is the epoch (as SOURCE_DATE_EPOCH=0 builds); the manifest says when each
 # was made.
@@ -38,6 +52,49 @@ _FRAME_FIELDS = ("camera", "time", "step", "intrinsics", "pose")
 
 class EpisodeError(RuntimeError):
     """An episode whose shard could not be made (the message says which and why)."""
+
+
+class StaleRunError(EpisodeError):
+    """An attempt of a run that is no longer its folder's current run (its driver died and a
+    later run took the folder over): it made nothing and left shards/ alone."""
+
+
+def new_run_id() -> str:
+    """A run's id, unique per run: the driver's pid and random bits."""
+    return f"{os.getpid()}-{secrets.token_hex(4)}"
+
+
+@contextlib.contextmanager
+def _locked_run_file(out: Path, operation: int):
+    """The folder's run file, open and locked (flock: released however its holder ends)."""
+    fd = os.open(out / RUN_FILE, os.O_RDWR | os.O_CREAT, 0o644)
+    try:
+        fcntl.flock(fd, operation)
+        yield fd
+    finally:
+        os.close(fd)
+
+
+def _run_of(fd: int) -> str:
+    return os.pread(fd, 256, 0).decode(errors="replace").strip()
+
+
+def take_over(out, run: str) -> None:
+    """Makes `run` the current run of dataset folder `out`: from then on, attempts of earlier
+    runs cannot move a shard into shards/ (waits for one that is doing so)."""
+    with _locked_run_file(Path(out), fcntl.LOCK_EX) as fd:
+        os.ftruncate(fd, 0)
+        os.pwrite(fd, f"{run}\n".encode(), 0)
+        os.fsync(fd)
+
+
+def _check_run(fd: int, out: Path, run: str | None, index: int) -> None:
+    current = _run_of(fd)
+    if run is not None and current != run:
+        raise StaleRunError(
+            f"{out}: episode {index}: run {run} is no longer this folder's current run "
+            f"({current or 'none'}); its attempt made nothing"
+        )
 
 
 def shard_name(index: int) -> str:
@@ -173,37 +230,52 @@ def _replace_rgb(frame, rgb: np.ndarray) -> dict:
     return out
 
 
-def partial_folder(out, index: int, attempt: int) -> Path:
-    """Where attempt `attempt` at episode `index` records its shard before it is complete (the
-    executor deletes it when the attempt fails)."""
-    return Path(out) / PARTIAL / f"{shard_name(index)[:-3]}.attempt{attempt}"
+def partial_folder(out, index: int, attempt: int, run: str | None = None) -> Path:
+    """Where attempt `attempt` of run `run` at episode `index` records its shard before it is
+    complete (the executor deletes it when the attempt fails). No two runs share one."""
+    stem = shard_name(index)[:-3] + (f".{run}" if run else "")
+    return Path(out) / PARTIAL / f"{stem}.attempt{attempt}"
 
 
-def run_episode(spec_data: dict, out, index: int, attempt: int = 0, worker: str = "") -> dict:
+def run_episode(
+    spec_data: dict,
+    out,
+    index: int,
+    attempt: int = 0,
+    worker: str = "",
+    run: str | None = None,
+) -> dict:
     """Makes episode `index`'s shard in dataset folder `out`: recorded under ``.partial/``,
-    validated, then moved into ``shards/`` (its parts first, its head last). Returns the
-    episode's manifest record."""
+    validated, then moved into ``shards/`` (its parts first, its head last), as attempt
+    `attempt` of run `run` (None: whatever run the folder has). Returns the episode's manifest
+    record. Raises StaleRunError, leaving nothing behind and shards/ untouched, once another run
+    has taken the folder over."""
     from ..recording import validate
 
     started, cpu_started = time.perf_counter(), time.process_time()
     out = Path(out)
     name = shard_name(index)
-    partial = partial_folder(out, index, attempt)
+    out.mkdir(parents=True, exist_ok=True)
+    with _locked_run_file(out, fcntl.LOCK_SH) as fd:
+        _check_run(fd, out, run, index)  # a dead run's queued task renders nothing
+    partial = partial_folder(out, index, attempt, run)
     shutil.rmtree(partial, ignore_errors=True)
     partial.mkdir(parents=True)
-    head = partial / name
-    summary = record_episode(spec_data, index, head)
-    report = validate(head, match_images=False)
-    if not report.ok:
-        failed = "; ".join(f"{c.name}: {c.detail}" for c in report.failed)
-        raise EpisodeError(f"episode {index}: its shard does not validate: {failed}")
-    files = [head] + [p for _, p in find_parts(head)]
-    digest, size = shard_checksum(files)
-    shards = out / SHARDS
-    shards.mkdir(exist_ok=True)
-    for file in files[1:] + files[:1]:  # the head last: it names a complete shard
-        os.replace(file, shards / file.name)
-    partial.rmdir()
+    try:
+        head = partial / name
+        summary = record_episode(spec_data, index, head)
+        report = validate(head, match_images=False)
+        if not report.ok:
+            failed = "; ".join(f"{c.name}: {c.detail}" for c in report.failed)
+            raise EpisodeError(f"episode {index}: its shard does not validate: {failed}")
+        files = [head] + [p for _, p in find_parts(head)]
+        digest, size = shard_checksum(files)
+        kept = _move_into_shards(out, files, run, index)
+        if kept is not None:  # an earlier attempt of this run finished it: that shard stays
+            files = kept
+            digest, size = shard_checksum(files)
+    finally:
+        shutil.rmtree(partial, ignore_errors=True)
     return {
         "episode": index,
         "seed": summary["seed"],
@@ -222,3 +294,20 @@ def run_episode(spec_data: dict, out, index: int, attempt: int = 0, worker: str 
         "worker": worker or f"{socket.gethostname()}:{os.getpid()}",
         "attempt": attempt,
     }
+
+
+def _move_into_shards(out: Path, files: list[Path], run: str | None, index: int):
+    """Moves a checked shard (head, then parts) into shards/, parts first and the head last (the
+    head names a complete shard), each by an atomic rename, while holding the run file's lock
+    and only if `run` is still the folder's run. Never replaces a complete shard: when the head
+    is there already, moves nothing and returns that shard's files (None when it moved)."""
+    shards = out / SHARDS
+    with _locked_run_file(out, fcntl.LOCK_EX) as fd:
+        _check_run(fd, out, run, index)
+        head = shards / files[0].name
+        if head.is_file():
+            return [head] + [p for _, p in find_parts(head)]
+        shards.mkdir(exist_ok=True)
+        for file in files[1:] + files[:1]:
+            os.replace(file, shards / file.name)
+    return None

@@ -53,11 +53,11 @@ class Executor:
         self.timeout = timeout
 
     @staticmethod
-    def discard(out, index: int, attempt: int) -> None:
+    def discard(out, run_id: str | None, index: int, attempt: int) -> None:
         """Deletes what a failed attempt left under .partial/ (its worker is gone)."""
         from .episode import partial_folder
 
-        shutil.rmtree(partial_folder(out, index, attempt), ignore_errors=True)
+        shutil.rmtree(partial_folder(out, index, attempt, run_id), ignore_errors=True)
 
     def connect(self) -> None:
         """Reaches the workers' side before anything is written (nothing to do locally)."""
@@ -66,8 +66,9 @@ class Executor:
         """What environment.json records of this executor."""
         return {"executor": self.name}
 
-    def run(self, spec_data: dict, out, todo: list[int]) -> Iterator:
-        """Runs the episodes of `todo` into dataset folder `out`, yielding events."""
+    def run(self, spec_data: dict, out, todo: list[int], run_id: str | None = None) -> Iterator:
+        """Runs the episodes of `todo` into dataset folder `out` as run `run_id` (see
+        ``episode.run_episode``), yielding events."""
         raise NotImplementedError
 
     def close(self) -> None:

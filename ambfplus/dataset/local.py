@@ -69,7 +69,9 @@ def _die_with_driver() -> None:
     threading.Thread(target=watch, name="driver-watch", daemon=True).start()
 
 
-def _worker_main(connection, spec_data: dict, out: str, name: str, environ: dict) -> None:
+def _worker_main(
+    connection, spec_data: dict, out: str, run_id: str | None, name: str, environ: dict
+) -> None:
     """A worker's loop: receive (episode, attempt), make the shard, send back its record."""
     _die_with_driver()
     os.environ.clear()  # the driver's environment now, not the fork server's
@@ -86,7 +88,7 @@ def _worker_main(connection, spec_data: dict, out: str, name: str, environ: dict
             return
         index, attempt = task
         try:
-            record = run_episode(spec_data, out, index, attempt, worker=name)
+            record = run_episode(spec_data, out, index, attempt, worker=name, run=run_id)
             connection.send(("done", index, attempt, record))
         except Exception:
             connection.send(("failed", index, attempt, traceback.format_exc()))
@@ -119,6 +121,7 @@ class LocalExecutor(Executor):
         self._context = _worker_context()
         self._started = 0
         self._start_failures = 0  # workers in a row that died before they were ready
+        self._out, self._run_id = None, None
 
     def describe(self) -> dict:
         return {"executor": self.name, "workers": self.workers}
@@ -129,7 +132,7 @@ class LocalExecutor(Executor):
         number = self._started
         process = self._context.Process(
             target=_worker_main,
-            args=(theirs, spec_data, out, f"local-{number}", dict(os.environ)),
+            args=(theirs, spec_data, out, self._run_id, f"local-{number}", dict(os.environ)),
             name=f"ambfplus-generate-{number}",
             daemon=True,
         )
@@ -137,9 +140,9 @@ class LocalExecutor(Executor):
         theirs.close()
         return _Slot(number, process, ours)
 
-    def run(self, spec_data: dict, out, todo: list[int]) -> Iterator:
+    def run(self, spec_data: dict, out, todo: list[int], run_id: str | None = None) -> Iterator:
         queue = deque((index, 0) for index in todo)
-        self._out = out
+        self._out, self._run_id = out, run_id
         slots: list[_Slot] = []
         try:
             slots = [self._start(spec_data, str(out)) for _ in range(min(self.workers, len(queue)))]
@@ -177,7 +180,7 @@ class LocalExecutor(Executor):
             yield from self._failed(index, attempt, payload, queue)
 
     def _failed(self, index: int, attempt: int, reason: str, queue: deque) -> Iterator:
-        self.discard(self._out, index, attempt)
+        self.discard(self._out, self._run_id, index, attempt)
         if attempt >= self.retries:
             yield Failed(index, attempt + 1, reason)
             return

@@ -33,7 +33,9 @@ def require_ray():
     return ray
 
 
-def ambfplus_episode(spec_data: dict, out: str, index: int, attempt: int) -> dict:
+def ambfplus_episode(
+    spec_data: dict, out: str, index: int, attempt: int, run_id: str | None = None
+) -> dict:
     """A Ray task: makes one episode's shard (see ``ambfplus.dataset.episode.run_episode``)."""
     import ray
 
@@ -41,7 +43,8 @@ def ambfplus_episode(spec_data: dict, out: str, index: int, attempt: int) -> dic
     from .episode import run_episode
 
     node = ray.get_runtime_context().get_node_id()[:8]
-    return run_episode(spec_data, out, index, attempt, worker=f"ray-{node}:{os.getpid()}")
+    worker = f"ray-{node}:{os.getpid()}"
+    return run_episode(spec_data, out, index, attempt, worker=worker, run=run_id)
 
 
 def select_gpu(gpu_ids, environ) -> str | None:
@@ -136,7 +139,7 @@ class RayExecutor(Executor):
             "task_gpus": self.gpus,
         }
 
-    def run(self, spec_data: dict, out, todo: list[int]) -> Iterator:
+    def run(self, spec_data: dict, out, todo: list[int], run_id: str | None = None) -> Iterator:
         ray = self._ray
         # A worker runs any number of these tasks in one process (one EGL context for all its
         # episodes) however the GPUs are asked for: Ray's default for a function declared with
@@ -154,7 +157,7 @@ class RayExecutor(Executor):
         while queue or running:
             while queue and len(running) < window:
                 index, attempt = queue.popleft()
-                ref = task.remote(spec_ref, str(out), index, attempt)
+                ref = task.remote(spec_ref, str(out), index, attempt, run_id)
                 running[ref] = (index, attempt, time.monotonic())
             ready, _ = ray.wait(list(running), num_returns=1, timeout=1.0)
             for ref in ready:
@@ -169,7 +172,7 @@ class RayExecutor(Executor):
                 if ref in cancelled:
                     reason = f"took more than {self.timeout} s and was cancelled"
                     cancelled.discard(ref)
-                self.discard(out, index, attempt)
+                self.discard(out, run_id, index, attempt)
                 if attempt >= self.retries:
                     yield Failed(index, attempt + 1, reason)
                     return

@@ -264,6 +264,36 @@ def test_slice_stack_bad_options_are_argument_errors(tmp_path, option, value):
     assert str(folder) in str(info.value)
 
 
+BAD_SIZES = [(0.0, 0.01, 0.01), (0.01, float("nan"), 0.01), (0.01, 0.01, -0.01),
+             (0.01, 0.01, float("inf"))]  # fmt: skip
+
+
+@pytest.mark.parametrize("argument", ["dimensions", "voxel_size"])
+@pytest.mark.parametrize("sizes", BAD_SIZES)
+def test_slice_stack_bad_sizes_name_the_argument_and_folder(tmp_path, argument, sizes):
+    folder = stack(tmp_path)
+    with pytest.raises(ambfplus.ArgumentError) as info:
+        ambfplus.load_slice_stack(folder, **{argument: sizes})
+    message = str(info.value)
+    assert f"{argument} must be three positive finite metres" in message, message
+    assert str(folder) in message, message
+
+
+@pytest.mark.parametrize("argument", ["dimensions", "voxel_size"])
+@pytest.mark.parametrize("sizes", BAD_SIZES)
+def test_volume_data_bad_sizes_name_the_argument(argument, sizes):
+    with pytest.raises(ambfplus.ArgumentError) as info:
+        ambfplus.VolumeData(LABELS.copy(), **{argument: sizes})
+    assert f"VolumeData: {argument} must be three positive finite metres" in str(info.value)
+
+
+@pytest.mark.parametrize("sizes", BAD_SIZES)
+def test_volume_data_dimensions_setter_refuses_bad_sizes(volume, sizes):
+    with pytest.raises(ambfplus.ArgumentError, match=r"VolumeData\.dimensions must be three"):
+        volume.dimensions = sizes
+    assert np.allclose(volume.dimensions, (0.008, 0.008, 0.008))
+
+
 def test_slice_stack_corrupt_image_names_the_file(tmp_path):
     folder = stack(tmp_path)
     (folder / "plane002.png").write_bytes(b"\x89PNG\r\n\x1a\n" + bytes(40))

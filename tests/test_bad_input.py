@@ -559,12 +559,25 @@ def test_ascii_stl_with_a_nan_vertex_is_an_error(tmp_path):
     expect_mesh_error(path, "vertex 2 of mesh 0", "expected finite coordinates")
 
 
-def test_good_obj_and_stl_files_still_load(tmp_path):
+OFF_TRIANGLE = "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"
+
+
+@pytest.mark.parametrize("counts", ["3 44444444444444444444 0", "4000000000 1 0", "3 9 0"])
+def test_off_counts_beyond_its_lines_are_an_error_not_gigabytes(tmp_path, counts):
+    # A fuzzer's finding: Debian's assimp allocated 3 GB for the faces a 100-byte file promised.
+    path = tmp_path / "huge.off"
+    path.write_text(f"OFF\n# a comment\n{counts}\n" + OFF_TRIANGLE)
+    expect_mesh_error(path, "OFF header (line 3) promises", "but only 5 lines follow it")
+
+
+def test_good_obj_stl_and_off_files_still_load(tmp_path):
     obj = tmp_path / "good.obj"
     obj.write_text(OBJ_TRIANGLE + "f 1 2 3\n")
     stl = tmp_path / "good.stl"
     stl.write_bytes(binary_stl(TWO_TRIANGLES, b"binary"))
-    for path in (obj, stl):
+    off = tmp_path / "good.off"
+    off.write_text("OFF\n3 1 0\n" + OFF_TRIANGLE)
+    for path in (obj, stl, off):
         code, output = load_mesh_in_a_process(path)
         assert code == 0 and "loaded" in output, output
 

@@ -16,6 +16,7 @@
 
 #include "ambfplus/errors.h"
 #include "ambfplus/io/mesh.h"
+#include "io/off_check.h"
 #include "io/ply_check.h"
 #include "io/stl_check.h"
 
@@ -49,11 +50,11 @@ std::string read_bytes(const std::string& path) {
   return s.str();
 }
 
-bool has_stl_extension(const std::string& path) {
+bool has_extension(const std::string& path, const char* wanted) {
   std::string ext = std::filesystem::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char c) { return std::tolower(c); });
-  return ext == ".stl";
+  return ext == wanted;
 }
 
 bool starts_with_ply(const std::string& path) {
@@ -161,7 +162,9 @@ MeshData load_mesh(const std::string& path, double scale) {
   // checks run, so PLY structure is checked here first.
   if (starts_with_ply(path)) io::check_ply(path, read_bytes(path));
   // assimp says only that it cannot tell which kind a cut binary STL is.
-  if (has_stl_extension(path)) io::check_stl(path, read_bytes(path));
+  if (has_extension(path, ".stl")) io::check_stl(path, read_bytes(path));
+  // assimp allocates what an OFF header's counts ask for before reading a row.
+  if (has_extension(path, ".off")) io::check_off(path, read_bytes(path));
   Assimp::Importer importer;
   // Points and lines carry no surface; drop them so a file of only those reads as empty.
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,

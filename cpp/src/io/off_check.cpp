@@ -1,57 +1,66 @@
-// The count check of an OFF file (a keyword such as OFF or COFF, then the vertex, face and edge
-// counts, then one vertex or face a line; '#' starts a comment), done before assimp reads it.
+// The count check of an OFF file (a keyword such as OFF, COFF or STOFF, then the vertex, face and
+// edge counts, then one vertex or face a line; '#' starts a comment), done before assimp reads it.
 
 #include "io/off_check.h"
 
 #include <algorithm>
-#include <cerrno>
-#include <cstdlib>
-#include <sstream>
-#include <vector>
+#include <cctype>
+#include <string>
 
 #include "ambfplus/errors.h"
 
 namespace ambfplus::io {
 
-void check_off(const std::string& path, const std::string& bytes) {
-  // The first three tokens (keyword, vertices, faces), comments skipped, and the line they end on.
-  std::vector<std::string> tokens;
-  std::size_t line_start = 0;
-  std::size_t header_lines = 0;
-  while (tokens.size() < 3 && line_start < bytes.size()) {
-    std::size_t end = bytes.find('\n', line_start);
-    if (end == std::string::npos) end = bytes.size();
-    std::string line = bytes.substr(line_start, end - line_start);
-    line = line.substr(0, line.find('#'));
-    std::istringstream words(line);
-    for (std::string word; tokens.size() < 3 && words >> word;) tokens.push_back(word);
-    ++header_lines;
-    line_start = end + 1;
-  }
-  if (tokens.size() < 3) return;
-  const std::string& keyword = tokens[0];
-  if (keyword.size() < 3 || keyword.compare(keyword.size() - 3, 3, "OFF") != 0) return;
-  unsigned long long counts[2] = {0, 0};
-  for (int c = 0; c < 2; ++c) {
-    const std::string& t = tokens[1 + c];
-    if (t.empty() ||
-        !std::all_of(t.begin(), t.end(), [](char ch) { return ch >= '0' && ch <= '9'; })) {
-      return;
+namespace {
+
+// Where the counts begin: after the keyword when the first line that is not a comment holds
+// one ("OFF4 2 0" counts 4 vertices, as assimp reads it), else at that line.
+std::size_t counts_start(const std::string& bytes) {
+  std::size_t at = 0;
+  while (at < bytes.size()) {
+    const std::size_t text = bytes.find_first_not_of(" \t\r\n", at);
+    if (text == std::string::npos) return bytes.size();
+    if (bytes[text] != '#') {
+      const std::size_t end = std::min(bytes.find('\n', text), bytes.size());
+      const std::size_t keyword = bytes.substr(text, end - text).find("OFF");
+      return keyword == std::string::npos ? text : text + keyword + 3;
     }
-    errno = 0;
-    counts[c] = std::strtoull(t.c_str(), nullptr, 10);
-    if (errno == ERANGE) counts[c] = ~0ull;
+    at = std::min(bytes.find('\n', text), bytes.size());
   }
-  const std::size_t lines =
-      static_cast<std::size_t>(std::count(
-          bytes.begin() + static_cast<std::ptrdiff_t>(std::min(line_start, bytes.size())),
-          bytes.end(), '\n')) +
-      1;
-  if (counts[0] > lines || counts[1] > lines || counts[0] + counts[1] > lines) {
-    throw ConfigError(path, "OFF header (line " + std::to_string(header_lines) + ") promises " +
-                                tokens[1] + " vertices and " + tokens[2] +
-                                " faces, one a line, but only " + std::to_string(lines) +
-                                " lines follow it");
+  return bytes.size();
+}
+
+}  // namespace
+
+void check_off(const std::string& path, const std::string& bytes) {
+  // The counts are the first two runs of digits after the keyword, comments skipped; a run is
+  // read as assimp reads it, its leading digits ("444z" is 444).
+  unsigned long long counts[2] = {0, 0};
+  int found = 0;
+  std::size_t i = counts_start(bytes);
+  while (found < 2 && i < bytes.size()) {
+    const char c = bytes[i];
+    if (c == '#') {
+      i = std::min(bytes.find('\n', i), bytes.size());
+    } else if (std::isdigit(static_cast<unsigned char>(c))) {
+      unsigned long long value = 0;
+      for (; i < bytes.size() && std::isdigit(static_cast<unsigned char>(bytes[i])); ++i) {
+        value = std::min<unsigned long long>(value * 10 + (bytes[i] - '0'), 1ull << 40);
+      }
+      counts[found++] = value;
+    } else {
+      ++i;
+    }
+  }
+  if (found < 2) return;  // assimp says what is missing
+  // Lines from the rest of the counts' line on (a last line without its newline counts too).
+  const auto lines = static_cast<unsigned long long>(std::count(
+                         bytes.begin() + static_cast<std::ptrdiff_t>(i), bytes.end(), '\n')) +
+                     (bytes.back() != '\n' ? 1 : 0);
+  if (counts[0] + counts[1] > lines) {
+    throw ConfigError(path, "OFF header promises " + std::to_string(counts[0]) + " vertices and " +
+                                std::to_string(counts[1]) + " faces, one a line, but only " +
+                                std::to_string(lines) + " lines follow the counts");
   }
 }
 

@@ -432,7 +432,7 @@ void define_drill(py::module_& m) {
                              })
       .def_property(
           "goal", [](Drill& d) { return Mat4(d.goal().matrix()); },
-          [](Drill& d, const Mat4& m) { d.set_goal(checked_pose(m)); },
+          [](Drill& d, const Mat4& m) { d.set_goal(checked_pose(m, d.describe() + " goal")); },
           "world from drill where the device puts it (burr centre at the origin, shaft along +x)")
       .def_property("on", &Drill::on, &Drill::set_on)
       .def_property("speed", &Drill::speed, &Drill::set_speed, "burr speed, 0..1")
@@ -472,7 +472,8 @@ void define_drill(py::module_& m) {
       .def(
           "attach",
           [](Drill& d, RigidBody& body, std::optional<Mat4> offset) {
-            d.attach(body, offset ? checked_pose(*offset) : Eigen::Isometry3d::Identity());
+            d.attach(body, offset ? checked_pose(*offset, d.describe() + " attach offset")
+                                  : Eigen::Isometry3d::Identity());
           },
           py::arg("body"), py::arg("offset") = py::none(), "move body with the drill")
       .def_property_readonly(

@@ -816,7 +816,7 @@ void define_object(py::class_<Object, std::shared_ptr<Object>>& object) {
       .def_property_readonly("model", [](Object& o) { return handle(&o.model(), o.world()); })
       .def_property(
           "pose", [](Object& o) { return Mat4(o.pose().matrix()); },
-          [](Object& o, const Mat4& m) { o.set_pose(checked_pose(m)); },
+          [](Object& o, const Mat4& m) { o.set_pose(checked_pose(m, o.describe())); },
           "4x4 world-from-object rigid transform (a copy; assign to change it)")
       .def_property("namespace", &Object::name_space, &Object::set_name_space,
                     "AMBF namespace, e.g. '/ambf/env/'")
@@ -829,7 +829,7 @@ void define_object(py::class_<Object, std::shared_ptr<Object>>& object) {
           "attach_to",
           [](Object& o, std::shared_ptr<Object> parent, std::optional<Mat4> local) {
             Eigen::Isometry3d l = parent ? parent->pose().inverse() * o.pose() : o.pose();
-            if (local) l = checked_pose(*local);
+            if (local) l = checked_pose(*local, o.describe() + " local");
             o.attach_to(parent.get(), l);
           },
           py::arg("parent"), py::arg("local") = py::none(),

@@ -84,8 +84,10 @@ std::shared_ptr<VolumeData> from_array(py::array labels, std::optional<Vec3> dim
   Vec3 dims;
   if (dimensions && voxel_size) throw ArgumentError("give dimensions or voxel_size, not both");
   if (dimensions) {
+    check_volume_sizes(*dimensions, "VolumeData: dimensions");
     dims = *dimensions;
   } else if (voxel_size) {
+    check_volume_sizes(*voxel_size, "VolumeData: voxel_size");
     dims = voxel_size->cwiseProduct(Vec3(shape[0], shape[1], shape[2]));
   } else {
     throw ArgumentError("give the volume's size: dimensions=(x, y, z) metres or voxel_size=");
@@ -218,7 +220,11 @@ void define_volume(py::module_& m) {
                              })
       .def_property(
           "dimensions", [](const VolumeData& v) { return Vec3(v.dimensions()); },
-          &VolumeData::set_dimensions, "full extents along x, y, z, metres")
+          [](VolumeData& v, const Vec3& d) {
+            check_volume_sizes(d, "VolumeData.dimensions");
+            v.set_dimensions(d);
+          },
+          "full extents along x, y, z, metres")
       .def_property_readonly("voxel_size", &VolumeData::voxel_size)
       .def_property_readonly("label_type",
                              [](const VolumeData& v) {
@@ -357,8 +363,13 @@ void define_volume(py::module_& m) {
         if (!dimensions && !voxel_size) {
           throw ArgumentError("give the stack's size: dimensions=(x, y, z) metres or voxel_size=");
         }
+        // Checked before the slices are read, naming the argument.
+        const std::string call = "load_slice_stack(" + folder.string() + "): ";
+        if (dimensions) check_volume_sizes(*dimensions, call + "dimensions");
+        if (voxel_size) check_volume_sizes(*voxel_size, call + "voxel_size");
         SliceStackSpec spec;
         spec.folder = folder.string();
+        if (dimensions) spec.dimensions = *dimensions;
         spec.prefix = prefix;
         spec.format = format;
         spec.count = count;

@@ -264,6 +264,36 @@ def test_slice_stack_bad_options_are_argument_errors(tmp_path, option, value):
     assert str(folder) in str(info.value)
 
 
+BAD_SIZES = [(0.0, 0.01, 0.01), (0.01, float("nan"), 0.01), (0.01, 0.01, -0.01),
+             (0.01, 0.01, float("inf"))]  # fmt: skip
+
+
+@pytest.mark.parametrize("argument", ["dimensions", "voxel_size"])
+@pytest.mark.parametrize("sizes", BAD_SIZES)
+def test_slice_stack_bad_sizes_name_the_argument_and_folder(tmp_path, argument, sizes):
+    folder = stack(tmp_path)
+    with pytest.raises(ambfplus.ArgumentError) as info:
+        ambfplus.load_slice_stack(folder, **{argument: sizes})
+    message = str(info.value)
+    assert f"{argument} must be three positive finite metres" in message, message
+    assert str(folder) in message, message
+
+
+@pytest.mark.parametrize("argument", ["dimensions", "voxel_size"])
+@pytest.mark.parametrize("sizes", BAD_SIZES)
+def test_volume_data_bad_sizes_name_the_argument(argument, sizes):
+    with pytest.raises(ambfplus.ArgumentError) as info:
+        ambfplus.VolumeData(LABELS.copy(), **{argument: sizes})
+    assert f"VolumeData: {argument} must be three positive finite metres" in str(info.value)
+
+
+@pytest.mark.parametrize("sizes", BAD_SIZES)
+def test_volume_data_dimensions_setter_refuses_bad_sizes(volume, sizes):
+    with pytest.raises(ambfplus.ArgumentError, match=r"VolumeData\.dimensions must be three"):
+        volume.dimensions = sizes
+    assert np.allclose(volume.dimensions, (0.008, 0.008, 0.008))
+
+
 def test_slice_stack_corrupt_image_names_the_file(tmp_path):
     folder = stack(tmp_path)
     (folder / "plane002.png").write_bytes(b"\x89PNG\r\n\x1a\n" + bytes(40))
@@ -448,6 +478,111 @@ def test_ply_header_cut_before_end_header_is_an_error(tmp_path):
     path = tmp_path / "header_only.ply"
     path.write_text(PLY_HEAD.format(n=3, f=1))
     expect_mesh_error(path, "no 'end_header' line")
+
+
+OBJ_TRIANGLE = "v 0 0 0\nv 1 0 0\nv 0 1 0\n"
+
+
+def test_obj_with_a_nan_vertex_is_an_error(tmp_path):
+    path = tmp_path / "nan.obj"
+    path.write_text(OBJ_TRIANGLE + "v nan 0 0\nf 1 2 3\nf 1 2 4\n")
+    expect_mesh_error(path, "is (nan, 0, 0); expected finite coordinates")
+
+
+def test_obj_with_a_nan_vertex_in_its_second_object_is_an_error_not_half_a_mesh(tmp_path):
+    # Two materials make two meshes; assimp's invalid-data step dropped the second one (its NaN
+    # vertex) and the first loaded alone, silently.
+    (tmp_path / "two.mtl").write_text("newmtl a\nKd 1 0 0\nnewmtl b\nKd 0 1 0\n")
+    path = tmp_path / "half.obj"
+    second = "v 0 0 1\nv 1 0 1\nv 0 nan 1\nusemtl b\nf 4 5 6\n"
+    path.write_text(f"mtllib two.mtl\no good\n{OBJ_TRIANGLE}usemtl a\nf 1 2 3\no bad\n{second}")
+    expect_mesh_error(path, "is (0, nan, 1); expected finite coordinates")
+
+
+@pytest.mark.parametrize(
+    ("face", "words"),
+    [("f 1 2 9", "vertex index out of range"), ("f 1 2 -9", "vertex index out of range"),
+     ("f 1 2 0", "Invalid face index")],
+)  # fmt: skip
+def test_obj_face_naming_a_missing_vertex_is_an_error(tmp_path, face, words):
+    path = tmp_path / "index.obj"
+    path.write_text(OBJ_TRIANGLE + face + "\n")
+    expect_mesh_error(path, words)
+
+
+def binary_stl(triangles: np.ndarray, header: bytes = b"", cut: int = 0) -> bytes:
+    """A binary STL of (n, 3, 3) triangles, cut short by `cut` bytes."""
+    data = header.ljust(80, b" ") + struct.pack("<I", len(triangles))
+    for triangle in triangles:
+        data += np.zeros(3, "<f4").tobytes() + np.asarray(triangle, "<f4").tobytes() + bytes(2)
+    return data[: len(data) - cut]
+
+
+TWO_TRIANGLES = np.array([np.eye(3), np.eye(3)[::-1] + 1.0])
+
+
+@pytest.mark.parametrize("header", [b"binary", b"solid but binary"])
+@pytest.mark.parametrize("cut", [1, 30, 50, 100])
+def test_binary_stl_cut_short_is_an_error(tmp_path, header, cut):
+    path = tmp_path / "cut.stl"
+    path.write_bytes(binary_stl(TWO_TRIANGLES, header, cut))
+    expect_mesh_error(path, "promises 2 triangles", "= 184 bytes", f"has {184 - cut} (cut short)")
+
+
+def test_binary_stl_with_bytes_left_over_is_an_error(tmp_path):
+    path = tmp_path / "long.stl"
+    path.write_bytes(binary_stl(TWO_TRIANGLES, b"binary") + bytes(7))
+    expect_mesh_error(path, "has 191 (bytes left over)")
+
+
+def test_binary_stl_shorter_than_its_header_is_an_error(tmp_path):
+    path = tmp_path / "header.stl"
+    path.write_bytes(binary_stl(TWO_TRIANGLES)[:60])
+    expect_mesh_error(path, "60 bytes is shorter than its 84-byte header")
+
+
+@pytest.mark.parametrize("value", [np.nan, np.inf, -np.inf])
+def test_binary_stl_with_a_non_finite_vertex_is_an_error(tmp_path, value):
+    triangles = TWO_TRIANGLES.copy()
+    triangles[1, 2, 0] = value
+    path = tmp_path / "nan.stl"
+    path.write_bytes(binary_stl(triangles, b"binary"))
+    expect_mesh_error(path, "vertex 5 of mesh 0", "expected finite coordinates")
+
+
+def test_ascii_stl_with_a_nan_vertex_is_an_error(tmp_path):
+    path = tmp_path / "nan_ascii.stl"
+    path.write_text(
+        "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n"
+        "vertex 0 nan 0\nendloop\nendfacet\nendsolid t\n"
+    )
+    expect_mesh_error(path, "vertex 2 of mesh 0", "expected finite coordinates")
+
+
+OFF_TRIANGLE = "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"
+
+
+@pytest.mark.parametrize(
+    "counts",
+    ["3 44444444444444444444 0", "4000000000 1 0", "3 9 0", "3 444444444z44 0", "3\n# c\n9 0"],
+)
+def test_off_counts_beyond_its_lines_are_an_error_not_gigabytes(tmp_path, counts):
+    # A fuzzer's finding: Debian's assimp allocated 3 GB for the faces a 100-byte file promised.
+    path = tmp_path / "huge.off"
+    path.write_text(f"OFF\n# a comment\n{counts}\n" + OFF_TRIANGLE)
+    expect_mesh_error(path, "OFF header promises", "but only 5 lines follow the counts")
+
+
+def test_good_obj_stl_and_off_files_still_load(tmp_path):
+    obj = tmp_path / "good.obj"
+    obj.write_text(OBJ_TRIANGLE + "f 1 2 3\n")
+    stl = tmp_path / "good.stl"
+    stl.write_bytes(binary_stl(TWO_TRIANGLES, b"binary"))
+    off = tmp_path / "good.off"
+    off.write_text("OFF\n3 1 0\n" + OFF_TRIANGLE)
+    for path in (obj, stl, off):
+        code, output = load_mesh_in_a_process(path)
+        assert code == 0 and "loaded" in output, output
 
 
 # ADF files (the YAML layer every loader reads through).

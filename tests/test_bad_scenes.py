@@ -96,6 +96,54 @@ def test_python_pose_beyond_the_bound_is_refused():
     assert len(world) == 0
 
 
+def with_pose_setter(world: ambfplus.World, kind: str):
+    """An object of each kind whose pose Python may set, placed at (1, 2, 3)."""
+    if kind == "body":
+        return world.add_body("a", "sphere", radius=0.1, pose=ambfplus.make_pose((1, 2, 3)))
+    if kind == "camera":
+        return world.add_camera("a", pose=ambfplus.make_pose((1, 2, 3)))
+    light = world.add_light("a", "point", position=(1, 2, 3))
+    light.pose = ambfplus.make_pose((1, 2, 3))
+    return light
+
+
+@pytest.mark.parametrize("kind", ["body", "camera", "light"])
+@pytest.mark.parametrize(
+    ("position", "words"),
+    [((1e300, 0, 0), "1e+06 m"), ((0, -2e6, 0), "1e+06 m"), ((0, 0, math.inf), "non-finite")],
+)
+def test_pose_setter_is_bounded_and_names_the_object(kind, position, words):
+    world = ambfplus.World()
+    thing = with_pose_setter(world, kind)
+    pose = np.eye(4)
+    pose[:3, 3] = position
+    with pytest.raises(ambfplus.ArgumentError) as info:
+        thing.pose = pose
+    message = str(info.value)
+    assert message.startswith(f"{kind} 'a': ") and words in message, message
+    assert np.allclose(thing.pose[:3, 3], (1, 2, 3))
+    world.step(2)
+    assert np.isfinite(thing.pose).all()
+
+
+def test_pose_setter_accepts_the_bound_itself():
+    world = ambfplus.World()
+    body = with_pose_setter(world, "body")
+    body.pose = ambfplus.make_pose((1e6, -1e6, 0))
+    assert body.pose[:3, 3].tolist() == [1e6, -1e6, 0]
+
+
+@pytest.mark.parametrize("kind", ["camera", "light"])
+def test_python_camera_or_light_position_beyond_the_bound_is_refused(kind):
+    world = ambfplus.World()
+    with pytest.raises(ambfplus.ArgumentError, match=rf"{kind} 'a'.*1e\+06 m"):
+        if kind == "camera":
+            world.add_camera("a", pose=ambfplus.make_pose((0, 0, 3e6)))
+        else:
+            world.add_light("a", "point", position=(0, 0, 3e6))
+    assert len(world) == 0
+
+
 @pytest.mark.parametrize("gains", ["{P: .nan, I: 0, D: 1}", "{P: -10, I: 0, D: 1}"])
 def test_controller_gains_must_be_finite_and_non_negative_in_a_file(tmp_path, gains):
     refused(tmp_path, jointed(f"controller: {gains}"), "JOINT a-b", "controller")
@@ -254,6 +302,7 @@ def test_two_cameras_of_one_name_warn_naming_both_blocks(tmp_path, caplog):
     warned = [r.getMessage() for r in caplog.records if "stereoL" in r.getMessage()]
     assert len(warned) == 1, warned
     assert "CAM one" in warned[0] and "CAM two" in warned[0] and "renamed" in warned[0]
+    assert str(path) in warned[0], warned
     assert {"stereoL", "stereoL1"} <= {o.name for o in world.objects}
 
 
@@ -272,9 +321,9 @@ def test_two_bodies_or_joints_of_one_name_warn_naming_both_blocks(tmp_path, capl
     world = ambfplus.World()
     with caplog.at_level(logging.WARNING, logger="ambfplus"):
         world.load_adf(path)
-    messages = [r.getMessage() for r in caplog.records]
+    messages = [r.getMessage() for r in caplog.records if str(path) in r.getMessage()]
     assert any("BODY a" in m and "BODY b" in m and "renamed" in m for m in messages), messages
-    assert any("JOINT one" in m and "JOINT two" in m for m in messages), messages
+    assert any("JOINT one" in m and "JOINT two" in m and "renamed" in m for m in messages), messages
     assert {"a", "a1", "j", "j1"} <= {o.name for o in world.objects}
 
 

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -122,6 +123,21 @@ TEST(Object, CheckedPoseRejectsNonRigidMatrices) {
   EXPECT_THROW(checked_pose(m), ArgumentError);
   m = Eigen::Matrix4d::Identity();
   m(3, 0) = 1;
+  EXPECT_THROW(checked_pose(m), ArgumentError);
+}
+
+TEST(Object, CheckedPoseBoundsThePositionAndNamesWhoGaveIt) {
+  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+  m(1, 3) = -kMaxPosition;
+  EXPECT_NO_THROW(checked_pose(m, "body 'a'"));
+  m(1, 3) = -2 * kMaxPosition;
+  try {
+    checked_pose(m, "body 'a'");
+    FAIL() << "a position beyond kMaxPosition was accepted";
+  } catch (const ArgumentError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("body 'a': position (", 0), 0u) << e.what();
+  }
+  m(1, 3) = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(checked_pose(m), ArgumentError);
 }
 

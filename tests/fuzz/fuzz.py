@@ -3,7 +3,7 @@
     python tests/fuzz/fuzz.py nrrd --seconds 600          # one target, 10 minutes
     python tests/fuzz/fuzz.py all --seconds 60            # each target for a minute (CI)
 
-Targets (``targets.py``): nrrd, slice_stack, recording, adf. Each starts from its regression
+Targets (``targets.py``): nrrd, slice_stack, recording, adf, mesh. Each starts from its regression
 corpus (``corpus/<target>/``: seeds and every input a fuzzer ever found) and writes what it
 learns to a scratch corpus (``--work``, default a temporary folder), never into the regression
 corpus. A finding (a crash, a hang over ``--timeout`` seconds, or an exception that is not an
@@ -88,7 +88,7 @@ def run(target: str, work: Path, seconds: int, timeout: int) -> dict:
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("target", help="nrrd, slice_stack, recording, adf or all")
+    parser.add_argument("target", help="nrrd, slice_stack, recording, adf, mesh or all")
     parser.add_argument("--seconds", type=int, default=60, help="fuzzing time per target")
     parser.add_argument("--timeout", type=int, default=10, help="seconds one input may take")
     parser.add_argument("--work", type=Path, help="scratch folder (default: a temporary one)")

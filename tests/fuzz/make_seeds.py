@@ -1,5 +1,5 @@
-"""Writes the fuzzers' seed inputs into corpus/<target>/seed-* (run once; the seeds are kept
-in the repository with the inputs the fuzzers found)."""
+"""Writes the fuzzers' seed inputs into corpus/<target>/seed-* (run once per target; the seeds
+are kept in the repository with the inputs the fuzzers found)."""
 
 from __future__ import annotations
 
@@ -184,8 +184,82 @@ def adf_seeds() -> None:
         write("adf", f"{name}.yaml", textwrap.dedent(text).encode())
 
 
-if __name__ == "__main__":
-    nrrd_seeds()
-    slice_stack_seeds()
-    recording_seeds()
-    adf_seeds()
+# The first byte picks the format (targets.MESH_FORMATS: 0 PLY, 1 OBJ, 2 STL, 3 OFF).
+PLY_TETRAHEDRON = """\
+ply
+format ascii 1.0
+element vertex 4
+property float x
+property float y
+property float z
+element face 4
+property list uchar int vertex_indices
+end_header
+0 0 0
+0.01 0 0
+0 0.01 0
+0 0 0.01
+3 0 2 1
+3 0 1 3
+3 0 3 2
+3 1 2 3
+"""
+OBJ_TETRAHEDRON = """\
+o tetra
+v 0 0 0
+v 0.01 0 0
+v 0 0.01 0
+v 0 0 0.01
+vn 0 0 1
+vt 0.5 0.5
+f 1/1/1 3/1/1 2/1/1
+f 1 2 4
+f 1 4 3
+f 2 3 4
+"""
+OFF_TETRAHEDRON = (
+    "OFF\n4 4 0\n0 0 0\n0.01 0 0\n0 0.01 0\n0 0 0.01\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n"
+)
+
+
+def binary_stl(triangles: np.ndarray) -> bytes:
+    data = b"binary seed".ljust(80, b" ") + np.uint32(len(triangles)).tobytes()
+    for triangle in triangles:
+        data += np.zeros(3, "<f4").tobytes() + np.asarray(triangle, "<f4").tobytes() + bytes(2)
+    return data
+
+
+def mesh_seeds() -> None:
+    write("mesh", "ascii.ply", bytes([0]) + PLY_TETRAHEDRON.encode())
+    head, body = PLY_TETRAHEDRON.split("end_header\n")
+    vertices = np.array([[0, 0, 0], [0.01, 0, 0], [0, 0.01, 0], [0, 0, 0.01]], "<f4")
+    faces = b"".join(
+        bytes([3]) + np.array(f, "<i4").tobytes()
+        for f in [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]]
+    )
+    binary_head = head.replace("ascii", "binary_little_endian") + "end_header\n"
+    write("mesh", "binary.ply", bytes([0]) + binary_head.encode() + vertices.tobytes() + faces)
+    write("mesh", "tetra.obj", bytes([1]) + OBJ_TETRAHEDRON.encode())
+    triangles = vertices[[[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]]]
+    write("mesh", "binary.stl", bytes([2]) + binary_stl(triangles))
+    facets = "".join(
+        "facet normal 0 0 0\nouter loop\n"
+        + "".join(f"vertex {x} {y} {z}\n" for x, y, z in t)
+        + "endloop\nendfacet\n"
+        for t in triangles.tolist()
+    )
+    write("mesh", "ascii.stl", bytes([2]) + f"solid seed\n{facets}endsolid seed\n".encode())
+    write("mesh", "tetra.off", bytes([3]) + OFF_TETRAHEDRON.encode())
+
+
+SEEDS = {
+    "nrrd": nrrd_seeds,
+    "slice_stack": slice_stack_seeds,
+    "recording": recording_seeds,
+    "adf": adf_seeds,
+    "mesh": mesh_seeds,
+}
+
+if __name__ == "__main__":  # python make_seeds.py [TARGET ...]: those targets' seeds (default all)
+    for name in sys.argv[1:] or SEEDS:
+        SEEDS[name]()

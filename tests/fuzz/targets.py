@@ -123,7 +123,33 @@ def adf(data: bytes) -> None:
     world.step(5)
 
 
-TARGETS = {"nrrd": nrrd, "slice_stack": slice_stack, "recording": recording, "adf": adf}
+# The mesh formats the mesh target writes, picked by the input's first byte.
+MESH_FORMATS = (".ply", ".obj", ".stl", ".off")
+
+
+def mesh(data: bytes) -> None:
+    """add_body on a mesh file made of the input after its first byte, which picks the format
+    (the file's extension: PLY, OBJ, STL or OFF), then a step of the world it is in."""
+    if not data:
+        return
+    path = scratch() / ("input" + MESH_FORMATS[data[0] % len(MESH_FORMATS)])
+    path.write_bytes(data[1:])
+    world = ambfplus.World()
+    try:
+        body = world.add_body("b", mesh=path)
+    except ambfplus.Error:
+        return
+    world.step(1)
+    assert np.isfinite(body.pose).all()
+
+
+TARGETS = {
+    "nrrd": nrrd,
+    "slice_stack": slice_stack,
+    "recording": recording,
+    "adf": adf,
+    "mesh": mesh,
+}
 CORPUS = Path(__file__).resolve().parent / "corpus"
 
 

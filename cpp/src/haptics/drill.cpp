@@ -109,7 +109,7 @@ void Drill::set_waypoints(const std::vector<DrillWaypoint>& waypoints) {
   for (const DrillWaypoint& w : waypoints) {
     if (!(w.time >= last)) throw ArgumentError("waypoint times must not decrease from 0");
     if (!(w.speed >= 0 && w.speed <= 1)) throw ArgumentError("waypoint speed must be 0..1");
-    checked_pose(w.pose);
+    checked_pose(w.pose, describe() + " waypoint");
     last = w.time;
   }
   waypoints_.clear();

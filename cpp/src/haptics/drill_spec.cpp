@@ -56,7 +56,7 @@ void DrillSpec::validate() const {
   require(finite_at_least(friction.static_coefficient, 0) &&
               finite_at_least(friction.dynamic_coefficient, 0),
           who, "friction coefficients must be >= 0");
-  checked_pose(pose);
+  checked_pose(pose, "drill '" + name + "'");
 }
 
 const OptionTable<DrillSpec>& drill_options() {

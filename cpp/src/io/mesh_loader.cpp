@@ -3,6 +3,7 @@
 #include <assimp/Importer.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -15,7 +16,9 @@
 
 #include "ambfplus/errors.h"
 #include "ambfplus/io/mesh.h"
+#include "io/off_check.h"
 #include "io/ply_check.h"
+#include "io/stl_check.h"
 
 namespace ambfplus {
 
@@ -47,6 +50,13 @@ std::string read_bytes(const std::string& path) {
   return s.str();
 }
 
+bool has_extension(const std::string& path, const char* wanted) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
+  return ext == wanted;
+}
+
 bool starts_with_ply(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   char head[5] = {};
@@ -54,8 +64,44 @@ bool starts_with_ply(const std::string& path) {
   return io::looks_like_ply(std::string(head, static_cast<std::size_t>(in.gcount())));
 }
 
-// Our own checks of what assimp produced: faces name vertices of their mesh, and every position
-// is finite (normals of degenerate triangles are replaced, not trusted).
+// Our own checks of what the file holds, made before any post-processing step can mend or drop
+// it (assimp's invalid-data step deletes a mesh with a non-finite vertex, which would leave the
+// file half-loaded): every mesh has vertices, its faces name them, and every position is finite.
+void check_file_meshes(const std::string& path, const aiScene& scene) {
+  for (unsigned m = 0; m < scene.mNumMeshes; ++m) {
+    const aiMesh* in = scene.mMeshes[m];
+    const std::string which =
+        "mesh " + std::to_string(m) +
+        (in && in->mName.length > 0 ? " ('" + std::string(in->mName.C_Str()) + "')"
+                                    : std::string());
+    if (in == nullptr || (in->mNumVertices > 0 && in->mVertices == nullptr)) {
+      throw ConfigError(path, which + " has no vertex positions");
+    }
+    for (unsigned v = 0; v < in->mNumVertices; ++v) {
+      const aiVector3D& p = in->mVertices[v];
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+        std::ostringstream at;
+        at << "(" << p.x << ", " << p.y << ", " << p.z << ")";
+        throw ConfigError(path, "vertex " + std::to_string(v) + " of " + which + " is " + at.str() +
+                                    "; expected finite coordinates");
+      }
+    }
+    for (unsigned f = 0; f < in->mNumFaces; ++f) {
+      const aiFace& face = in->mFaces[f];
+      for (unsigned i = 0; i < face.mNumIndices; ++i) {
+        if (face.mIndices[i] >= in->mNumVertices) {
+          throw ConfigError(path, "face " + std::to_string(f) + " of " + which + " names vertex " +
+                                      std::to_string(face.mIndices[i]) + " but there are " +
+                                      std::to_string(in->mNumVertices) + " vertices");
+        }
+      }
+    }
+  }
+}
+
+// Our own checks of what assimp's post-processing produced: faces name vertices of their mesh, and
+// every position is finite after the node transforms and scale (normals of degenerate triangles
+// are replaced, not trusted).
 // With textured, texture coordinates too ((0, 0) for a mesh without them).
 void append_mesh(const std::string& path, const aiMesh& in, double scale, bool textured,
                  MeshData& mesh) {
@@ -115,15 +161,24 @@ MeshData load_mesh(const std::string& path, double scale) {
   // Debian's assimp hangs or corrupts memory on some malformed PLY files before any of its
   // checks run, so PLY structure is checked here first.
   if (starts_with_ply(path)) io::check_ply(path, read_bytes(path));
+  // assimp says only that it cannot tell which kind a cut binary STL is.
+  if (has_extension(path, ".stl")) io::check_stl(path, read_bytes(path));
+  // assimp allocates what an OFF header's counts ask for before reading a row.
+  if (has_extension(path, ".off")) io::check_off(path, read_bytes(path));
   Assimp::Importer importer;
   // Points and lines carry no surface; drop them so a file of only those reads as empty.
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
                               aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-  const unsigned flags = aiProcess_ValidateDataStructure | aiProcess_Triangulate |
-                         aiProcess_JoinIdenticalVertices | aiProcess_GenSmoothNormals |
-                         aiProcess_PreTransformVertices | aiProcess_SortByPType |
-                         aiProcess_FindInvalidData;
-  const aiScene* scene = importer.ReadFile(path, flags);
+  // Read and validated first, checked by us, and only then post-processed.
+  const aiScene* scene = importer.ReadFile(path, aiProcess_ValidateDataStructure);
+  if (scene == nullptr) {
+    throw ConfigError(path, std::string("cannot read mesh: ") + importer.GetErrorString());
+  }
+  check_file_meshes(path, *scene);
+  const unsigned steps = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                         aiProcess_GenSmoothNormals | aiProcess_PreTransformVertices |
+                         aiProcess_SortByPType | aiProcess_FindInvalidData;
+  scene = importer.ApplyPostProcessing(steps);
   if (scene == nullptr) {
     throw ConfigError(path, std::string("cannot read mesh: ") + importer.GetErrorString());
   }

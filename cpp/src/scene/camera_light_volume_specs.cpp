@@ -54,7 +54,7 @@ void CameraSpec::validate() const {
   if (publish.image_interval < 1 || publish.depth_interval < 1) {
     throw ArgumentError(who + "publish intervals must be >= 1");
   }
-  checked_pose(pose);
+  checked_pose(pose, "camera '" + name + "'");
 }
 
 const OptionTable<CameraSpec>& camera_options() {
@@ -101,6 +101,11 @@ void LightSpec::validate() const {
   const std::string who = "light '" + name + "'";
   if (!(direction.norm() > 0.0) || !direction.allFinite() || !position.allFinite()) {
     throw ArgumentError(who + ": needs a finite position and a non-zero direction");
+  }
+  if (position.cwiseAbs().maxCoeff() > kMaxPosition) {
+    throw ArgumentError(who +
+                        ": position is beyond 1e+06 m of the origin, where nothing keeps "
+                        "its precision");
   }
   check_rgb(color, who, "color");
   require_non_negative(intensity, who, "intensity");
@@ -149,7 +154,7 @@ void VolumeSpec::validate() const {
   require_non_negative(optical_density, who, "optical density");
   require_non_negative(specular, who, "specular");
   require_non_negative(shininess, who, "shininess");
-  checked_pose(pose);
+  checked_pose(pose, who);
 }
 
 const OptionTable<VolumeSpec>& volume_options() {

@@ -25,7 +25,7 @@ const char* actuator_hold_name(ActuatorHold hold) {
 
 void ConstraintActuatorSpec::validate() const {
   const std::string who = "actuator '" + name + "'";
-  checked_pose(location);
+  checked_pose(location, who + " location");
   if (!(max_impulse > 0) || !std::isfinite(max_impulse)) {
     throw ArgumentError(who + ": max impulse must be > 0 N s, got " + std::to_string(max_impulse));
   }

@@ -44,6 +44,10 @@ Object::~Object() = default;
 
 World& Object::world() const { return model_->world(); }
 
+std::string Object::describe() const {
+  return std::string(object_kind_name(kind())) + " '" + name_ + "'";
+}
+
 void Object::attach_to(const Object* parent, const Eigen::Isometry3d& local) {
   std::string chain = name_;
   for (const Object* p = parent; p != nullptr; p = p->attached_to_) {
@@ -63,20 +67,29 @@ void Object::follow_parent() {
   if (attached_to_ != nullptr) set_pose(attached_to_->pose() * local_);
 }
 
-Eigen::Isometry3d checked_pose(const Eigen::Matrix4d& m, double tol) {
-  if (!m.allFinite()) throw ArgumentError("pose has non-finite entries");
+Eigen::Isometry3d checked_pose(const Eigen::Matrix4d& m, std::string_view who, double tol) {
+  const auto fail = [&](const std::string& what) {
+    throw ArgumentError(who.empty() ? what : std::string(who) + ": " + what);
+  };
+  if (!m.allFinite()) fail("pose has non-finite entries");
   const Eigen::RowVector4d last = m.row(3);
   if ((last - Eigen::RowVector4d(0, 0, 0, 1)).cwiseAbs().maxCoeff() > tol) {
     std::ostringstream s;
     s << "pose must have last row [0 0 0 1], got [" << last << "]";
-    throw ArgumentError(s.str());
+    fail(s.str());
   }
   const Eigen::Matrix3d r = m.topLeftCorner<3, 3>();
   const double orthonormality =
       (r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
   if (orthonormality > tol || r.determinant() < 0) {
-    throw ArgumentError(
-        "pose must be a rigid transform: its 3x3 block must be a rotation (orthonormal, det +1)");
+    fail("pose must be a rigid transform: its 3x3 block must be a rotation (orthonormal, det +1)");
+  }
+  const Eigen::Vector3d position = m.topRightCorner<3, 1>();
+  if (position.cwiseAbs().maxCoeff() > kMaxPosition) {
+    std::ostringstream s;
+    s << "position (" << position.transpose() << ") is beyond " << kMaxPosition
+      << " m of the origin, where nothing keeps its precision";
+    fail(s.str());
   }
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   pose.matrix() = m;

@@ -89,7 +89,7 @@ std::vector<SensorRay> parametric_sensor_rays(const OptionMap& p) {
 
 void ProximitySensorSpec::validate() const {
   const std::string who = "sensor '" + name + "'";
-  checked_pose(location);
+  checked_pose(location, who + " location");
   if (!(range > 0) || !std::isfinite(range)) {
     throw ArgumentError(who + ": range must be > 0 m, got " + std::to_string(range));
   }

@@ -1,7 +1,6 @@
 // RigidBodySpec: the names of its kinds, its checks and its keyword options.
 
 #include <cmath>
-#include <sstream>
 #include <string>
 
 #include "ambfplus/errors.h"
@@ -251,7 +250,7 @@ void RigidBodySpec::validate() const {
       throw ArgumentError(who + ": inertia must be finite and >= 0");
     }
   }
-  if (d.inertial_offset) checked_pose(*d.inertial_offset);
+  if (d.inertial_offset) checked_pose(*d.inertial_offset, who + " inertial offset");
   if (d.gravity && !d.gravity->allFinite()) throw ArgumentError(who + ": gravity must be finite");
   require_non_negative(collision.margin, "collision margin", who);
   shape.validate(who);
@@ -270,19 +269,9 @@ void RigidBodySpec::validate() const {
                           "(mass 0) or kinematic");
     }
     part.validate(who);
-    checked_pose(pose);
+    checked_pose(pose, who + " collision shape");
   }
-  try {
-    checked_pose(pose);
-  } catch (const ArgumentError& e) {
-    throw ArgumentError(who + ": " + e.what());
-  }
-  if (pose.topRightCorner<3, 1>().cwiseAbs().maxCoeff() > kMaxPosition) {
-    std::ostringstream at;
-    at << pose.topRightCorner<3, 1>().transpose();
-    throw ArgumentError(who + ": position (" + at.str() +
-                        ") is beyond 1e+06 m of the origin, where nothing keeps its precision");
-  }
+  checked_pose(pose, who);
 }
 
 const OptionTable<RigidBodySpec>& rigid_body_options() {

@@ -144,7 +144,7 @@ void SoftBodySpec::validate() const {
   }
   require_at_least(margin, 0, who, "collision margin");
   config.validate(who);
-  checked_pose(pose);
+  checked_pose(pose, who);
 }
 
 const OptionTable<SoftBodySpec>& soft_body_options() {

@@ -83,10 +83,7 @@ std::shared_ptr<VolumeData> load_slice_stack(const SliceStackSpec& spec) {
     throw ArgumentError("slice stack " + spec.folder + ": alpha_threshold " +
                         std::to_string(spec.alpha_threshold) + " is outside 0..255");
   }
-  if (!spec.dimensions.allFinite() || !(spec.dimensions.minCoeff() > 0)) {
-    throw ArgumentError("slice stack " + spec.folder +
-                        ": dimensions must be three positive finite metres");
-  }
+  check_volume_sizes(spec.dimensions, "slice stack " + spec.folder + ": dimensions");
   const std::map<int, fs::path> slices = find_slices(spec);
   if (slices.size() > 8192) {
     throw ConfigError(

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 
 #include "volume/grid_access.h"
@@ -106,12 +107,17 @@ VolumeData::VolumeData(const std::array<int, 3>& shape, const Eigen::Vector3d& d
   original_ = labels_;
 }
 
-void VolumeData::set_dimensions(const Eigen::Vector3d& dimensions) {
-  if (!(dimensions.minCoeff() > 0.0) || !dimensions.allFinite()) {
-    throw ArgumentError("volume dimensions must be positive finite metres, got (" +
-                        std::to_string(dimensions.x()) + ", " + std::to_string(dimensions.y()) +
-                        ", " + std::to_string(dimensions.z()) + ")");
+void check_volume_sizes(const Eigen::Vector3d& sizes, const std::string& what) {
+  if (!(sizes.minCoeff() > 0.0) || !sizes.allFinite()) {
+    std::ostringstream s;
+    s << what << " must be three positive finite metres, got (" << sizes.x() << ", " << sizes.y()
+      << ", " << sizes.z() << ")";
+    throw ArgumentError(s.str());
   }
+}
+
+void VolumeData::set_dimensions(const Eigen::Vector3d& dimensions) {
+  check_volume_sizes(dimensions, "volume dimensions");
   dimensions_ = dimensions;
 }
 

@@ -2,6 +2,7 @@
 
 #include <memory>
 #include <string>
+#include <string_view>
 
 #include <Eigen/Geometry>
 
@@ -44,6 +45,8 @@ class AMBFPLUS_API Object {
   virtual ObjectKind kind() const = 0;
   /// Unique within the world.
   const std::string& name() const { return name_; }
+  /// Its kind and name as messages name it: "body 'a'".
+  std::string describe() const;
   /// Stable instance id (>= 1, never reused in a world); segmentation images use it.
   int id() const { return id_; }
   Model& model() const { return *model_; }
@@ -89,12 +92,14 @@ class AMBFPLUS_API Object {
   std::unique_ptr<ObjectState> physics_state_;
 };
 
-/// The largest |coordinate| (m) of a body's position that a spec or an ADF file may give: beyond
+/// The largest |coordinate| (m) of a position that a pose, a spec or an ADF file may give: beyond
 /// it neither Bullet nor the renderer keeps any precision, so such a value is a mistake.
 constexpr double kMaxPosition = 1e6;
 
 /// Throws ArgumentError unless m is a rigid transform (orthonormal rotation with det +1,
-/// last row 0 0 0 1, finite), tolerating rounding of tol.
-AMBFPLUS_API Eigen::Isometry3d checked_pose(const Eigen::Matrix4d& m, double tol = 1e-6);
+/// last row 0 0 0 1, finite) whose position is within kMaxPosition of the origin, tolerating
+/// rounding of tol. The message begins with who ("body 'a'") when it is given.
+AMBFPLUS_API Eigen::Isometry3d checked_pose(const Eigen::Matrix4d& m, std::string_view who = {},
+                                            double tol = 1e-6);
 
 }  // namespace ambfplus

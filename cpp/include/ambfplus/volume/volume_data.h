@@ -56,6 +56,10 @@ struct AMBFPLUS_API VolumeHit {
   std::int64_t voxel = -1;  ///< linear index of the voxel whose label this is
 };
 
+/// Throws ArgumentError unless sizes are three positive finite metres (a volume's dimensions or
+/// voxel size); the message begins with what ("VolumeData: dimensions") and quotes the values.
+AMBFPLUS_API void check_volume_sizes(const Eigen::Vector3d& sizes, const std::string& what);
+
 /// A segmented volume: a label grid with its table, an optional intensity grid, its physical size,
 /// an edit history and the derived fields rendering and haptics read.
 ///

@@ -987,7 +987,8 @@ class _PartFile:
             self.summary.groups[group].strings[name] = (string.encoding, string.length)
 
     def _widen(self, group: str, name: str, dataset: h5py.Dataset, dtype) -> h5py.Dataset:
-        """The text dataset rewritten with wider fixed-length strings (the part is in memory)."""
+        """The text dataset rewritten with wider fixed-length strings (text columns are small, and
+        HDF5 reuses the space it frees while the part is open)."""
         rows, chunk_rows = dataset[()], dataset.chunks[0]
         del self.file[group][name]
         return _create(self.file[group], name, rows.astype(dtype), chunk_rows, self.compression)

@@ -112,13 +112,15 @@ ignore: every frame up to the last flush survives with its exact bytes. The pric
 flush interval; raise ``flush_interval_s`` for long sessions if that matters more than the
 seconds at risk. Surviving power loss as well would need fsync, which this does not do.
 
-Failed writes: a part is built in memory (HDF5's core driver) and its bytes are written to its
-``.tmp`` file in one go when it closes, so HDF5 never meets a failing disk (after such errors its
-open objects crash the process when they are freed). A full disk or an I/O error removes that
-``.tmp``, ends the recording at its last closed part and raises ``RecordingError`` from the next
-call (``add_*``, ``flush``, ``close``, every later ``close`` too); the process exits cleanly
-whichever way the recorder is then closed, or if it is not. The price is one part's data in
-memory (``flush_interval_s`` of the session, compressed).
+Failed writes: HDF5 writes a part to its ``.tmp`` file through a guard (h5py's file-object
+driver) that never passes a failed write on: at the first one (disk full, I/O error) the guard
+keeps the rest of the part in memory and reports success, so that HDF5 never meets a failing
+disk (after such errors its open objects crash the process when they are freed). The recorder
+then removes that ``.tmp``, ends the recording at its last closed part and raises
+``RecordingError`` from the next call (``add_*``, ``flush``, ``close``, every later ``close``
+too); the process exits cleanly whichever way the recorder is then closed, or if it is not.
+Until a write fails, a part costs no memory beyond HDF5's chunk cache; after one, at most the
+rest of that part (``flush_interval_s`` of the session, compressed).
 """
 
 from __future__ import annotations
@@ -535,6 +537,7 @@ class Recorder:
                 number = len(self._parts) + 1
                 self._part = _PartFile(part_name(self.path, number), self._head, self.compression)
             self._part.append(item)
+            self._part.raise_if_failed()
         elif isinstance(item, _Legend):
             self._head.legend = item.text
             self._head_dirty = True
@@ -560,11 +563,11 @@ class Recorder:
         write_head(self.path, self._head, self._parts, complete=True)
 
     def _abandon_part(self) -> None:
-        """After a failure the part being built (in memory) is dropped: the recording ends at
-        its last closed part."""
+        """After a failure the part being written is dropped with its ``.tmp``: the recording
+        ends at its last closed part."""
         if self._part is not None:
             try:
-                self._part.file.close()
+                self._part.discard()
             except Exception:
                 pass  # the original error is the one to report
             self._part = None
@@ -784,9 +787,10 @@ class _HeadInfo:
 
 
 def _memory_file(path: Path, **options) -> h5py.File:
-    """An HDF5 file built in memory (HDF5's core driver, nothing on disk): HDF5 itself then never
-    meets a failing disk, whose errors leave its open objects in a state that crashes the
-    process when they are freed (at interpreter exit at the latest)."""
+    """An HDF5 file built in memory (HDF5's core driver, nothing on disk), for the small head:
+    HDF5 itself then never meets a failing disk, whose errors leave its open objects in a state
+    that crashes the process when they are freed (at interpreter exit at the latest). Parts,
+    which are large, go to disk as they are written, through a ``_GuardedFile``."""
     return h5py.File(path, "w", driver="core", backing_store=False, block_size=4 * MiB, **options)
 
 
@@ -807,30 +811,132 @@ def _store(file: h5py.File, path: Path) -> None:
     os.replace(tmp, path)
 
 
+class _GuardedFile:
+    """The file HDF5 writes a part through (h5py's "fileobj" driver): the part's ``.tmp`` on
+    disk, written in place, until a write or truncation fails (disk full, I/O error). From then
+    on the file lives in memory and every call succeeds, so that HDF5 never meets the failure;
+    ``error`` holds it for the recorder to raise once HDF5 is done with the file."""
+
+    def __init__(self, path: Path) -> None:
+        self.error: OSError | None = None
+        self._fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_TRUNC, 0o644)
+        self._memory: bytearray | None = None
+        self._position = 0
+        self._size = 0
+
+    def seek(self, offset: int, whence: int = os.SEEK_SET) -> int:
+        base = {os.SEEK_SET: 0, os.SEEK_CUR: self._position, os.SEEK_END: self._size}[whence]
+        self._position = base + offset
+        return self._position
+
+    def tell(self) -> int:
+        return self._position
+
+    def write(self, data) -> int:
+        view = memoryview(data).cast("B")
+        end = self._position + len(view)
+        if self._memory is None:
+            try:
+                done = 0
+                while done < len(view):
+                    written = os.pwrite(self._fd, view[done:], self._position + done)
+                    if written == 0:
+                        raise OSError(28, os.strerror(28))
+                    done += written
+            except OSError as error:
+                self._fail(error)
+        if self._memory is not None:
+            if end > len(self._memory):
+                self._memory.extend(bytes(end - len(self._memory)))
+            self._memory[self._position : end] = view
+        self._position, self._size = end, max(self._size, end)
+        return len(view)
+
+    def readinto(self, buffer) -> int:
+        """Reads at the position; bytes past the end read as zeros (as HDF5's own drivers do)."""
+        view = memoryview(buffer).cast("B")
+        if self._memory is not None:
+            got = self._memory[self._position : self._position + len(view)]
+            view[: len(got)] = got
+            count = len(got)
+        else:
+            try:
+                count = os.preadv(self._fd, [view], self._position)
+            except OSError as error:
+                self._fail(error)
+                return self.readinto(buffer)
+        view[count:] = bytes(len(view) - count)
+        self._position += len(view)
+        return len(view)
+
+    def read(self, size: int = -1) -> bytes:
+        size = self._size - self._position if size < 0 else size
+        buffer = bytearray(max(size, 0))
+        self.readinto(buffer)
+        return bytes(buffer)
+
+    def truncate(self, size: int | None = None) -> int:
+        size = self._position if size is None else size
+        if self._memory is None:
+            try:
+                os.ftruncate(self._fd, size)
+            except OSError as error:
+                self._fail(error)
+        if self._memory is not None:
+            del self._memory[size:]
+            self._memory.extend(bytes(size - len(self._memory)))
+        self._size = size
+        return size
+
+    def flush(self) -> None:
+        pass  # unbuffered; fsync is not promised (see the module docstring)
+
+    def close(self) -> None:
+        if self._fd >= 0:
+            os.close(self._fd)
+            self._fd = -1
+
+    def _fail(self, error: OSError) -> None:
+        """From the first failure on, the file lives in memory: what reached the disk is read
+        back into it (zeros where even that fails), the rest is kept there."""
+        self.error = self.error or error
+        self._memory = bytearray(self._size)
+        try:
+            os.preadv(self._fd, [self._memory], 0)
+        except OSError:
+            pass
+
+
 class _PartFile:
-    """The segment being written, built in memory until ``close`` writes it to ``<part>.tmp``
-    and renames it into place."""
+    """The segment being written, as ``<part>.tmp`` (through a ``_GuardedFile``) until ``close``
+    renames it into place."""
 
     def __init__(self, path: Path, head: _HeadInfo, compression: str | None) -> None:
         self.path = path
         self.compression = compression
         self.tmp = temporary_name(path)
-        self.file = _memory_file(self.tmp)
-        _set_attributes(
-            self.file,
-            {
-                "format": FORMAT,
-                VERSION_ATTR: VERSION,
-                MINOR_VERSION_ATTR: MINOR_VERSION,
-                "recording_id": head.recording_id,
-                "part": _number_of(path),
-            },
-        )
+        self.disk = _GuardedFile(self.tmp)
+        self.file: h5py.File | None = None
         self.summary = PartSummary(path)
         self._buffers: dict[tuple[str, str], list[np.ndarray]] = {}
         self._buffered_bytes: dict[tuple[str, str], int] = {}
         # Open datasets stay open: reopening one per write costs as much as compressing it.
         self._datasets: dict[tuple[str, str], h5py.Dataset] = {}
+        try:
+            self.file = h5py.File(self.disk, "w")
+            _set_attributes(
+                self.file,
+                {
+                    "format": FORMAT,
+                    VERSION_ATTR: VERSION,
+                    MINOR_VERSION_ATTR: MINOR_VERSION,
+                    "recording_id": head.recording_id,
+                    "part": _number_of(path),
+                },
+            )
+        except BaseException:
+            self.discard()
+            raise
 
     def append(self, rows: _Rows) -> None:
         group = self.summary.groups.get(rows.group)
@@ -881,17 +987,41 @@ class _PartFile:
             self.summary.groups[group].strings[name] = (string.encoding, string.length)
 
     def _widen(self, group: str, name: str, dataset: h5py.Dataset, dtype) -> h5py.Dataset:
-        """The text dataset rewritten with wider fixed-length strings (the part is in memory)."""
+        """The text dataset rewritten with wider fixed-length strings (text columns are small, and
+        HDF5 reuses the space it frees while the part is open)."""
         rows, chunk_rows = dataset[()], dataset.chunks[0]
         del self.file[group][name]
         return _create(self.file[group], name, rows.astype(dtype), chunk_rows, self.compression)
 
     def close(self) -> PartSummary:
+        """Writes what is buffered, closes the file and renames it into place; a failed write
+        removes the ``.tmp`` and raises its OSError."""
         for group, name in list(self._buffers):
             self._write_buffer(group, name)
         self._datasets.clear()
-        _store(self.file, self.path)
+        self.file.close()
+        self.disk.close()
+        if self.disk.error is not None:
+            self.tmp.unlink(missing_ok=True)
+            raise self.disk.error
+        os.replace(self.tmp, self.path)
         return self.summary
+
+    def raise_if_failed(self) -> None:
+        """A failed write surfaces at the next item, not only when the part closes."""
+        if self.disk.error is not None:
+            raise self.disk.error
+
+    def discard(self) -> None:
+        """Drops the part (after a failure): HDF5 closes it (into memory if a write failed),
+        and its ``.tmp`` is removed."""
+        try:
+            self._datasets.clear()
+            if self.file is not None:
+                self.file.close()
+        finally:
+            self.disk.close()
+            self.tmp.unlink(missing_ok=True)
 
 
 def _new_group_summary(rows: _Rows) -> GroupSummary:

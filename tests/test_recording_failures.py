@@ -6,6 +6,7 @@ recording's columns, forces included, and names its device."""
 
 from __future__ import annotations
 
+import errno
 import json
 import os
 import shutil
@@ -19,7 +20,14 @@ import numpy as np
 import pytest
 
 import ambfplus
-from ambfplus.recording import Recorder, open_recording, repair, scan_parts, validate
+from ambfplus.recording import (
+    Recorder,
+    RecordingError,
+    open_recording,
+    repair,
+    scan_parts,
+    validate,
+)
 
 # Writes frames until the disk is full, then closes the recorder the way argv[2] says and
 # prints what happened as JSON. With argv[3] == "engine" the frames are real captures.
@@ -186,6 +194,44 @@ def test_a_part_boundary_never_splits_a_stereo_pair(tmp_path):
     for part in parts:
         rows = {name: group.rows for name, group in part.groups.items()}
         assert rows.get("cameras/left") == rows.get("cameras/right") == rows.get("rigs/rig")
+    assert validate(path, match_images=False).ok
+
+
+@pytest.mark.parametrize("code", [errno.ENOSPC, errno.EIO])
+def test_a_failed_write_ends_the_recording_at_its_last_closed_part(tmp_path, monkeypatch, code):
+    """Writes to disk that fail in the middle of a part (a short write, then an error) end the
+    recording with a RecordingError at its last closed part, with no .tmp left; HDF5 never sees
+    the error (the part's writes go on in memory). Needs no root, unlike the full tmpfs above."""
+    budget = {"bytes": None}
+    pwrite = os.pwrite
+
+    def failing_pwrite(fd, data, offset):
+        if budget["bytes"] is None:
+            return pwrite(fd, data, offset)
+        if budget["bytes"] <= 0:
+            raise OSError(code, os.strerror(code))
+        written = pwrite(fd, memoryview(data)[: budget["bytes"]], offset)
+        budget["bytes"] -= written
+        return written
+
+    monkeypatch.setattr(os, "pwrite", failing_pwrite)
+    path = tmp_path / "failing.h5"
+    rec = Recorder(path, flush_interval_s=100.0, compression=None)
+    for step in range(1, 6):
+        rec.add_stereo("rig", Pair(step))
+    rec.flush()
+    budget["bytes"] = 3000
+    with pytest.raises(RecordingError, match=os.strerror(code)):
+        for step in range(6, 100):
+            rec.add_stereo("rig", Pair(step))
+            rec.flush()
+    for _ in range(2):
+        with pytest.raises(RecordingError):
+            rec.close()
+    monkeypatch.undo()
+    assert not list(tmp_path.glob("*.tmp"))
+    with open_recording(path) as recording:
+        assert len(recording.rigs["rig"]) == 5 and not recording.complete
     assert validate(path, match_images=False).ok
 
 

@@ -313,7 +313,7 @@ class VolumeData:
     @property
     def smoothed_occupancy(self) -> numpy.ndarray:
         """
-        read-only (nx, ny, nz) view of the blurred occupancy (0..255) whose 0.5 level is the rendered surface
+        read-only (nx, ny, nz) view of the blurred occupancy (0..255) whose 0.5 level is the rendered surface, brought up to date with the edits made since whenever it is read (a view taken earlier shows it as of then until it, or raycast, is read again)
         """
     @property
     def source(self) -> str:

@@ -213,7 +213,8 @@ void define_volume(py::module_& m) {
             return grid_view(self, v, field.data(), py::dtype::of<std::uint8_t>(), false);
           },
           "read-only (nx, ny, nz) view of the blurred occupancy (0..255) whose 0.5 level is the "
-          "rendered surface")
+          "rendered surface, brought up to date with the edits made since whenever it is read "
+          "(a view taken earlier shows it as of then until it, or raycast, is read again)")
       .def_property_readonly("shape",
                              [](const VolumeData& v) {
                                return py::make_tuple(v.shape()[0], v.shape()[1], v.shape()[2]);

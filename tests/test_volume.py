@@ -224,6 +224,29 @@ def test_many_scattered_edits_upload_as_a_full_upload_would():
         assert np.array_equal(getattr(edited, name), getattr(full, name)), name
 
 
+def test_more_edits_than_the_history_keeps_upload_little_and_render_as_a_full_upload():
+    # Over 4500 small removals between two captures, more than a volume lists: the renderer copies
+    # the union of the edits no longer listed, not the grid, and draws what a full upload draws.
+    data = ambfplus.phantom(96)
+    world, volume, camera = render_world(data)
+    camera.capture()
+    rng = np.random.default_rng(11)
+    start, removed = data.revision, 0
+    for centre in rng.uniform(-0.006, 0.006, (20000, 3)) + (0.0, 0.0, 0.012):
+        removed += volume.remove_sphere(tuple(centre), 0.0003)
+        if data.revision - start > 4500:
+            break
+    assert removed > 100 and data.revision - start > 4500, data.revision - start
+    edited = camera.capture()
+    upload = volume.last_upload
+    assert not upload["full"] and 0 < upload["voxels"] < 0.1 * 96**3, upload
+    _, fresh_volume, fresh_camera = render_world(data)
+    full = fresh_camera.capture()
+    assert fresh_volume.last_upload["full"]
+    for name in ("rgb", "depth", "label"):
+        assert np.array_equal(getattr(edited, name), getattr(full, name)), name
+
+
 def test_edit_through_numpy_changes_the_next_render_and_reset_restores_it():
     data = ambfplus.phantom(64)
     _, volume, camera = render_world(data)

@@ -117,6 +117,23 @@ TEST(SmoothedOccupancy, FromAPackedCopyEqualsTheVolumes) {
   }
 }
 
+// More edits than the history keeps: what is no longer listed counts as the union of the
+// dropped boxes (the corner edited), not the whole grid, so a late reader copies little.
+TEST(VolumeData, EditsBeyondTheHistoryStayWithinTheirUnion) {
+  VolumeData v({64, 64, 64}, Eigen::Vector3d::Constant(0.064), LabelType::kUInt8, bone());
+  const std::int64_t start = v.revision();
+  for (int e = 0; e < 5000; ++e) v.mark_dirty(VoxelBox{{e % 8, 2, 3}, {e % 8 + 1, 3, 4}});
+  v.mark_dirty(VoxelBox{{60, 60, 60}, {61, 61, 61}});
+  VoxelBox box;
+  ASSERT_TRUE(v.dirty_since(start, &box));
+  EXPECT_EQ(box, (VoxelBox{{0, 2, 3}, {61, 61, 61}}));
+  std::vector<VoxelBox> boxes;
+  ASSERT_TRUE(v.dirty_boxes_since(start, &boxes));
+  ASSERT_EQ(boxes.size(), 2u);
+  EXPECT_EQ(boxes.front(), (VoxelBox{{0, 2, 3}, {8, 3, 4}}));
+  EXPECT_EQ(boxes.back(), (VoxelBox{{60, 60, 60}, {61, 61, 61}}));
+}
+
 TEST(VolumeData, DirtySinceUnitesLaterEdits) {
   VolumeData v({10, 10, 10}, Eigen::Vector3d::Constant(0.01), LabelType::kUInt8, bone());
   const std::int64_t r0 = v.revision();

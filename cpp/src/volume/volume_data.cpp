@@ -219,6 +219,7 @@ void VolumeData::record(VolumeEdit edit) {
   dirty_.emplace_back(edit.revision, edit.box);
   if (dirty_.size() > kDirtyHistory) {
     dirty_floor_ = dirty_.front().first;
+    dirty_dropped_ = dirty_dropped_.united(dirty_.front().second);
     dirty_.pop_front();
   }
   // Readers bring the derived fields up to date; the editing thread (a haptic tick) only notes
@@ -380,11 +381,8 @@ void VolumeData::commit() { original_ = labels_; }
 
 bool VolumeData::dirty_since(std::int64_t since, VoxelBox* box) const {
   if (since >= revision_) return false;
-  if (since < dirty_floor_) {
-    *box = VoxelBox{{0, 0, 0}, shape_};
-    return true;
-  }
-  VoxelBox u;
+  // Edits no longer listed lie within the union of those dropped.
+  VoxelBox u = since < dirty_floor_ ? dirty_dropped_ : VoxelBox{};
   for (auto it = dirty_.rbegin(); it != dirty_.rend() && it->first > since; ++it) {
     u = u.united(it->second);
   }
@@ -396,10 +394,9 @@ bool VolumeData::dirty_boxes_since(std::int64_t since, std::vector<VoxelBox>* bo
                                    std::size_t max_boxes) const {
   boxes->clear();
   if (since >= revision_) return false;
-  if (since < dirty_floor_) {
-    boxes->push_back(VoxelBox{{0, 0, 0}, shape_});
-    return true;
-  }
+  // Edits no longer listed lie within the union of those dropped (a drill's region, not the
+  // grid, unless something edited it all).
+  if (since < dirty_floor_ && !dirty_dropped_.empty()) boxes->push_back(dirty_dropped_);
   auto first = dirty_.end();
   while (first != dirty_.begin() && std::prev(first)->first > since) --first;
   for (auto it = first; it != dirty_.end(); ++it) {

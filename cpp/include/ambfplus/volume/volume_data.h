@@ -160,13 +160,15 @@ class AMBFPLUS_API VolumeData {
 
   /// Increases with every edit.
   std::int64_t revision() const { return revision_; }
-  /// The union of the boxes edited after `since`: returns false when nothing changed, and the
-  /// whole grid when the history no longer reaches back that far.
+  /// The union of the boxes edited after `since`: returns false when nothing changed. Where the
+  /// history no longer reaches back that far, the edits no longer listed count as the union of
+  /// every box dropped from it.
   bool dirty_since(std::int64_t since, VoxelBox* box) const;
   /// The boxes edited after `since`, oldest first, a box merged into the one before it where
   /// that costs few extra voxels, and all merged into their union beyond max_boxes: false when
-  /// nothing changed, the whole grid when the history no longer reaches back that far. Far-apart
-  /// edits stay apart, so a consumer copies what changed, not the box around it.
+  /// nothing changed; where the history no longer reaches back that far, the union of every box
+  /// dropped from it stands for the edits no longer listed. Far-apart edits stay apart, so a
+  /// consumer copies what changed, not the box around it.
   bool dirty_boxes_since(std::int64_t since, std::vector<VoxelBox>* boxes,
                          std::size_t max_boxes = 64) const;
   /// Edits kept for edit_log(): the newest kEditLogEdits, holding at most kEditLogVoxels removed
@@ -232,6 +234,7 @@ class AMBFPLUS_API VolumeData {
   std::int64_t revision_ = 0;
   std::deque<std::pair<std::int64_t, VoxelBox>> dirty_;  // recent edits, oldest first
   std::int64_t dirty_floor_ = 0;  // edits at or before this revision are no longer listed
+  VoxelBox dirty_dropped_;        // the union of the boxes of those edits
   std::deque<VolumeEdit> edit_log_;
   std::size_t edit_log_voxels_ = 0;
   std::int64_t edit_log_dropped_ = 0;

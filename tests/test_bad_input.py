@@ -573,6 +573,14 @@ def test_off_counts_beyond_its_lines_are_an_error_not_gigabytes(tmp_path, counts
     expect_mesh_error(path, "OFF header promises", "but only 5 lines follow the counts")
 
 
+@pytest.mark.parametrize("edges", ["444444444", "444444444z444444"])
+def test_an_off_edge_count_beyond_the_file_is_an_error_not_gigabytes(tmp_path, edges):
+    # A fuzzer's finding in CI: Debian's assimp took 7 GB for the edges a 66-byte file promised.
+    path = tmp_path / "edges.off"
+    path.write_text(f"OFF\n3 1 {edges}\n" + OFF_TRIANGLE)
+    expect_mesh_error(path, "OFF header promises 444444444 edges", "can hold")
+
+
 def test_good_obj_stl_and_off_files_still_load(tmp_path):
     obj = tmp_path / "good.obj"
     obj.write_text(OBJ_TRIANGLE + "f 1 2 3\n")

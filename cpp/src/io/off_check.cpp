@@ -33,12 +33,12 @@ std::size_t counts_start(const std::string& bytes) {
 }  // namespace
 
 void check_off(const std::string& path, const std::string& bytes) {
-  // The counts are the first two runs of digits after the keyword, comments skipped; a run is
-  // read as assimp reads it, its leading digits ("444z" is 444).
-  unsigned long long counts[2] = {0, 0};
+  // The counts are the first three runs of digits after the keyword, comments skipped (vertices,
+  // faces, edges); a run is read as assimp reads it, its leading digits ("444z" is 444).
+  unsigned long long counts[3] = {0, 0, 0};
   int found = 0;
-  std::size_t i = counts_start(bytes);
-  while (found < 2 && i < bytes.size()) {
+  std::size_t i = counts_start(bytes), after_faces = bytes.size();
+  while (found < 3 && i < bytes.size()) {
     const char c = bytes[i];
     if (c == '#') {
       i = std::min(bytes.find('\n', i), bytes.size());
@@ -48,19 +48,28 @@ void check_off(const std::string& path, const std::string& bytes) {
         value = std::min<unsigned long long>(value * 10 + (bytes[i] - '0'), 1ull << 40);
       }
       counts[found++] = value;
+      if (found == 2) after_faces = i;
     } else {
       ++i;
     }
   }
   if (found < 2) return;  // assimp says what is missing
   // Lines from the rest of the counts' line on (a last line without its newline counts too).
-  const auto lines = static_cast<unsigned long long>(std::count(
-                         bytes.begin() + static_cast<std::ptrdiff_t>(i), bytes.end(), '\n')) +
-                     (bytes.back() != '\n' ? 1 : 0);
+  const auto lines =
+      static_cast<unsigned long long>(
+          std::count(bytes.begin() + static_cast<std::ptrdiff_t>(after_faces), bytes.end(), '\n')) +
+      (bytes.back() != '\n' ? 1 : 0);
   if (counts[0] + counts[1] > lines) {
     throw ConfigError(path, "OFF header promises " + std::to_string(counts[0]) + " vertices and " +
                                 std::to_string(counts[1]) + " faces, one a line, but only " +
                                 std::to_string(lines) + " lines follow the counts");
+  }
+  // assimp allocates by the edge count too (a 66-byte file asking for 444444444 edges took 7 GB);
+  // every edge belongs to a face, whose indices take at least two bytes each.
+  if (found == 3 && counts[2] > bytes.size()) {
+    throw ConfigError(path, "OFF header promises " + std::to_string(counts[2]) +
+                                " edges, more than a file of " + std::to_string(bytes.size()) +
+                                " bytes can hold");
   }
 }
 

@@ -247,10 +247,14 @@ void GpuVolume::stage(double iso) {
   // over their whole footprints, which needs the labels kSmoothRadius around those.
   for (const VoxelBox& box : boxes_) {
     if (box.empty()) continue;
-    const VoxelBox bricks = bricks_reaching(box.grown(VolumeData::kSmoothRadius).clipped(n), n);
-    const VoxelBox frame = brick_footprints(bricks, n).grown(VolumeData::kSmoothRadius).clipped(n);
-    pending.regions.push_back(
-        {box, frame, pack_box(data_->label_data(), VoxelBox{{0, 0, 0}, n}, frame, bytes)});
+    Region region;
+    region.edited = box;
+    region.grown = box.grown(VolumeData::kSmoothRadius).clipped(n);
+    region.bricks = bricks_reaching(region.grown, n);
+    region.footprints = brick_footprints(region.bricks, n);
+    region.frame = region.footprints.grown(VolumeData::kSmoothRadius).clipped(n);
+    region.labels = pack_box(data_->label_data(), VoxelBox{{0, 0, 0}, n}, region.frame, bytes);
+    pending.regions.push_back(std::move(region));
   }
   revision_ = data_->revision();
   const bool level_changed = pending.level != staged_level_;
@@ -264,18 +268,16 @@ void GpuVolume::stage(double iso) {
 
 void GpuVolume::derive(const Region& region, int bytes, Derived& out) const {
   const auto& n = data_->shape();
-  const VoxelBox grown = region.edited.grown(VolumeData::kSmoothRadius).clipped(n);
-  const VoxelBox bricks = bricks_reaching(grown, n);
-  const VoxelBox footprints = brick_footprints(bricks, n);
+  const VoxelBox& footprints = region.footprints;
   std::vector<std::uint8_t> smoothed(static_cast<std::size_t>(footprints.count()));
   smooth_occupancy(region.labels.data(), region.frame, bytes, n, footprints, smoothed.data(),
                    footprints);
   out.labels.push_back(
       {region.edited, pack_box(region.labels.data(), region.frame, region.edited, bytes)});
-  out.occupancy.push_back({grown, pack_box(smoothed.data(), footprints, grown, 1)});
-  std::vector<std::uint8_t> maxima(static_cast<std::size_t>(bricks.count()));
-  brick_maxima(smoothed.data(), footprints, n, bricks, maxima.data(), bricks);
-  out.brick_max.push_back({bricks, std::move(maxima)});
+  out.occupancy.push_back({region.grown, pack_box(smoothed.data(), footprints, region.grown, 1)});
+  std::vector<std::uint8_t> maxima(static_cast<std::size_t>(region.bricks.count()));
+  brick_maxima(smoothed.data(), footprints, n, region.bricks, maxima.data(), region.bricks);
+  out.brick_max.push_back({region.bricks, std::move(maxima)});
 }
 
 void GpuVolume::update_distances(const std::vector<Box>& brick_boxes, double level, bool full) {

@@ -65,11 +65,11 @@ class GpuVolume {
     VoxelBox box;
     std::vector<std::uint8_t> bytes;
   };
-  // Labels copied under the lock: the box edited, and the labels of `frame` (a packed box of
-  // the grid) around it from which upload() derives what the edit changed.
+  // Labels copied under the lock: the box edited, the smoothed field it changes (`grown`), the
+  // bricks whose maxima that reaches and their footprints, and the labels of `frame` (a packed
+  // box of the grid) from which upload() derives them.
   struct Region {
-    VoxelBox edited;
-    VoxelBox frame;
+    VoxelBox edited, grown, bricks, footprints, frame;
     std::vector<std::uint8_t> labels;
   };
   // What upload() sends for a staged update.

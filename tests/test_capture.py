@@ -92,7 +92,8 @@ def test_poses_under_a_real_time_loop_belong_to_the_frames_step():
     frames = []
 
     def capture():
-        for _ in range(40):
+        # At least 40 captures, over more than 10 steps (a fast machine captures 40 within 10).
+        while len(frames) < 40 or (len({f.step for f in frames}) <= 10 and len(frames) < 4000):
             frames.append(camera.capture(passes=["depth"], poses=["ball"]))
 
     with ambfplus.RealTimeLoop(world):

@@ -592,7 +592,7 @@ class World:
         """
     def lock(self) -> typing.Any:
         """
-        A context manager holding the world's state lock: a real-time loop's steps and captures from other threads wait meanwhile.
+        A context manager holding the world's state lock: a real-time loop's steps and captures from other threads wait meanwhile. Python may run other threads while it is held (the GIL changes hands), so hold it for a few lines at most; to read state for another thread, use read_state.
         """
     def lookup(self, query: str, kind: str | None = None) -> list:
         """
@@ -609,6 +609,10 @@ class World:
     def mouse_scroll(self, dx: typing.SupportsFloat | typing.SupportsIndex, dy: typing.SupportsFloat | typing.SupportsIndex) -> None:
         """
         Gives the plugins a scroll event.
+        """
+    def read_state(self, objects: collections.abc.Sequence[Object]) -> dict:
+        """
+        One consistent read of several objects, in one call that holds the world's lock with the GIL released (nothing else of Python runs under it, so a real-time loop never waits for Python). Returns {'time': s, 'objects': [one dict per object, in order]}; each has 'pose' (4x4), a camera's 'intrinsics' (3x3), a drill's 'force' (N, world frame) and 'critical_distances' ({structure: metres}).
         """
     def reset_plugins(self) -> None:
         """
@@ -1085,7 +1089,7 @@ class _StateLock:
     """
     def __enter__(self) -> None:
         """
-        Takes the world's state lock (waiting with the GIL released).
+        Takes the world's state lock (waiting with the GIL released; the GIL is never waited for while the lock is held).
         """
     def __exit__(self, *args) -> bool:
         """

@@ -715,6 +715,62 @@ void define_world_adf(py::class_<World, std::shared_ptr<World>>& world) {
                     "namespace of models whose files name none");
 }
 
+// One object's state as World.read_state copies it under the lock: plain C++, no Python.
+struct ObjectState {
+  Mat4 pose;
+  std::optional<Eigen::Matrix3d> intrinsics;             // cameras
+  std::optional<Vec3> force;                             // drills
+  std::vector<std::pair<std::string, double>> critical;  // drills: label name, metres
+};
+
+py::dict read_state(World& w, const std::vector<std::shared_ptr<Object>>& objects) {
+  for (const auto& o : objects) {
+    if (!o) throw py::type_error("World.read_state: expected objects of this world, got None");
+    if (&o->world() != &w)
+      throw py::value_error("World.read_state: " + o->describe() + " belongs to another world");
+  }
+  double time = 0.0;
+  std::vector<ObjectState> states(objects.size());
+  {
+    // The GIL is released before the lock is taken and taken back after it is given back: no
+    // other Python thread can keep a real-time loop waiting while this one holds the lock.
+    py::gil_scoped_release release;
+    auto lock = w.lock_state_for_copy();
+    time = w.time();
+    for (std::size_t i = 0; i < objects.size(); ++i) {
+      Object* o = objects[i].get();
+      ObjectState& s = states[i];
+      s.pose = o->pose().matrix();
+      if (const auto* c = dynamic_cast<const Camera*>(o)) s.intrinsics = c->intrinsics();
+      if (const auto* d = dynamic_cast<const Drill*>(o)) {
+        s.force = d->force();
+        const LabelTable& table = d->volume().data()->label_table();
+        for (const auto& [label, distance] : d->critical_distances()) {
+          const Label* l = table.find(label);
+          s.critical.emplace_back(l ? l->name : std::to_string(label), distance);
+        }
+      }
+    }
+  }
+  py::list out;
+  for (const ObjectState& s : states) {
+    py::dict d;
+    d["pose"] = s.pose;
+    if (s.intrinsics) d["intrinsics"] = *s.intrinsics;
+    if (s.force) {
+      d["force"] = *s.force;
+      py::dict critical;
+      for (const auto& [name, distance] : s.critical) critical[py::str(name)] = distance;
+      d["critical_distances"] = critical;
+    }
+    out.append(d);
+  }
+  py::dict result;
+  result["time"] = time;
+  result["objects"] = out;
+  return result;
+}
+
 void define_world(py::class_<World, std::shared_ptr<World>>& world) {
   world
       .def(py::init([](double time_step, const std::string& name) {
@@ -783,7 +839,15 @@ void define_world(py::class_<World, std::shared_ptr<World>>& world) {
           "`shaders`): None (the engine's own), 'builtin', or (vertex_path, fragment_path)")
       .def("lock", &state_lock,
            "A context manager holding the world's state lock: a real-time loop's steps and "
-           "captures from other threads wait meanwhile.")
+           "captures from other threads wait meanwhile. Python may run other threads while "
+           "it is held (the GIL changes hands), so hold it for a few lines at most; to read "
+           "state for another thread, use read_state.")
+      .def("read_state", &read_state, py::arg("objects"),
+           "One consistent read of several objects, in one call that holds the world's lock "
+           "with the GIL released (nothing else of Python runs under it, so a real-time loop "
+           "never waits for Python). Returns {'time': s, 'objects': [one dict per object, in "
+           "order]}; each has 'pose' (4x4), a camera's 'intrinsics' (3x3), a drill's 'force' "
+           "(N, world frame) and 'critical_distances' ({structure: metres}).")
       .def("__repr__", [](World& w) {
         std::ostringstream s;
         s << "<World '" << w.name() << "' objects=" << w.objects().size()
@@ -975,10 +1039,17 @@ void define_realtime(py::module_& m) {
       .def(
           "__enter__",
           [](StateLock& s) {
-            py::gil_scoped_release release;
-            s.lock = s.world->lock_state();
+            // Never wait for the GIL while holding the lock (another Python thread may keep the
+            // GIL for a switch interval, 5 ms, and a real-time loop would wait as long): take
+            // the lock only while holding the GIL, and wait for it to be free without the GIL.
+            s.lock = std::unique_lock<StateMutex>(s.world->state_mutex(), std::defer_lock);
+            while (!s.lock.try_lock()) {
+              py::gil_scoped_release release;
+              std::lock_guard<StateMutex> wait(s.world->state_mutex());
+            }
           },
-          "Takes the world's state lock (waiting with the GIL released).")
+          "Takes the world's state lock (waiting with the GIL released; the GIL is never "
+          "waited for while the lock is held).")
       .def(
           "__exit__",
           [](StateLock& s, py::args) {

@@ -71,6 +71,50 @@ def test_refilling_a_frame_without_asking_for_poses_leaves_none_behind():
         camera.capture(poses=["nothing"])
 
 
+def test_read_state_under_a_real_time_loop_is_one_step_of_the_world():
+    world, ball, camera = moving_ball_world()
+    offset = np.eye(4)
+    offset[:3, 3] = (0.0, -0.5, 0.0)
+    camera.attach_to(ball, offset)
+    dt = world.time_step
+    reads = []
+
+    def read():
+        while len(reads) < 200 or (len({r["time"] for r in reads}) <= 10 and len(reads) < 20000):
+            reads.append(world.read_state([ball, camera]))
+
+    with ambfplus.RealTimeLoop(world):
+        thread = threading.Thread(target=read)
+        thread.start()
+        thread.join()
+    assert len({r["time"] for r in reads}) > 10, "the loop stepped while the thread read"
+    for r in reads:
+        (b, c) = r["objects"]
+        # Same step as the time: one step away is SPEED * dt = 0.5 mm.
+        assert b["pose"][0, 3] == pytest.approx(SPEED * r["time"], abs=2e-5), r["time"]
+        np.testing.assert_allclose(c["pose"], b["pose"] @ offset, atol=1e-12)
+        assert r["time"] / dt == pytest.approx(round(r["time"] / dt))
+
+
+def test_the_state_lock_excludes_other_threads_and_is_reentrant():
+    world = ambfplus.World()
+    events = []
+
+    def other():
+        with world.lock():
+            events.append("other")
+
+    with world.lock():
+        with world.lock():  # the same thread again
+            thread = threading.Thread(target=other)
+            thread.start()
+            thread.join(0.2)
+            assert thread.is_alive(), "the other thread waits for the lock"
+            events.append("main")
+    thread.join(10)
+    assert events == ["main", "other"]
+
+
 def moving_ball_world():
     """A ball gliding along x at SPEED with nothing to slow it, and a camera riding on it: at step
     n its pose and the camera's are known exactly."""

@@ -196,6 +196,32 @@ def test_critical_structures_raise_events_and_report_their_distance():
     assert events and all(e["kind"] == "critical" and e["label"] == 2 for e in events)
     assert drill.critical_distances["Nerve"] < 0.0002, "the burr ends against the nerve"
     assert drill.events == []
+    # World.read_state reads the same in one call (what the live view publishes); the drill,
+    # off, pressed 1 mm further into the bone has a force to read.
+    drill.on = False
+    drill.set_waypoints([])  # the plunge's last waypoint holds the goal otherwise
+    drill.goal = ambfplus.make_pose((0, 0, r - 0.0045), rotation=UP)
+    world.step(20)
+    camera = world.add_camera("cam", 32, 24, fov_y=0.8, near=0.001, far=1.0)
+    camera.principal_point = (15.25, 13.5)
+    camera.look_at((0, -0.05, 0.02), (0, 0, 0))
+    read = world.read_state([volume, drill, camera])
+    assert read["time"] == world.time
+    bone, tool, cam = read["objects"]
+    assert set(bone) == {"pose"} and set(cam) == {"pose", "intrinsics"}
+    np.testing.assert_array_equal(bone["pose"], volume.pose)
+    np.testing.assert_array_equal(tool["pose"], drill.pose)
+    np.testing.assert_array_equal(tool["force"], drill.force)
+    assert np.linalg.norm(tool["force"]) > 0, "the burr presses on the nerve's bone"
+    assert tool["critical_distances"] == drill.critical_distances
+    np.testing.assert_array_equal(cam["intrinsics"], camera.intrinsics)
+    assert cam["intrinsics"][0, 2] == 15.25
+    other = ambfplus.World()
+    stranger = other.add_body("ball", "sphere", radius=0.01, mass=0.0)
+    with pytest.raises(ValueError, match="'ball'.* belongs to another world"):
+        world.read_state([drill, stranger])
+    with pytest.raises(TypeError):
+        world.read_state([drill, None])
 
 
 def test_drill_moves_attached_bodies_and_reports_tick_times():

@@ -128,6 +128,10 @@ class FoxgloveServer:
         # Objects whose pose /tf carries, chosen once.
         self._posed_objects = [o for o in world.objects if o.kind in ("body", "volume", "drill")]
         self._posed = [o.name for o in self._posed_objects]
+        # What each tick reads: the posed objects, the cameras, then the drill.
+        self._read_objects = self._posed_objects + list(self.cameras)
+        if self.drill is not None:
+            self._read_objects.append(self.drill)
 
     # Life cycle -------------------------------------------------------------------------------
 
@@ -329,23 +333,23 @@ class FoxgloveServer:
         self.publish_images()
 
     def _snapshot(self) -> dict:
-        """The state a tick publishes, read in one batch under the world's lock (copies only:
-        the messages are built after the lock is released)."""
-        world, drill = self.world, self.drill
-        with world.lock():
-            now = world.time
-            poses = [o.pose for o in self._posed_objects]
-            cameras = [(c.pose, c.intrinsics) for c in self.cameras]
-            if drill is not None:
-                force, distances = drill.force, drill.critical_distances
+        """The state a tick publishes, read in one engine call that holds the world's lock with
+        no Python running under it (World.read_state): the messages are built afterwards."""
+        drill = self.drill
+        read = self.world.read_state(self._read_objects)
+        states = read["objects"]
+        n = len(self._posed_objects)
+        cameras = states[n : n + len(self.cameras)]
         state = {
-            "time": now,
-            "poses": list(zip(self._posed, poses)),
-            "cameras": {c.name: v for c, v in zip(self.cameras, cameras)},
+            "time": read["time"],
+            "poses": [(name, s["pose"]) for name, s in zip(self._posed, states)],
+            "cameras": {
+                c.name: (s["pose"], s["intrinsics"]) for c, s in zip(self.cameras, cameras)
+            },
         }
         if drill is not None:
-            state["force"] = [float(v) for v in force]
-            state["distances"] = distances
+            state["force"] = [float(v) for v in states[-1]["force"]]
+            state["distances"] = states[-1]["critical_distances"]
         return state
 
     def _critical(self, t: int, state: dict) -> dict:

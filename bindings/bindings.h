@@ -9,6 +9,7 @@
 
 #include <array>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 
@@ -108,5 +109,8 @@ pybind11::array readonly(pybind11::array array);
 
 /// A context manager holding the world's state lock for a `with` block.
 pybind11::object state_lock(World& world);
+/// The world's state lock for a thread holding the GIL, taken so that it never waits for the
+/// GIL while holding the lock (a real-time loop waiting for the lock would wait as long).
+std::unique_lock<StateMutex> lock_holding_gil(World& world);
 
 }  // namespace ambfplus::bindings

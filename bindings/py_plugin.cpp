@@ -381,7 +381,7 @@ void register_plugin(py::module_& m) {
       .def(
           "send_key",
           [](World& w, int key, int scancode, int action, int mods) {
-            py::gil_scoped_release release;
+            auto lock = lock_holding_gil(w);
             w.plugins().keyboard(key, scancode, action, mods);
           },
           py::arg("key"), py::arg("scancode") = 0, py::arg("action") = 1, py::arg("mods") = 0,
@@ -389,7 +389,7 @@ void register_plugin(py::module_& m) {
       .def(
           "send_mouse_button",
           [](World& w, int button, int action, int mods) {
-            py::gil_scoped_release release;
+            auto lock = lock_holding_gil(w);
             w.plugins().mouse_button(button, action, mods);
           },
           py::arg("button"), py::arg("action") = 1, py::arg("mods") = 0,
@@ -397,14 +397,14 @@ void register_plugin(py::module_& m) {
       .def(
           "send_mouse_move",
           [](World& w, double x, double y) {
-            py::gil_scoped_release release;
+            auto lock = lock_holding_gil(w);
             w.plugins().mouse_move(x, y);
           },
           py::arg("x"), py::arg("y"), "Gives the plugins a cursor position.")
       .def(
           "send_mouse_scroll",
           [](World& w, double dx, double dy) {
-            py::gil_scoped_release release;
+            auto lock = lock_holding_gil(w);
             w.plugins().mouse_scroll(dx, dy);
           },
           py::arg("dx"), py::arg("dy"), "Gives the plugins a scroll event.");

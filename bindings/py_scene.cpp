@@ -586,13 +586,13 @@ void define_simulator(py::class_<Simulator, std::shared_ptr<Simulator>>& simulat
 }
 
 void define_world_input(py::class_<World, std::shared_ptr<World>>& world) {
-  // Input events reach the plugins under the world's lock (a real-time loop may be stepping).
+  // Input events reach the plugins under the world's lock (a real-time loop may be stepping),
+  // taken holding the GIL: a Python plugin then never waits for the GIL under the lock.
   world
       .def(
           "keyboard",
           [](World& w, int key, int scancode, int action, int mods) {
-            py::gil_scoped_release release;
-            auto lock = w.lock_state();
+            auto lock = lock_holding_gil(w);
             w.plugins().keyboard(key, scancode, action, mods);
           },
           py::arg("key"), py::arg("scancode"), py::arg("action"), py::arg("mods"),
@@ -600,8 +600,7 @@ void define_world_input(py::class_<World, std::shared_ptr<World>>& world) {
       .def(
           "mouse_button",
           [](World& w, int button, int action, int mods) {
-            py::gil_scoped_release release;
-            auto lock = w.lock_state();
+            auto lock = lock_holding_gil(w);
             w.plugins().mouse_button(button, action, mods);
           },
           py::arg("button"), py::arg("action"), py::arg("mods"),
@@ -609,16 +608,14 @@ void define_world_input(py::class_<World, std::shared_ptr<World>>& world) {
       .def(
           "mouse_move",
           [](World& w, double x, double y) {
-            py::gil_scoped_release release;
-            auto lock = w.lock_state();
+            auto lock = lock_holding_gil(w);
             w.plugins().mouse_move(x, y);
           },
           py::arg("x"), py::arg("y"), "Gives the plugins the mouse's position (pixels).")
       .def(
           "mouse_scroll",
           [](World& w, double dx, double dy) {
-            py::gil_scoped_release release;
-            auto lock = w.lock_state();
+            auto lock = lock_holding_gil(w);
             w.plugins().mouse_scroll(dx, dy);
           },
           py::arg("dx"), py::arg("dy"), "Gives the plugins a scroll event.");
@@ -1037,17 +1034,7 @@ void define_light(py::class_<Light, Object, std::shared_ptr<Light>>& light) {
 void define_realtime(py::module_& m) {
   bound<StateLock>(m, "_StateLock")
       .def(
-          "__enter__",
-          [](StateLock& s) {
-            // Never wait for the GIL while holding the lock (another Python thread may keep the
-            // GIL for a switch interval, 5 ms, and a real-time loop would wait as long): take
-            // the lock only while holding the GIL, and wait for it to be free without the GIL.
-            s.lock = std::unique_lock<StateMutex>(s.world->state_mutex(), std::defer_lock);
-            while (!s.lock.try_lock()) {
-              py::gil_scoped_release release;
-              std::lock_guard<StateMutex> wait(s.world->state_mutex());
-            }
-          },
+          "__enter__", [](StateLock& s) { s.lock = lock_holding_gil(*s.world); },
           "Takes the world's state lock (waiting with the GIL released; the GIL is never "
           "waited for while the lock is held).")
       .def(
@@ -1068,10 +1055,17 @@ void define_realtime(py::module_& m) {
              o.poll_rate = poll_rate;
              LoopHolder loop(new RealTimeLoop(*world, o));
              World* w = world.get();
-             // Python plugins get their physics update on the low-rate thread.
+             // Python plugins get their physics update on the low-rate thread, under the
+             // world's lock taken while holding the GIL (see lock_holding_gil).
              loop->set_poll_hook([w](double dt) {
-               auto lock = w->lock_state();
-               if (dt > 0) w->plugins().foreign_physics_update(dt);
+               if (dt <= 0) return;
+               {
+                 auto lock = w->lock_state_for_copy();
+                 if (!w->plugins().has_foreign()) return;
+               }
+               py::gil_scoped_acquire gil;
+               auto lock = lock_holding_gil(*w);
+               w->plugins().foreign_physics_update(dt);
              });
              return loop;
            }),
@@ -1126,6 +1120,19 @@ void define_realtime(py::module_& m) {
 }  // namespace
 
 py::object state_lock(World& world) { return py::cast(StateLock{handle(&world, world), {}}); }
+
+// The world's state lock for a thread holding the GIL, taken so that it never waits for the GIL
+// while holding the lock: another Python thread may keep the GIL for a switch interval (5 ms),
+// and a real-time loop waiting for the lock would wait as long. The lock is only taken while
+// the GIL is held, and waited for, while busy, with the GIL released.
+std::unique_lock<StateMutex> lock_holding_gil(World& world) {
+  std::unique_lock<StateMutex> lock(world.state_mutex(), std::defer_lock);
+  while (!lock.try_lock()) {
+    py::gil_scoped_release release;
+    std::lock_guard<StateMutex> wait(world.state_mutex());
+  }
+  return lock;
+}
 
 void declare_scene(py::module_& m) {
   declare_enum<LightSpec::Type>(m, "LightType", "How a light shines.",

@@ -285,6 +285,10 @@ def test_python_plugins_and_callbacks_run_off_the_real_time_thread():
             Counter.calls += 1
             Counter.seconds += dt
 
+        def mouse_move(self, x, y):
+            Counter.moves.append((x, y))
+
+    Counter.moves = []
     world.load_plugin(Counter())
     device = ambfplus.ScriptedDevice()
     samples = []
@@ -292,8 +296,11 @@ def test_python_plugins_and_callbacks_run_off_the_real_time_thread():
     world.add_input_device("dev", device, drill)
     loop = ambfplus.RealTimeLoop(world, poll_rate=50.0)
     with loop:
-        time.sleep(1.0)
+        time.sleep(0.5)
+        world.mouse_move(3.0, 4.0)  # input reaches the Python plugin while the loop steps
+        time.sleep(0.5)
     steps = loop.stats["steps"]
+    assert Counter.moves == [(3.0, 4.0)]
     # 50 Hz, not 1 kHz: the plugin's time adds up to the loop's.
     assert 20 <= Counter.calls <= 80
     assert 20 <= len(samples) <= 80

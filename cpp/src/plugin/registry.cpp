@@ -144,6 +144,15 @@ bool PluginRegistry::empty() const {
   return true;
 }
 
+bool PluginRegistry::has_foreign() const {
+  for (const auto& scope : entries_) {
+    for (const auto& e : scope) {
+      if (!e->native && e->attached && e->enabled) return true;
+    }
+  }
+  return false;
+}
+
 // Calls a hook on every live plugin in call order (model plugins only of model_scope_of when it
 // is given, object plugins then left out). Plugins attached or removed by a hook take part from
 // the next call on.

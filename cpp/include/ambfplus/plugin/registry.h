@@ -138,6 +138,8 @@ class AMBFPLUS_API PluginRegistry : public System {
   /// False once a hook of the plugin threw.
   bool enabled(const PluginInstance& plugin) const;
   bool empty() const;
+  /// Whether a live plugin of another language is attached (what foreign_physics_update calls).
+  bool has_foreign() const;
 
   /// physics_update(dt) of every plugin, or with native_only of C++ plugins alone (a real-time
   /// loop's physics thread, which never waits on another language's runtime).

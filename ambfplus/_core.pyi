@@ -2011,7 +2011,9 @@ class Drill(Object):
     def take_events(self) -> list:
         ...
     def take_removed(self) -> dict:
-        ...
+        """
+        the voxels removed since the last take, handed over (the drill keeps none)
+        """
     @property
     def burr(self) -> int:
         """
@@ -2086,7 +2088,7 @@ class Drill(Object):
     @property
     def removed(self) -> dict:
         """
-        voxels removed and not yet taken: dict of step, voxel (N, 3), label
+        voxels removed and not yet taken: dict of step, voxel (N, 3), label (a copy made under the world's lock; take_removed() takes them without copying)
         """
     @property
     def removed_dropped(self) -> int:

@@ -173,8 +173,11 @@ class Orbit:
     last: tuple | None = None
     dragging: int | None = None
 
-    def drag(self, camera, dx: float, dy: float, button: int) -> None:
-        pose = camera.pose.copy()
+    def drag(self, pose: np.ndarray, dx: float, dy: float, button: int) -> dict:
+        """What a drag of (dx, dy) pixels does to a camera at `pose`: {'look_at': (eye, target,
+        up)} to turn about the target (left button), else {'pose': the new pose} to pan (the
+        target moves with it). Computed off the world's lock; applying it is one engine call."""
+        pose = np.array(pose, dtype=float)
         eye = pose[:3, 3]
         if button == MOUSE_LEFT:
             # Turn the eye about the target: yaw about world z, pitch about the camera's x.
@@ -182,19 +185,19 @@ class Orbit:
             yaw, pitch = -dx * self.rotate, -dy * self.rotate
             offset = _rotate(offset, np.array([0.0, 0.0, 1.0]), yaw)
             offset = _rotate(offset, pose[:3, 0], pitch)
-            camera.look_at(self.target + offset, self.target, up=-pose[:3, 1])
-        else:
-            distance = np.linalg.norm(eye - self.target)
-            shift = (-dx * pose[:3, 0] - dy * pose[:3, 1]) * self.pan * distance
-            self.target = self.target + shift
-            pose[:3, 3] = eye + shift
-            camera.pose = pose
+            return {"look_at": (self.target + offset, self.target, -pose[:3, 1])}
+        distance = np.linalg.norm(eye - self.target)
+        shift = (-dx * pose[:3, 0] - dy * pose[:3, 1]) * self.pan * distance
+        self.target = self.target + shift
+        pose[:3, 3] = eye + shift
+        return {"pose": pose}
 
-    def scroll(self, camera, steps: float) -> None:
-        pose = camera.pose.copy()
+    def scroll(self, pose: np.ndarray, steps: float) -> np.ndarray:
+        """The pose of a camera at `pose` after `steps` wheel steps towards the target."""
+        pose = np.array(pose, dtype=float)
         eye = pose[:3, 3]
         pose[:3, 3] = self.target + (eye - self.target) * (1.0 - self.zoom) ** steps
-        camera.pose = pose
+        return pose
 
 
 def _rotate(v: np.ndarray, axis: np.ndarray, angle: float) -> np.ndarray:
@@ -568,16 +571,28 @@ def run_window(glfw, args: argparse.Namespace, plugin_args: list[str]) -> int:
             orbit.dragging = None
         world.mouse_button(button, action, mods)
 
+    # The camera's moves are worked out off the world's lock, from a pose read in one engine
+    # call, and applied in one: Python under the lock may lose the GIL to another thread, and the
+    # physics loop would wait for that thread.
+    def camera_pose():
+        return world.read_state([camera])["objects"][0]["pose"]
+
     def on_move(_window, x, y):
         if orbit.dragging is not None and orbit.last is not None:
+            move = orbit.drag(camera_pose(), x - orbit.last[0], y - orbit.last[1], orbit.dragging)
+            turn = move.get("look_at")
             with world.lock():
-                orbit.drag(camera, x - orbit.last[0], y - orbit.last[1], orbit.dragging)
+                if turn is not None:
+                    camera.look_at(*turn)
+                else:
+                    camera.pose = move["pose"]
             orbit.last = (x, y)
         world.mouse_move(x, y)
 
     def on_scroll(_window, dx, dy):
+        pose = orbit.scroll(camera_pose(), dy)
         with world.lock():
-            orbit.scroll(camera, dy)
+            camera.pose = pose
         world.mouse_scroll(dx, dy)
 
     glfw.set_key_callback(window, on_key)

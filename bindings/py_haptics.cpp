@@ -235,12 +235,27 @@ py::list event_list(const std::deque<DrillEvent>& events) {
   return out;
 }
 
+// What f returns, called under the drill's world's lock with the GIL released: the drill's
+// containers change at every step of a real-time loop, so they are copied (or swapped out) under
+// the lock, and Python objects are made from the copy after it.
+template <typename F>
+auto locked_copy(const Drill& d, F&& f) {
+  py::gil_scoped_release release;
+  auto lock = d.world().lock_state_for_copy();
+  return f();
+}
+
 py::array_t<double> cursor_points(const Drill& d, bool proxies) {
-  py::array_t<double> out({py::ssize_t(d.cursor_count()), py::ssize_t(3)});
+  const std::vector<Vec3> points = locked_copy(d, [&] {
+    std::vector<Vec3> p;
+    for (int i = 0; i < d.cursor_count(); ++i)
+      p.push_back(proxies ? d.cursor_proxy(i) : d.cursor_goal(i));
+    return p;
+  });
+  py::array_t<double> out({py::ssize_t(points.size()), py::ssize_t(3)});
   auto o = out.mutable_unchecked<2>();
-  for (int i = 0; i < d.cursor_count(); ++i) {
-    const Vec3 p = proxies ? d.cursor_proxy(i) : d.cursor_goal(i);
-    for (int a = 0; a < 3; ++a) o(i, a) = p[a];
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    for (int a = 0; a < 3; ++a) o(py::ssize_t(i), a) = points[i][a];
   }
   return out;
 }
@@ -503,7 +518,8 @@ void define_drill(py::module_& m) {
           [](Drill& d) {
             py::dict out;
             const LabelTable& t = d.volume().data()->label_table();
-            for (const auto& [label, dist] : d.critical_distances()) {
+            const auto distances = locked_copy(d, [&] { return d.critical_distances(); });
+            for (const auto& [label, dist] : distances) {
               const Label* l = t.find(label);
               out[py::str(l ? l->name : std::to_string(label))] = dist;
             }
@@ -511,11 +527,18 @@ void define_drill(py::module_& m) {
           },
           "metres from the burr's surface to each critical structure")
       .def_property_readonly(
-          "removed", [](Drill& d) { return removed_arrays(d.removed()); },
-          "voxels removed and not yet taken: dict of step, voxel (N, 3), label")
-      .def("take_removed", [](Drill& d) { return removed_arrays(d.take_removed()); })
-      .def_property_readonly("events", [](Drill& d) { return event_list(d.events()); })
-      .def("take_events", [](Drill& d) { return event_list(d.take_events()); })
+          "removed",
+          [](Drill& d) { return removed_arrays(locked_copy(d, [&] { return d.removed(); })); },
+          "voxels removed and not yet taken: dict of step, voxel (N, 3), label (a copy made "
+          "under the world's lock; take_removed() takes them without copying)")
+      .def(
+          "take_removed",
+          [](Drill& d) { return removed_arrays(locked_copy(d, [&] { return d.take_removed(); })); },
+          "the voxels removed since the last take, handed over (the drill keeps none)")
+      .def_property_readonly(
+          "events", [](Drill& d) { return event_list(locked_copy(d, [&] { return d.events(); })); })
+      .def("take_events",
+           [](Drill& d) { return event_list(locked_copy(d, [&] { return d.take_events(); })); })
       .def_property_readonly("removed_dropped", &Drill::removed_dropped,
                              "removed voxels dropped because nobody took them in time (the newest "
                              "Drill.MAX_REMOVED are kept)")

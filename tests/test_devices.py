@@ -242,28 +242,39 @@ def test_real_time_session_replays_exactly_in_scripted_mode():
     camera.look_at((0.04, -0.04, 0.05), (0.0, 0.0, 0.0))
     camera.capture()
     frames, stop = [], threading.Event()
+    taken = []  # removed voxels taken in pieces while the loop drills
 
     def capture():
         while not stop.is_set():
             frame = camera.capture(passes=["rgb", "depth"])
             frames.append(frame.step)
 
+    def take():
+        while not stop.is_set():
+            taken.append(drill.take_removed())
+            drill.events, drill.critical_distances, drill.cursor_proxies  # noqa: B018
+            time.sleep(0.002)
+
     loop = ambfplus.RealTimeLoop(world)
-    capturer = threading.Thread(target=capture)
+    threads = [threading.Thread(target=capture), threading.Thread(target=take)]
     with loop:
         assert "SCHED_" in loop.scheduling
-        capturer.start()
+        for thread in threads:
+            thread.start()
         hand.set_target((0.0, 0.0, -0.0015), buttons=1)
         time.sleep(1.0)
         hand.set_target((0.003, 0.002, -0.002), buttons=1)
         time.sleep(1.0)
         stop.set()
-        capturer.join()
+        for thread in threads:
+            thread.join()
     stats = loop.stats
     assert stats["steps"] > 1500
     assert stats["mean_rate"] == pytest.approx(1000, rel=0.05)
     assert len(frames) > 5 and frames == sorted(frames)
-    removed = drill.removed
+    taken.append(drill.take_removed())
+    assert sum(len(t["step"]) > 0 for t in taken) > 5, "voxels were taken while the loop drilled"
+    removed = {k: np.concatenate([t[k] for t in taken]) for k in ("step", "voxel", "label")}
     assert len(removed["step"]) > 100
     log = binding.take_log()
     assert log["step"].tolist() == list(range(1, stats["steps"] + 1))

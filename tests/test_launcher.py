@@ -8,6 +8,7 @@ import json
 import time
 
 import numpy as np
+import pytest
 from x11 import finish, launch, screenshot, window_origin, xdo
 
 import ambfplus
@@ -76,3 +77,43 @@ def test_a_recorded_interactive_session_replays_to_the_same_removal(fixtures, di
     report = replay(record, compare_images=False)
     assert report.voxels_removed > 100, "the session drilled"
     assert report.removal_identical and report.forces_identical, report.differences
+
+
+def test_mouse_navigation_turns_about_the_target_pans_and_zooms():
+    from ambfplus.launcher import MOUSE_LEFT, MOUSE_RIGHT, Orbit
+
+    world = ambfplus.World()
+    camera = world.add_camera("cam", 64, 48, fov_y=0.8, near=0.01, far=5.0)
+    target = np.array([0.1, -0.2, 0.05])
+    camera.look_at(target + (0.3, -0.4, 0.2), target)
+    orbit = Orbit(target=target.copy())
+    distance = np.linalg.norm(camera.pose[:3, 3] - target)
+
+    def pixel_of(point):
+        p = np.linalg.inv(camera.pose) @ np.append(point, 1.0)
+        uv = camera.intrinsics @ (p[:3] / p[2])
+        return uv[:2]
+
+    # A turn: the eye stays at its distance and the target at the image's centre.
+    before = camera.pose.copy()
+    turn = orbit.drag(camera.pose, 40.0, -25.0, MOUSE_LEFT)["look_at"]
+    camera.look_at(*turn)
+    assert np.linalg.norm(camera.pose[:3, 3] - target) == pytest.approx(distance, rel=1e-12)
+    np.testing.assert_allclose(pixel_of(target), (32.0, 24.0), atol=1e-9)
+    assert np.linalg.norm(camera.pose[:3, 3] - before[:3, 3]) > 0.05
+    # A pan: the orientation stays, the eye and the target move by the same vector in the image
+    # plane.
+    before = camera.pose.copy()
+    pan = orbit.drag(camera.pose, 10.0, 5.0, MOUSE_RIGHT)["pose"]
+    np.testing.assert_array_equal(pan[:3, :3], before[:3, :3])
+    shift = pan[:3, 3] - before[:3, 3]
+    np.testing.assert_allclose(orbit.target - target, shift, atol=1e-15)
+    assert abs(shift @ before[:3, 2]) < 1e-12 and np.linalg.norm(shift) > 0
+    camera.pose = pan
+    np.testing.assert_allclose(pixel_of(orbit.target), (32.0, 24.0), atol=1e-9)
+    # Two wheel steps towards the target: (1 - zoom)^2 of the distance, same orientation.
+    zoomed = orbit.scroll(camera.pose, 2.0)
+    np.testing.assert_allclose(
+        np.linalg.norm(zoomed[:3, 3] - orbit.target), distance * (1 - orbit.zoom) ** 2, rtol=1e-12
+    )
+    np.testing.assert_array_equal(zoomed[:3, :3], camera.pose[:3, :3])

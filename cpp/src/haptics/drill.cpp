@@ -374,12 +374,14 @@ Eigen::Vector3d Drill::tip_normal() const {
 
 std::deque<RemovedVoxel> Drill::take_removed() {
   std::deque<RemovedVoxel> out;
+  auto lock = world().lock_state_for_copy();  // a real-time loop's step appends meanwhile
   out.swap(removed_);
   return out;
 }
 
 std::deque<DrillEvent> Drill::take_events() {
   std::deque<DrillEvent> out;
+  auto lock = world().lock_state_for_copy();
   out.swap(events_);
   return out;
 }

@@ -158,7 +158,9 @@ class AMBFPLUS_API Drill : public Object {
     return critical_distances_;
   }
   /// Voxels removed so far and not yet taken; take_* hands them over. Bounded: the newest
-  /// kMaxRemoved voxels and kMaxEvents events are kept, older ones dropped and counted.
+  /// kMaxRemoved voxels and kMaxEvents events are kept, older ones dropped and counted. Every
+  /// step appends to them: read removed() and events() under the world's lock while a
+  /// real-time loop steps; take_removed() and take_events() take the lock themselves.
   const std::deque<RemovedVoxel>& removed() const { return removed_; }
   std::deque<RemovedVoxel> take_removed();
   const std::deque<DrillEvent>& events() const { return events_; }

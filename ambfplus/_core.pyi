@@ -2078,6 +2078,14 @@ class Drill(Object):
     def leading_cursor(self) -> int:
         ...
     @property
+    def pose(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
+        """
+        4x4 world from drill (a copy); assigning places the drill there at once, goal and cursors too, as at its creation (assign goal to move it there through the tissue)
+        """
+    @pose.setter
+    def pose(self, arg1: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"]) -> None:
+        ...
+    @property
     def removal(self) -> str:
         """
         physical or compatible

@@ -446,6 +446,11 @@ void define_drill(py::module_& m) {
                                    d.world().simulator().shared_from_this(), &d.volume()));
                              })
       .def_property(
+          "pose", [](Drill& d) { return Mat4(d.pose().matrix()); },
+          [](Drill& d, const Mat4& m) { d.place(checked_pose(m, d.describe())); },
+          "4x4 world from drill (a copy); assigning places the drill there at once, goal and "
+          "cursors too, as at its creation (assign goal to move it there through the tissue)")
+      .def_property(
           "goal", [](Drill& d) { return Mat4(d.goal().matrix()); },
           [](Drill& d, const Mat4& m) { d.set_goal(checked_pose(m, d.describe() + " goal")); },
           "world from drill where the device puts it (burr centre at the origin, shaft along +x)")

@@ -234,6 +234,27 @@ def test_drill_moves_attached_bodies_and_reports_tick_times():
     assert len(drill.tick_seconds) == 3 and (drill.tick_seconds > 0).all()
 
 
+def test_assigning_a_drills_pose_places_it_there_at_once():
+    world, volume, drill = drill_world(slab())
+    r = drill.burr_radius
+    world.step()
+    # Deep in the bone: a goal there is only reached by drilling; a pose is taken at once.
+    inside = ambfplus.make_pose((0.002, -0.001, -0.004), rotation=UP)
+    drill.goal = inside
+    world.step(5)
+    assert drill.pose[2, 3] > r - 1e-4, "a goal in the bone stops at its surface"
+    above = ambfplus.make_pose((0.003, 0.002, 0.02), rotation=UP)
+    drill.pose = above
+    np.testing.assert_array_equal(drill.goal, above)
+    np.testing.assert_allclose(drill.cursor_proxies[0], above[:3, 3], atol=1e-12)
+    np.testing.assert_allclose(drill.cursor_goals[0], above[:3, 3], atol=1e-12)
+    world.step(5)
+    np.testing.assert_allclose(drill.pose, above, atol=1e-9)
+    assert drill.cursor_contacts == [0] * len(drill.cursor_contacts)
+    with pytest.raises(ValueError, match="drill 'drill'"):
+        drill.pose = np.full((4, 4), np.nan)
+
+
 def test_bad_drill_arguments():
     world, volume, drill = drill_world(slab(20))
     with pytest.raises(ValueError, match="burr index"):

@@ -383,7 +383,9 @@ def realtime_scene():
         hit = volume.raycast((0.0, 0.0, 0.05), (0.0, 0.0, -1.0))
     into = -hit["normal"] / np.linalg.norm(hit["normal"])
     start = hit["position"] - into * (drill.burr_radius + 0.002)
-    drill.goal = ambfplus.make_pose(start, rotation=ambfplus.rotation_between((1, 0, 0), -into))
+    # Placed there at once (goal and cursors), as a scene's drill starts: a drill made at the
+    # phantom's centre would start inside the bone.
+    drill.pose = ambfplus.make_pose(start, rotation=ambfplus.rotation_between((1, 0, 0), -into))
     return world, drill, camera, into
 
 

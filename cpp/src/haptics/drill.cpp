@@ -49,19 +49,23 @@ Drill::Drill(Model& model, const DrillSpec& spec, int id)
   critical_ = std::make_unique<CriticalDistances>(*volume_->data(), critical);
   hardness_.assign(65536, 1.0);
   cursors_.resize(spec_.cursors);
-  set_goal(checked_pose(spec_.pose));
-  const Eigen::Isometry3d volume_from_world = volume_->pose().inverse();
-  const Eigen::Vector3d tip = volume_from_world * goal_.translation();
-  const Eigen::Vector3d axis = volume_from_world.linear() * goal_.linear().col(0);
   for (int i = 0; i < spec_.cursors; ++i) {
     cursors_[i].set_radius(i == 0 ? burr_radius() : spec_.shaft_radii[i - 1]);
-    cursors_[i].reset(tip + axis * (spec_.spacing * i));
   }
-  last_goal_position_ = goal_.translation();
-  set_pose(goal_);
+  place(checked_pose(spec_.pose));
 }
 
 Drill::~Drill() = default;
+
+void Drill::place(const Eigen::Isometry3d& pose) {
+  set_goal(pose);
+  const Eigen::Isometry3d volume_from_world = volume_->pose().inverse();
+  const Eigen::Vector3d tip = volume_from_world * goal_.translation();
+  const Eigen::Vector3d axis = volume_from_world.linear() * goal_.linear().col(0);
+  for (int i = 0; i < spec_.cursors; ++i) cursors_[i].reset(tip + axis * (spec_.spacing * i));
+  last_goal_position_ = goal_.translation();
+  set_pose(goal_);
+}
 
 void Drill::set_goal(const Eigen::Isometry3d& goal) {
   if (!goal.matrix().allFinite()) throw ArgumentError("drill goal must be finite");

@@ -104,6 +104,9 @@ class AMBFPLUS_API Drill : public Object {
   const DrillSpec& spec() const { return spec_; }
 
   // --- Commands
+  /// Places the drill at pose at once, as at its creation: goal, cursors and pose (a set_goal
+  /// moves it there through the proxies, stopping at tissue; this does not).
+  void place(const Eigen::Isometry3d& pose);
   /// Where the device puts the drill (world from drill).
   void set_goal(const Eigen::Isometry3d& goal);
   const Eigen::Isometry3d& goal() const { return goal_; }

@@ -234,7 +234,7 @@ class VolumeData:
         """
     def raycast(self, origin: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], direction: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], iso: typing.SupportsFloat | typing.SupportsIndex = 0.5) -> typing.Any:
         """
-        first iso-surface hit of a volume-frame ray: dict(distance, position, normal, label) or None
+        first iso-surface hit of a volume-frame ray: dict(distance, position, normal, label) or None (it brings the smoothed field up to date: while a real-time loop drills this data, call it under world.lock(), or use Volume.raycast, which takes the lock)
         """
     def remove_sphere(self, center: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], radius: typing.SupportsFloat | typing.SupportsIndex, only_removable: bool = True) -> int:
         """
@@ -313,7 +313,7 @@ class VolumeData:
     @property
     def smoothed_occupancy(self) -> numpy.ndarray:
         """
-        read-only (nx, ny, nz) view of the blurred occupancy (0..255) whose 0.5 level is the rendered surface, brought up to date with the edits made since whenever it is read (a view taken earlier shows it as of then until it, or raycast, is read again)
+        read-only (nx, ny, nz) view of the blurred occupancy (0..255) whose 0.5 level is the rendered surface, brought up to date with the edits made since whenever it is read (a view taken earlier shows it as of then until it, or raycast, is read again); while a real-time loop drills this data, read it under world.lock()
         """
     @property
     def source(self) -> str:
@@ -1015,7 +1015,7 @@ class Volume(Object):
         """
     def raycast(self, origin: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], direction: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> typing.Any:
         """
-        first iso-surface hit of a world-frame ray: dict(distance, position, normal, label) or None
+        first iso-surface hit of a world-frame ray: dict(distance, position, normal, label) or None (under the world's lock: a real-time loop waits for it)
         """
     def remove_sphere(self, center: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], radius: typing.SupportsFloat | typing.SupportsIndex, only_removable: bool = True) -> int:
         """

@@ -119,8 +119,9 @@ disk (after such errors its open objects crash the process when they are freed).
 then removes that ``.tmp``, ends the recording at its last closed part and raises
 ``RecordingError`` from the next call (``add_*``, ``flush``, ``close``, every later ``close``
 too); the process exits cleanly whichever way the recorder is then closed, or if it is not.
-Until a write fails, a part costs no memory beyond HDF5's chunk cache; after one, at most the
-rest of that part (``flush_interval_s`` of the session, compressed).
+Until a write fails, a part costs no memory beyond HDF5's chunk cache; after one, the whole part
+(what was written before is read back, since HDF5 reads its metadata while closing): at most
+``flush_interval_s`` of the session, compressed.
 """
 
 from __future__ import annotations
@@ -825,8 +826,14 @@ class _GuardedFile:
         self._size = 0
 
     def seek(self, offset: int, whence: int = os.SEEK_SET) -> int:
-        base = {os.SEEK_SET: 0, os.SEEK_CUR: self._position, os.SEEK_END: self._size}[whence]
-        self._position = base + offset
+        if whence == os.SEEK_SET:
+            self._position = offset
+        elif whence == os.SEEK_CUR:
+            self._position += offset
+        elif whence == os.SEEK_END:
+            self._position = self._size + offset
+        else:
+            raise ValueError(f"seek: whence must be 0, 1 or 2, not {whence}")
         return self._position
 
     def tell(self) -> int:

@@ -12,12 +12,18 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "ambfplus/render/shader.h"
 #include "ambfplus/scene/camera.h"
 #include "ambfplus/scene/options.h"
 #include "ambfplus/scene/simulator.h"
 #include "ambfplus/volume/volume_data.h"
+
+namespace ambfplus {
+class Drill;
+}
 
 namespace ambfplus::bindings {
 
@@ -112,5 +118,8 @@ pybind11::object state_lock(World& world);
 /// The world's state lock for a thread holding the GIL, taken so that it never waits for the
 /// GIL while holding the lock (a real-time loop waiting for the lock would wait as long).
 std::unique_lock<StateMutex> lock_holding_gil(World& world);
+/// A drill's distances to each critical structure, by the structure's name (its label number
+/// where the label table has none), metres. Plain C++: callable under the world's lock.
+std::vector<std::pair<std::string, double>> critical_distances_by_name(const Drill& drill);
 
 }  // namespace ambfplus::bindings

@@ -235,15 +235,38 @@ py::list event_list(const std::deque<DrillEvent>& events) {
   return out;
 }
 
-// What f returns, called under the drill's world's lock with the GIL released: the drill's
-// containers change at every step of a real-time loop, so they are copied (or swapped out) under
-// the lock, and Python objects are made from the copy after it.
+// What f returns, called with the GIL released (f takes the world's lock: Python never runs
+// under it, and other Python threads run while this one waits for it).
 template <typename F>
-auto locked_copy(const Drill& d, F&& f) {
+auto without_gil(F&& f) {
   py::gil_scoped_release release;
-  auto lock = d.world().lock_state_for_copy();
   return f();
 }
+
+// What f returns, called under the drill's world's lock with the GIL released: the drill's
+// containers change at every step of a real-time loop, so they are copied under the lock, and
+// Python objects are made from the copy after it.
+template <typename F>
+auto locked_copy(const Drill& d, F&& f) {
+  return without_gil([&] {
+    auto lock = d.world().lock_state_for_copy();
+    return f();
+  });
+}
+
+}  // namespace
+
+std::vector<std::pair<std::string, double>> critical_distances_by_name(const Drill& drill) {
+  const LabelTable& table = drill.volume().data()->label_table();
+  std::vector<std::pair<std::string, double>> out;
+  for (const auto& [label, distance] : drill.critical_distances()) {
+    const Label* l = table.find(label);
+    out.emplace_back(l ? l->name : std::to_string(label), distance);
+  }
+  return out;
+}
+
+namespace {
 
 py::array_t<double> cursor_points(const Drill& d, bool proxies) {
   const std::vector<Vec3> points = locked_copy(d, [&] {
@@ -447,12 +470,12 @@ void define_drill(py::module_& m) {
                              })
       .def_property(
           "pose", [](Drill& d) { return Mat4(d.pose().matrix()); },
-          [](Drill& d, const Mat4& m) { d.place(checked_pose(m, d.describe())); },
+          [](Drill& d, const Mat4& m) { d.place(checked_pose(m, d)); },
           "4x4 world from drill (a copy); assigning places the drill there at once, goal and "
           "cursors too, as at its creation (assign goal to move it there through the tissue)")
       .def_property(
           "goal", [](Drill& d) { return Mat4(d.goal().matrix()); },
-          [](Drill& d, const Mat4& m) { d.set_goal(checked_pose(m, d.describe() + " goal")); },
+          [](Drill& d, const Mat4& m) { d.set_goal(checked_pose(m, d, "goal")); },
           "world from drill where the device puts it (burr centre at the origin, shaft along +x)")
       .def_property("on", &Drill::on, &Drill::set_on)
       .def_property("speed", &Drill::speed, &Drill::set_speed, "burr speed, 0..1")
@@ -492,7 +515,7 @@ void define_drill(py::module_& m) {
       .def(
           "attach",
           [](Drill& d, RigidBody& body, std::optional<Mat4> offset) {
-            d.attach(body, offset ? checked_pose(*offset, d.describe() + " attach offset")
+            d.attach(body, offset ? checked_pose(*offset, d, "attach offset")
                                   : Eigen::Isometry3d::Identity());
           },
           py::arg("body"), py::arg("offset") = py::none(), "move body with the drill")
@@ -522,11 +545,9 @@ void define_drill(py::module_& m) {
           "critical_distances",
           [](Drill& d) {
             py::dict out;
-            const LabelTable& t = d.volume().data()->label_table();
-            const auto distances = locked_copy(d, [&] { return d.critical_distances(); });
-            for (const auto& [label, dist] : distances) {
-              const Label* l = t.find(label);
-              out[py::str(l ? l->name : std::to_string(label))] = dist;
+            for (const auto& [name, distance] :
+                 locked_copy(d, [&] { return critical_distances_by_name(d); })) {
+              out[py::str(name)] = distance;
             }
             return out;
           },
@@ -538,12 +559,12 @@ void define_drill(py::module_& m) {
           "under the world's lock; take_removed() takes them without copying)")
       .def(
           "take_removed",
-          [](Drill& d) { return removed_arrays(locked_copy(d, [&] { return d.take_removed(); })); },
+          [](Drill& d) { return removed_arrays(without_gil([&] { return d.take_removed(); })); },
           "the voxels removed since the last take, handed over (the drill keeps none)")
       .def_property_readonly(
           "events", [](Drill& d) { return event_list(locked_copy(d, [&] { return d.events(); })); })
       .def("take_events",
-           [](Drill& d) { return event_list(locked_copy(d, [&] { return d.take_events(); })); })
+           [](Drill& d) { return event_list(without_gil([&] { return d.take_events(); })); })
       .def_property_readonly("removed_dropped", &Drill::removed_dropped,
                              "removed voxels dropped because nobody took them in time (the newest "
                              "Drill.MAX_REMOVED are kept)")

@@ -470,7 +470,7 @@ void define_actuator(ActuatorClass& actuator) {
             }
             const py::array arr = py::array::ensure(offset);
             if (arr && arr.ndim() == 2) {
-              a.actuate(body, checked_pose(offset.cast<Mat4>(), a.describe() + " offset"));
+              a.actuate(body, checked_pose(offset.cast<Mat4>(), a, "offset"));
             } else {
               Eigen::Isometry3d o = Eigen::Isometry3d::Identity();
               o.translation() = to_option(offset).vector3("offset");

@@ -279,6 +279,28 @@ PluginSite site_of(World& world, const py::object& scope_object) {
       "object of the world");
 }
 
+// Input events reach the plugins under the world's lock (a real-time loop may be stepping),
+// taken holding the GIL: a Python plugin then never waits for the GIL under the lock.
+void send_key(World& w, int key, int scancode, int action, int mods) {
+  auto lock = lock_holding_gil(w);
+  w.plugins().keyboard(key, scancode, action, mods);
+}
+
+void send_mouse_button(World& w, int button, int action, int mods) {
+  auto lock = lock_holding_gil(w);
+  w.plugins().mouse_button(button, action, mods);
+}
+
+void send_mouse_move(World& w, double x, double y) {
+  auto lock = lock_holding_gil(w);
+  w.plugins().mouse_move(x, y);
+}
+
+void send_mouse_scroll(World& w, double dx, double dy) {
+  auto lock = lock_holding_gil(w);
+  w.plugins().mouse_scroll(dx, dy);
+}
+
 }  // namespace
 
 void register_plugin(py::module_& m) {
@@ -366,7 +388,7 @@ void register_plugin(py::module_& m) {
       .def(
           "reset_plugins",
           [](World& w) {
-            py::gil_scoped_release release;
+            auto lock = lock_holding_gil(w);
             w.reset_plugins();
           },
           "Calls every plugin's reset() (the scene itself is not reset).")
@@ -378,36 +400,24 @@ void register_plugin(py::module_& m) {
           },
           "Calls close() on every plugin (reverse call order) and lets them go; the world "
           "does it when it is destroyed.")
-      .def(
-          "send_key",
-          [](World& w, int key, int scancode, int action, int mods) {
-            auto lock = lock_holding_gil(w);
-            w.plugins().keyboard(key, scancode, action, mods);
-          },
-          py::arg("key"), py::arg("scancode") = 0, py::arg("action") = 1, py::arg("mods") = 0,
-          "Gives the plugins a key event (GLFW's codes; action 0 release, 1 press, 2 repeat).")
-      .def(
-          "send_mouse_button",
-          [](World& w, int button, int action, int mods) {
-            auto lock = lock_holding_gil(w);
-            w.plugins().mouse_button(button, action, mods);
-          },
-          py::arg("button"), py::arg("action") = 1, py::arg("mods") = 0,
-          "Gives the plugins a mouse button event.")
-      .def(
-          "send_mouse_move",
-          [](World& w, double x, double y) {
-            auto lock = lock_holding_gil(w);
-            w.plugins().mouse_move(x, y);
-          },
-          py::arg("x"), py::arg("y"), "Gives the plugins a cursor position.")
-      .def(
-          "send_mouse_scroll",
-          [](World& w, double dx, double dy) {
-            auto lock = lock_holding_gil(w);
-            w.plugins().mouse_scroll(dx, dy);
-          },
-          py::arg("dx"), py::arg("dy"), "Gives the plugins a scroll event.");
+      // The window's input (GLFW's codes), and the same with defaults for scripts.
+      .def("keyboard", &send_key, py::arg("key"), py::arg("scancode"), py::arg("action"),
+           py::arg("mods"), "Gives the plugins a key event (GLFW codes).")
+      .def("mouse_button", &send_mouse_button, py::arg("button"), py::arg("action"),
+           py::arg("mods"), "Gives the plugins a mouse button event (GLFW codes).")
+      .def("mouse_move", &send_mouse_move, py::arg("x"), py::arg("y"),
+           "Gives the plugins the mouse's position (pixels).")
+      .def("mouse_scroll", &send_mouse_scroll, py::arg("dx"), py::arg("dy"),
+           "Gives the plugins a scroll event.")
+      .def("send_key", &send_key, py::arg("key"), py::arg("scancode") = 0, py::arg("action") = 1,
+           py::arg("mods") = 0,
+           "Gives the plugins a key event (GLFW's codes; action 0 release, 1 press, 2 repeat).")
+      .def("send_mouse_button", &send_mouse_button, py::arg("button"), py::arg("action") = 1,
+           py::arg("mods") = 0, "Gives the plugins a mouse button event.")
+      .def("send_mouse_move", &send_mouse_move, py::arg("x"), py::arg("y"),
+           "Gives the plugins a cursor position.")
+      .def("send_mouse_scroll", &send_mouse_scroll, py::arg("dx"), py::arg("dy"),
+           "Gives the plugins a scroll event.");
 
   auto simulator = py::reinterpret_borrow<py::class_<Simulator, std::shared_ptr<Simulator>>>(
       m.attr("Simulator"));

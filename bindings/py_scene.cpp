@@ -585,42 +585,6 @@ void define_simulator(py::class_<Simulator, std::shared_ptr<Simulator>>& simulat
           py::arg("name"), py::arg("kind") = py::none(), "world.get(name, kind)");
 }
 
-void define_world_input(py::class_<World, std::shared_ptr<World>>& world) {
-  // Input events reach the plugins under the world's lock (a real-time loop may be stepping),
-  // taken holding the GIL: a Python plugin then never waits for the GIL under the lock.
-  world
-      .def(
-          "keyboard",
-          [](World& w, int key, int scancode, int action, int mods) {
-            auto lock = lock_holding_gil(w);
-            w.plugins().keyboard(key, scancode, action, mods);
-          },
-          py::arg("key"), py::arg("scancode"), py::arg("action"), py::arg("mods"),
-          "Gives the plugins a key event (GLFW codes).")
-      .def(
-          "mouse_button",
-          [](World& w, int button, int action, int mods) {
-            auto lock = lock_holding_gil(w);
-            w.plugins().mouse_button(button, action, mods);
-          },
-          py::arg("button"), py::arg("action"), py::arg("mods"),
-          "Gives the plugins a mouse button event (GLFW codes).")
-      .def(
-          "mouse_move",
-          [](World& w, double x, double y) {
-            auto lock = lock_holding_gil(w);
-            w.plugins().mouse_move(x, y);
-          },
-          py::arg("x"), py::arg("y"), "Gives the plugins the mouse's position (pixels).")
-      .def(
-          "mouse_scroll",
-          [](World& w, double dx, double dy) {
-            auto lock = lock_holding_gil(w);
-            w.plugins().mouse_scroll(dx, dy);
-          },
-          py::arg("dx"), py::arg("dy"), "Gives the plugins a scroll event.");
-}
-
 void define_world_logs(py::class_<World, std::shared_ptr<World>>& world) {
   world
       .def(
@@ -741,11 +705,7 @@ py::dict read_state(World& w, const std::vector<std::shared_ptr<Object>>& object
       if (const auto* c = dynamic_cast<const Camera*>(o)) s.intrinsics = c->intrinsics();
       if (const auto* d = dynamic_cast<const Drill*>(o)) {
         s.force = d->force();
-        const LabelTable& table = d->volume().data()->label_table();
-        for (const auto& [label, distance] : d->critical_distances()) {
-          const Label* l = table.find(label);
-          s.critical.emplace_back(l ? l->name : std::to_string(label), distance);
-        }
+        s.critical = critical_distances_by_name(*d);
       }
     }
   }
@@ -851,7 +811,6 @@ void define_world(py::class_<World, std::shared_ptr<World>>& world) {
           << " step=" << w.step_index() << ">";
         return s.str();
       });
-  define_world_input(world);
   define_world_logs(world);
   define_world_adf(world);
   def_adders(world, [](World& w) -> Model& { return w.default_model(); });
@@ -877,7 +836,7 @@ void define_object(py::class_<Object, std::shared_ptr<Object>>& object) {
       .def_property_readonly("model", [](Object& o) { return handle(&o.model(), o.world()); })
       .def_property(
           "pose", [](Object& o) { return Mat4(o.pose().matrix()); },
-          [](Object& o, const Mat4& m) { o.set_pose(checked_pose(m, o.describe())); },
+          [](Object& o, const Mat4& m) { o.set_pose(checked_pose(m, o)); },
           "4x4 world-from-object rigid transform (a copy; assign to change it)")
       .def_property("namespace", &Object::name_space, &Object::set_name_space,
                     "AMBF namespace, e.g. '/ambf/env/'")
@@ -890,7 +849,7 @@ void define_object(py::class_<Object, std::shared_ptr<Object>>& object) {
           "attach_to",
           [](Object& o, std::shared_ptr<Object> parent, std::optional<Mat4> local) {
             Eigen::Isometry3d l = parent ? parent->pose().inverse() * o.pose() : o.pose();
-            if (local) l = checked_pose(*local, o.describe() + " local");
+            if (local) l = checked_pose(*local, o, "local");
             o.attach_to(parent.get(), l);
           },
           py::arg("parent"), py::arg("local") = py::none(),
@@ -991,14 +950,17 @@ void define_volume_object(py::class_<Volume, Object, std::shared_ptr<Volume>>& v
           [](Volume& v, const Vec3& origin, const Vec3& direction) -> py::object {
             VolumeHit h;
             {
+              // Under the world's lock: a drill may be editing the labels, and the ray cast
+              // brings the volume's smoothed field up to date with those edits.
               py::gil_scoped_release release;
+              auto lock = v.world().lock_state_for_copy();
               h = v.raycast(origin, direction);
             }
             return hit_dict(h);
           },
           py::arg("origin"), py::arg("direction"),
           "first iso-surface hit of a world-frame ray: dict(distance, position, normal, label) "
-          "or None")
+          "or None (under the world's lock: a real-time loop waits for it)")
       .def(
           "mark_dirty",
           [](Volume& v, std::optional<std::array<int, 3>> lo,

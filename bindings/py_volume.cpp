@@ -214,7 +214,8 @@ void define_volume(py::module_& m) {
           },
           "read-only (nx, ny, nz) view of the blurred occupancy (0..255) whose 0.5 level is the "
           "rendered surface, brought up to date with the edits made since whenever it is read "
-          "(a view taken earlier shows it as of then until it, or raycast, is read again)")
+          "(a view taken earlier shows it as of then until it, or raycast, is read again); "
+          "while a real-time loop drills this data, read it under world.lock()")
       .def_property_readonly("shape",
                              [](const VolumeData& v) {
                                return py::make_tuple(v.shape()[0], v.shape()[1], v.shape()[2]);
@@ -320,7 +321,8 @@ void define_volume(py::module_& m) {
           },
           py::arg("origin"), py::arg("direction"), py::arg("iso") = 0.5,
           "first iso-surface hit of a volume-frame ray: dict(distance, position, normal, label) "
-          "or None")
+          "or None (it brings the smoothed field up to date: while a real-time loop drills this "
+          "data, call it under world.lock(), or use Volume.raycast, which takes the lock)")
       .def(
           "save_nrrd",
           [](const VolumeData& v, const std::filesystem::path& path, const std::string& what,

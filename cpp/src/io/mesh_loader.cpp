@@ -19,6 +19,7 @@
 #include "io/off_check.h"
 #include "io/ply_check.h"
 #include "io/stl_check.h"
+#include "util/strings.h"
 
 namespace ambfplus {
 
@@ -51,10 +52,7 @@ std::string read_bytes(const std::string& path) {
 }
 
 bool has_extension(const std::string& path, const char* wanted) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return std::tolower(c); });
-  return ext == wanted;
+  return to_lower(std::filesystem::path(path).extension().string()) == wanted;
 }
 
 bool starts_with_ply(const std::string& path) {

@@ -61,11 +61,11 @@ Result guarded(Result fallback, const Call& call) {
   return fallback;
 }
 
-Eigen::Isometry3d pose_from(const double* m, std::string_view who) {
+Eigen::Isometry3d pose_from(const double* m, const Object& object, std::string_view role = {}) {
   Eigen::Matrix4d matrix;
   for (int r = 0; r < 4; ++r)
     for (int c = 0; c < 4; ++c) matrix(r, c) = m[4 * r + c];
-  return checked_pose(matrix, who);
+  return checked_pose(matrix, object, role);
 }
 
 void pose_to(const Eigen::Isometry3d& pose, double* m) {
@@ -186,7 +186,7 @@ Table drill_properties() {
   t["goal"] = {[=](Object& o) { return pose_values(drill(o).goal()); },
                [=](Object& o, const std::vector<double>& v) {
                  want("goal", v, 16);
-                 drill(o).set_goal(pose_from(v.data(), o.describe() + " goal"));
+                 drill(o).set_goal(pose_from(v.data(), o, "goal"));
                }};
   t["on"] = {[=](Object& o) { return std::vector<double>{drill(o).on() * 1.0}; },
              [=](Object& o, const std::vector<double>& v) {
@@ -449,7 +449,7 @@ int ambfplus_object_pose(const AmbfplusWorld* world, AmbfplusId object, double p
 int ambfplus_object_set_pose(AmbfplusWorld* world, AmbfplusId object, const double pose[16]) {
   return guarded(-1, [&] {
     ambfplus::Object& o = ambfplus::object_of(world, object);
-    o.set_pose(ambfplus::pose_from(pose, o.describe()));
+    o.set_pose(ambfplus::pose_from(pose, o));
     return 0;
   });
 }
@@ -479,7 +479,7 @@ int ambfplus_object_set(AmbfplusWorld* world, AmbfplusId object, const char* pro
     const std::vector<double> v(values, values + std::max(count, 0));
     if (name == "pose") {
       ambfplus::want("pose", v, 16);
-      o.set_pose(ambfplus::pose_from(v.data(), o.describe()));
+      o.set_pose(ambfplus::pose_from(v.data(), o));
       return 0;
     }
     const auto& p = ambfplus::property(o, name);
@@ -499,7 +499,7 @@ int ambfplus_object_attach(AmbfplusWorld* world, AmbfplusId object, AmbfplusId p
     }
     ambfplus::Object& p = ambfplus::object_of(world, parent);
     const Eigen::Isometry3d offset = local != nullptr
-                                         ? ambfplus::pose_from(local, o.describe() + " local")
+                                         ? ambfplus::pose_from(local, o, "local")
                                          : Eigen::Isometry3d(p.pose().inverse() * o.pose());
     if (p.kind() == ambfplus::ObjectKind::kDrill && o.kind() == ambfplus::ObjectKind::kRigidBody) {
       static_cast<ambfplus::Drill&>(p).attach(static_cast<ambfplus::RigidBody&>(o), offset);

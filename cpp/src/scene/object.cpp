@@ -97,4 +97,15 @@ Eigen::Isometry3d checked_pose(const Eigen::Matrix4d& m, std::string_view who, d
   return pose;
 }
 
+Eigen::Isometry3d checked_pose(const Eigen::Matrix4d& m, const Object& object,
+                               std::string_view role) {
+  try {
+    return checked_pose(m);
+  } catch (const ArgumentError& e) {
+    std::string who = object.describe();
+    if (!role.empty()) who += " " + std::string(role);
+    throw ArgumentError(who + ": " + e.what());
+  }
+}
+
 }  // namespace ambfplus

@@ -595,7 +595,7 @@ void VolumeData::update_derived_box(const VoxelBox& box) {
   // maxima of the bricks whose footprint meets that.
   const VoxelBox affected = box.grown(kSmoothRadius).clipped(shape_);
   if (affected.empty()) return;
-  const int bytes = label_type_ == LabelType::kUInt16 ? 2 : 1;
+  const int bytes = static_cast<int>(label_bytes(label_type_));
   smooth_occupancy(labels_.data(), whole(shape_), bytes, shape_, affected, smoothed_.data(),
                    whole(shape_));
   brick_maxima(smoothed_.data(), whole(shape_), shape_, bricks_reaching(affected, shape_),

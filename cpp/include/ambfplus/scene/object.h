@@ -101,5 +101,9 @@ constexpr double kMaxPosition = 1e6;
 /// rounding of tol. The message begins with who ("body 'a'") when it is given.
 AMBFPLUS_API Eigen::Isometry3d checked_pose(const Eigen::Matrix4d& m, std::string_view who = {},
                                             double tol = 1e-6);
+/// checked_pose for an object's pose: the message begins with object.describe() and role
+/// ("body 'a' local"), the name made only on failure (setters may run at every step).
+AMBFPLUS_API Eigen::Isometry3d checked_pose(const Eigen::Matrix4d& m, const Object& object,
+                                            std::string_view role = {});
 
 }  // namespace ambfplus

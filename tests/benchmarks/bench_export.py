@@ -155,7 +155,7 @@ def _live_round(seconds: float, size: tuple[int, int] | None, image_rate: float 
     """One round of the 1 kHz loop drilling; `size`: the served camera's, None: no server. The
     realtime benchmark's witness runs around the loop, so that each period over 2 ms is
     attributed to the host or to us (rt_witness.realtime_attribution)."""
-    from rt_witness import Witness, loop_phase, realtime_attribution, step_anchors
+    from rt_witness import Witness, anchored, realtime_attribution
 
     from ambfplus.export.live import FoxgloveServer
 
@@ -179,11 +179,7 @@ def _live_round(seconds: float, size: tuple[int, int] | None, image_rate: float 
     loop = ambfplus.RealTimeLoop(world)
     server = FoxgloveServer(world, [camera], image_rate=image_rate, port=0) if size else None
     first_index = world.step_index
-    with Witness() as witness, loop:
-        # The loop's steps against CLOCK_MONOTONIC, at the start and at the end, place its
-        # periods on the witness's clock; the witness wakes half a period away from the loop.
-        anchors = step_anchors(world, first_index, 0.02)
-        witness.align(loop_phase(anchors, 1e-3))
+    with Witness() as witness, loop, anchored(world, first_index, witness) as anchors:
         client = None
         if server is not None:
             server.start()
@@ -195,7 +191,6 @@ def _live_round(seconds: float, size: tuple[int, int] | None, image_rate: float 
         if client is not None:
             client.join()
             server.stop()
-        anchors += step_anchors(world, first_index, 0.02)
     s = loop.stats
     out = {"p99": s["p99"], "max": s["max"], "rate": s["mean_rate"], "over_2ms": s["over_2ms"],
            "lock_wait_max": s["lock_wait_max"], "lock_wait_p99": s["lock_wait_p99"],
@@ -219,6 +214,8 @@ def _ms(values) -> list[float]:
 def foxglove_live(args):
     """The real-time loop's periods without and with the live view serving a client, and the
     rates the client receives, at two camera sizes."""
+    from rt_witness import attribution_fields
+
     seconds = 3.0 if args.quick else 8.0
     rounds = 1 if args.quick else 3
     # name -> (camera size, most images per second asked for: 10 is the default, 1000 lets
@@ -246,16 +243,11 @@ def foxglove_live(args):
             "max_target_ms": 2.0,
             "over_2ms": [r["over_2ms"] for r in runs],
             # Whose they are, per round: the witness's verdict on each (rt_witness).
-            **{
-                f"over_2ms_{whose}": [r["attribution"][f"over_2ms_{whose}"] for r in runs]
-                for whose in ("host", "ours", "unknown")
-            },
-            "late": [r["attribution"]["late"] for r in runs],
+            **attribution_fields(runs),
             "witness": runs[0]["attribution"].get("witness"),
             "steal_ms": [r["attribution"]["steal_ms"] for r in runs],
             "lock_wait_max_ms": _ms(r["lock_wait_max"] for r in runs),
             "lock_wait_p99_ms": _ms(r["lock_wait_p99"] for r in runs),
-            "lock_wait_max_verdict": [r["attribution"]["lock_wait_max_verdict"] for r in runs],
             "mean_rate_hz": round(statistics.median(r["rate"] for r in runs), 2),
             "what": "1 kHz loop drilling the 128^3 phantom headless"
             + ("" if name == "none" else f", the live view serving a {name} camera to a client"),

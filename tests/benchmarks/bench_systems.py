@@ -161,14 +161,12 @@ def _contention_round(seconds: float) -> dict:
             counts["reads"] += 1
             time.sleep(0.001)
 
-    from rt_witness import Witness, loop_phase, realtime_attribution, step_anchors
+    from rt_witness import Witness, anchored, realtime_attribution
 
     loop = ambfplus.RealTimeLoop(world)
     threads = [threading.Thread(target=hog), threading.Thread(target=reader)]
     first_index = world.step_index
-    with Witness() as witness, loop:
-        anchors = step_anchors(world, first_index, 0.02)
-        witness.align(loop_phase(anchors, 1e-3))
+    with Witness() as witness, loop, anchored(world, first_index, witness) as anchors:
         for thread in threads:
             thread.start()
         end = time.monotonic() + seconds
@@ -178,7 +176,6 @@ def _contention_round(seconds: float) -> dict:
         stop.set()
         for thread in threads:
             thread.join()
-        anchors += step_anchors(world, first_index, 0.02)
     s = loop.stats
     return {"lock_wait_max": s["lock_wait_max"], "lock_wait_p99": s["lock_wait_p99"],
             "p99": s["p99"], "max": s["max"], "over_2ms": s["over_2ms"], "rate": s["mean_rate"],
@@ -188,6 +185,8 @@ def _contention_round(seconds: float) -> dict:
 
 
 def python_contention(args) -> Iterator[dict]:
+    from rt_witness import attribution_fields
+
     seconds = 3.0 if args.quick else 8.0
     rounds = [_contention_round(seconds) for _ in range(1 if args.quick else 3)]
     waits = [r["lock_wait_max"] * 1e3 for r in rounds]
@@ -201,12 +200,7 @@ def python_contention(args) -> Iterator[dict]:
         "p99_ms": [round(r["p99"] * 1e3, 4) for r in rounds],
         "max_ms": [round(r["max"] * 1e3, 3) for r in rounds],
         "over_2ms": [r["over_2ms"] for r in rounds],
-        **{
-            f"over_2ms_{whose}": [r["attribution"][f"over_2ms_{whose}"] for r in rounds]
-            for whose in ("host", "ours", "unknown")
-        },
-        "lock_wait_max_verdict": [r["attribution"]["lock_wait_max_verdict"] for r in rounds],
-        "late": [r["attribution"]["late"] for r in rounds],
+        **attribution_fields(rounds),
         "mean_rate_hz": [round(r["rate"], 1) for r in rounds],
         "plugin_updates": [r["updates"] for r in rounds],
         "plugin_events": [r["events"] for r in rounds],

@@ -16,6 +16,7 @@ benchmark (run.py) and the ``foxglove_live`` one (bench_export.py) both call it.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import os
@@ -222,6 +223,32 @@ def step_anchors(world, first_index: int, seconds: float) -> list[tuple[float, i
             seen = index
         if now > end:
             return anchors
+
+
+@contextlib.contextmanager
+def anchored(world, first_index: int, witness=None):
+    """Inside a running RealTimeLoop of `world` (whose first step was `first_index` + 1): the
+    loop's steps against CLOCK_MONOTONIC at the start of the block (then the witness, if given,
+    is put out of the loop's phase) and at its end. Yields the anchors, complete after the
+    block, for realtime_attribution."""
+    anchors = step_anchors(world, first_index, 0.02)
+    if witness is not None:
+        witness.align(loop_phase(anchors, 1e-3))
+    yield anchors
+    anchors += step_anchors(world, first_index, 0.02)
+
+
+def attribution_fields(runs: list[dict]) -> dict:
+    """A benchmark line's per-round attribution fields, from rounds that each hold
+    realtime_attribution's result under "attribution"."""
+    return {
+        **{
+            f"over_2ms_{whose}": [r["attribution"][f"over_2ms_{whose}"] for r in runs]
+            for whose in ("host", "ours", "unknown")
+        },
+        "late": [r["attribution"]["late"] for r in runs],
+        "lock_wait_max_verdict": [r["attribution"]["lock_wait_max_verdict"] for r in runs],
+    }
 
 
 def loop_phase(anchors: list[tuple[float, int]], period: float) -> float:

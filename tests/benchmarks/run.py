@@ -396,7 +396,7 @@ def realtime_session(seconds: float, drilling: bool, witness=None):
     thread's counters; a running witness is put out of the loop's phase)."""
     import threading
 
-    from rt_witness import loop_phase, loop_thread, step_anchors, thread_counters
+    from rt_witness import anchored, loop_thread, thread_counters
 
     world, drill, camera, into = realtime_scene()
     hand = ambfplus.SimulatedDevice()
@@ -412,10 +412,7 @@ def realtime_session(seconds: float, drilling: bool, witness=None):
     loop = ambfplus.RealTimeLoop(world)
     thread = threading.Thread(target=capture)
     first_index = world.step_index
-    with loop:
-        anchors = step_anchors(world, first_index, 0.02)
-        if witness is not None:
-            witness.align(loop_phase(anchors, 1e-3))
+    with loop, anchored(world, first_index, witness) as anchors:
         tid = loop_thread()
         before = thread_counters(tid)
         thread.start()
@@ -432,7 +429,6 @@ def realtime_session(seconds: float, drilling: bool, witness=None):
         stop.set()
         thread.join()
         after = thread_counters(tid)
-        anchors += step_anchors(world, first_index, 0.02)
     counters = {k: round(after[k] - before[k], 3) for k in before if k != "timer_slack_ns"}
     counters["timer_slack_ns"] = before.get("timer_slack_ns")
     return world, drill, binding, loop, frames[0], anchors, counters

@@ -72,6 +72,7 @@ from . import (
 )
 from ._core import OpenXrSession, RenderError, Window, use_x11_display
 from .hmd import HmdError, HmdView, OpenHMD, XrView
+from .recording_schema import replace_text
 from .stereo import StereoRig
 
 # GLFW's codes for the keys and buttons the launcher handles itself.
@@ -644,7 +645,8 @@ def run_window(glfw, args: argparse.Namespace, plugin_args: list[str]) -> int:
                 current = {**status.__dict__, "step": step,
                            "stereo": views.describe(width, height)}  # fmt: skip
                 if current != last_status:
-                    args.status.write_text(json.dumps(current))
+                    # Atomically: whoever reads the status never sees it half written.
+                    replace_text(args.status, json.dumps(current))
                     last_status = current
     session.stop_live()
     session.drain()

@@ -5,6 +5,7 @@ shared by the writer (``recording``), the reader (``recording_reader``) and the 
 from __future__ import annotations
 
 import json
+import os
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -131,6 +132,14 @@ def part_name(head: Path, number: int) -> Path:
 def temporary_name(path: Path) -> Path:
     """Where a file is written before it is renamed into place (atomic on POSIX)."""
     return path.with_name(path.name + ".tmp")
+
+
+def replace_text(path: Path, text: str) -> None:
+    """Writes text to path atomically: to its temporary name, then renamed into place, so that
+    a reader sees the old file or the new one, never a partial one."""
+    tmp = temporary_name(Path(path))
+    tmp.write_text(text)
+    os.replace(tmp, path)
 
 
 def part_number(head: Path, candidate: Path) -> int | None:

@@ -19,6 +19,8 @@ import json
 import os
 from pathlib import Path
 
+from ..recording_schema import replace_text
+
 MANIFEST = "manifest.jsonl"
 # Fields that depend on the run (time, place, retries), not on the spec and the episode.
 RUN_FIELDS = ("seconds", "cpu_seconds", "worker", "attempt")
@@ -98,8 +100,5 @@ class ManifestWriter:
 
 def rewrite_manifest(folder, records: list[dict]) -> None:
     """Replaces the manifest with `records` sorted by episode (atomically)."""
-    path = Path(folder) / MANIFEST
-    tmp = path.with_name(path.name + ".tmp")
     lines = [json.dumps(r, sort_keys=True) for r in sorted(records, key=lambda r: r["episode"])]
-    tmp.write_text("".join(line + "\n" for line in lines))
-    os.replace(tmp, path)
+    replace_text(Path(folder) / MANIFEST, "".join(line + "\n" for line in lines))

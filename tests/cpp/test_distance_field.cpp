@@ -1,0 +1,153 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "ambfplus/errors.h"
+#include "ambfplus/volume/distance_field.h"
+#include "ambfplus/volume/volume_data.h"
+
+namespace ambfplus {
+namespace {
+
+LabelTable anatomy() {
+  return LabelTable({Label{1, "Bone", {200, 200, 200}, true, false},
+                     Label{2, "Facial nerve", {250, 220, 0}, true, true},
+                     Label{3, "Chorda", {250, 120, 0}, true, true}});
+}
+
+// A small anisotropic volume: bone everywhere, a few nerve blobs of labels 2 and 3.
+void fill(VolumeData& v, unsigned seed) {
+  const auto& n = v.shape();
+  v.set_region(VoxelBox{{0, 0, 0}, {n[0], n[1], n[2]}}, 1);
+  std::mt19937 rng(seed);
+  for (int blob = 0; blob < 4; ++blob) {
+    std::array<int, 3> lo, hi;
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::uniform_int_distribution<int>(0, n[a] - 4)(rng);
+      hi[a] = lo[a] + std::uniform_int_distribution<int>(1, 4)(rng);
+    }
+    v.set_region(VoxelBox{lo, hi}, static_cast<std::uint16_t>(2 + blob % 2));
+  }
+}
+
+// Brute force: the signed distance between voxel centres, clamped to the band.
+double brute(const VolumeData& v, int i, int j, int k, double band) {
+  const auto& n = v.shape();
+  const auto in = [&](int a, int b, int c) {
+    const auto l = v.label(a, b, c);
+    return l == 2 || l == 3;
+  };
+  const bool inside = in(i, j, k);
+  const Eigen::Vector3d p = v.voxel_center(i, j, k);
+  double best = std::numeric_limits<double>::infinity();
+  for (int c = 0; c < n[2]; ++c)
+    for (int b = 0; b < n[1]; ++b)
+      for (int a = 0; a < n[0]; ++a)
+        if (in(a, b, c) != inside) best = std::min(best, (v.voxel_center(a, b, c) - p).norm());
+  return std::clamp(inside ? -best : best, -band, band);
+}
+
+TEST(DistanceField, EqualsBruteForceOnAnisotropicVoxels) {
+  VolumeData v({21, 15, 13}, Eigen::Vector3d(0.0042, 0.0045, 0.0026), LabelType::kUInt8, anatomy());
+  fill(v, 7);
+  const double band = 0.0015;
+  DistanceField field(v, {2, 3}, band);
+  const auto& n = v.shape();
+  int inside = 0, clamped = 0, between = 0;
+  for (int k = 0; k < n[2]; ++k)
+    for (int j = 0; j < n[1]; ++j)
+      for (int i = 0; i < n[0]; ++i) {
+        const double want = brute(v, i, j, k, band);
+        ASSERT_NEAR(field.at(i, j, k), want, 1e-9) << i << " " << j << " " << k;
+        inside += want < 0;
+        clamped += want >= band;
+        between += want > 0 && want < band;
+      }
+  // The volume exercises every case: inside, within the band, beyond it.
+  EXPECT_GT(inside, 0);
+  EXPECT_GT(clamped, 0);
+  EXPECT_GT(between, 0);
+}
+
+TEST(DistanceField, UpdatedFieldEqualsAFreshBuild) {
+  VolumeData v({40, 36, 30}, Eigen::Vector3d(0.008, 0.0072, 0.009), LabelType::kUInt8, anatomy());
+  fill(v, 11);
+  v.commit();
+  DistanceField field(v, {2, 3}, 0.001);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> where(-0.0035, 0.0035);
+  std::int64_t recomputed = 0;
+  for (int round = 0; round < 12; ++round) {
+    // Drilling (through nerve and bone alike), a structure grown by an edit, and a reset.
+    if (round == 5) {
+      v.set_region(VoxelBox{{30, 2, 3}, {33, 5, 6}}, 3);
+    } else if (round == 9) {
+      v.reset();
+    } else {
+      v.remove_sphere(Eigen::Vector3d(where(rng), where(rng), where(rng)), 0.0012, false);
+    }
+    recomputed += field.update();
+    const DistanceField fresh(v, {2, 3}, 0.001);
+    EXPECT_EQ(field.structure_voxels(), fresh.structure_voxels()) << round;
+    const auto a = field.values(), b = fresh.values();
+    ASSERT_EQ(a.size(), b.size());
+    for (std::size_t s = 0; s < a.size(); ++s) ASSERT_NEAR(a[s], b[s], 1e-9) << round << " " << s;
+  }
+  EXPECT_GT(recomputed, 0);
+  EXPECT_EQ(field.revision(), v.revision());
+}
+
+TEST(DistanceField, EditsThatLeaveTheStructureCostNothing) {
+  VolumeData v({24, 24, 24}, Eigen::Vector3d(0.006, 0.006, 0.006), LabelType::kUInt8, anatomy());
+  v.set_region(VoxelBox{{0, 0, 0}, {24, 24, 24}}, 1);
+  v.set_region(VoxelBox{{2, 2, 2}, {4, 4, 4}}, 2);
+  DistanceField field(v, {2}, 0.002);
+  // Bone far from the nerve: nothing of the structure changes.
+  v.remove_sphere(Eigen::Vector3d(0.002, 0.002, 0.002), 0.0008, false);
+  EXPECT_EQ(field.update(), 0);
+  EXPECT_EQ(field.revision(), v.revision());
+  EXPECT_EQ(field.structure_voxels(), 8);
+}
+
+TEST(DistanceField, SamplesInterpolateAndPointAwayFromTheStructure) {
+  VolumeData v({31, 31, 31}, Eigen::Vector3d(0.0031, 0.0031, 0.0031), LabelType::kUInt8, anatomy());
+  v.set_region(VoxelBox{{15, 15, 15}, {16, 16, 16}}, 2);
+  DistanceField field(v, {2}, 0.001);
+  // At voxel centres the sample is the stored value.
+  for (auto c : {std::array<int, 3>{15, 15, 15}, {18, 15, 15}, {17, 19, 14}}) {
+    EXPECT_NEAR(field.sample(v.voxel_center(c[0], c[1], c[2])).distance, field.at(c[0], c[1], c[2]),
+                1e-12);
+  }
+  // Near the point structure the field is a cone: the gradient points away from it with a
+  // length close to one, and the distance grows along it.
+  const Eigen::Vector3d centre = v.voxel_center(15, 15, 15);
+  for (const Eigen::Vector3d& dir :
+       {Eigen::Vector3d(1, 0.3, -0.2), Eigen::Vector3d(-0.4, 1, 0.5)}) {
+    const Eigen::Vector3d p = centre + 0.00043 * dir.normalized();
+    const DistanceSample s = field.sample(p);
+    EXPECT_NEAR(s.distance, 0.00043, 0.0001);
+    EXPECT_GT(s.gradient.normalized().dot(dir.normalized()), 0.9);
+    EXPECT_NEAR(s.gradient.norm(), 1.0, 0.25);
+  }
+  // Far away the field is clamped to the band, with no gradient.
+  const DistanceSample far = field.sample(v.voxel_center(2, 2, 2));
+  EXPECT_DOUBLE_EQ(far.distance, 0.001);
+  EXPECT_EQ(far.gradient, Eigen::Vector3d::Zero());
+}
+
+TEST(DistanceField, RefusesBadArguments) {
+  VolumeData v({4, 4, 4}, Eigen::Vector3d(0.004, 0.004, 0.004), LabelType::kUInt8, anatomy());
+  EXPECT_THROW(DistanceField(v, {}, 0.001), ArgumentError);
+  EXPECT_THROW(DistanceField(v, {0}, 0.001), ArgumentError);
+  EXPECT_THROW(DistanceField(v, {2}, 0.0), ArgumentError);
+  EXPECT_THROW(DistanceField(v, {2}, std::nan("")), ArgumentError);
+  const DistanceField empty(v, {2}, 0.001);
+  EXPECT_EQ(empty.structure_voxels(), 0);
+  EXPECT_DOUBLE_EQ(empty.at(1, 2, 3), 0.001);
+  EXPECT_THROW(empty.at(4, 0, 0), OutOfRange);
+}
+
+}  // namespace
+}  // namespace ambfplus

@@ -111,23 +111,26 @@ def record_episode(spec_data: dict, index: int, path, plan: EpisodePlan | None =
     label_colors = jitter_label_colors(table, plan.label_color_jitter, plan.rngs["colors"])
     scene = drilling_scene(**plan.scene, label_colors=label_colors)
     target = np.asarray(scene.target)
-    path_plan = dataclasses.replace(
-        plan.camera_path, target=tuple(float(v) for v in target + plan.camera_path.target)
-    )
+    x, y, z = target + plan.camera_path.target
+    path_plan = dataclasses.replace(plan.camera_path, target=(float(x), float(y), float(z)))
     seconds = plan.frames * plan.capture_every * scene.world.time_step
+    device: NullDevice | ScriptedDevice
     device, motion = (
         NullDevice(),
         (path_plan if path_plan.azimuth_swing or path_plan.elevation_swing else None),
     )
-    scene.rig.aim(*path_plan(0.0))
+    rig = scene.rig
+    assert rig is not None, "a drilling scene has a stereo rig"
+    rig.aim(*path_plan(0.0))
     if plan.scenario["kind"] in ("drilling", "mixed"):
         drill = scene.drill
         script = DrillScript(
             drill.volume, drill.goal[:3, 3], drill.burr_radius, plan.rngs["motion"]
         )
         script.plunge_until(seconds)
-        device = ScriptedDevice()
-        device.set_callback(script, every=10)
+        scripted = ScriptedDevice()
+        scripted.set_callback(script, every=10)
+        device = scripted
     counter = _LabelCounter(table)
     noise = _RgbNoise(plan.rgb_noise)
     sampled = plan.describe()
@@ -175,7 +178,7 @@ class _LabelCounter:
 
     def __init__(self, table) -> None:
         self.names = {label.id: label.name for label in table}
-        self.counts = np.zeros(1, dtype=np.int64)
+        self.counts: np.ndarray = np.zeros(1, dtype=np.int64)
 
     def __call__(self, pair: StereoFrame) -> StereoFrame:
         for frame in (pair.left, pair.right):

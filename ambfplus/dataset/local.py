@@ -26,7 +26,7 @@ import traceback
 from collections import deque
 from collections.abc import Iterator
 from dataclasses import dataclass, field
-from multiprocessing.connection import wait
+from multiprocessing.connection import Connection, wait
 
 from .executor import Done, Executor, Failed, Retry, WorkerStartError
 
@@ -98,7 +98,7 @@ def _worker_main(
 class _Slot:
     number: int
     process: multiprocessing.Process
-    connection: object
+    connection: Connection
     task: tuple[int, int] | None = None
     since: float = field(default_factory=time.monotonic)
     ready: bool = False

@@ -17,6 +17,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+from functools import partial
 from pathlib import Path
 
 from ..recording_schema import replace_text
@@ -43,7 +44,7 @@ def shard_checksum(files) -> tuple[str, int]:
     digest, size = hashlib.sha256(), 0
     for file in files:
         with open(file, "rb") as f:
-            for block in iter(lambda f=f: f.read(1 << 20), b""):
+            for block in iter(partial(f.read, 1 << 20), b""):
                 digest.update(block)
                 size += len(block)
     return digest.hexdigest(), size

@@ -18,6 +18,7 @@ import time
 from collections import deque
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 from .executor import Done, Executor, Failed, Retry
 
@@ -98,7 +99,7 @@ class RayExecutor(Executor):
         self.address = address
         self.cpus, self.gpus = float(cpus), float(gpus)
         self.init_options = dict(init_options or {})
-        self._ray = None
+        self._ray: Any = None
         self._resources: dict = {}
 
     def connect(self) -> None:
@@ -128,7 +129,7 @@ class RayExecutor(Executor):
         self._resources = ray.cluster_resources()
 
     def describe(self) -> dict:
-        nodes = [n for n in self._ray.nodes() if n.get("Alive")] if self._ray else []
+        nodes: list = [n for n in self._ray.nodes() if n.get("Alive")] if self._ray else []
         return {
             "executor": self.name,
             "address": self.address,

@@ -221,7 +221,11 @@ def _lights(spec: dict | None, rng: np.random.Generator) -> list | None:
 
 
 def _materials(appearance: dict, rng: np.random.Generator) -> dict:
-    out = {"volume_material": None, "drill_metal": None, "drill_handle": None}
+    out: dict[str, dict | None] = {
+        "volume_material": None,
+        "drill_metal": None,
+        "drill_handle": None,
+    }
     material = appearance.get("material")
     if material:
         out["volume_material"] = {k: draw(v, rng) for k, v in material.items()}

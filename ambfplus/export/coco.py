@@ -152,7 +152,8 @@ def write_coco(recording, out: Path, bar, *, images: bool = True) -> dict:
         "(c + 0.5, r + 0.5); pose is world-from-camera, OpenCV camera axes",
     }
     for stream in export.streams:
-        image_entries, annotations = [], []
+        image_entries: list[dict] = []
+        annotations: list[dict] = []
         if images and stream.rgb is not None:
             (out / stream.name).mkdir()
         for index in range(len(stream)):

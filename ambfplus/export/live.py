@@ -40,6 +40,7 @@ import threading
 import time
 from collections import deque
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -138,7 +139,8 @@ class FoxgloveServer:
     def start(self) -> FoxgloveServer:
         fox = self._foxglove
         self._context = fox.Context()
-        self._channels, self._msgtypes = {}, {}
+        self._channels: dict[str, Any] = {}
+        self._msgtypes: dict[str, Any] = {}
         for camera in self.cameras:
             self._channel(f"/{camera.name}/image_rect_color", IMAGE)
             self._channel(f"/{camera.name}/camera_info", CAMERA_INFO)

@@ -173,11 +173,12 @@ def point_cloud(time_ns: int, frame: str, columns: dict, height: int, width: int
              "k": ("<i4", INT32), "instance": ("<i4", INT32), "label": ("<u2", UINT16)}  # fmt: skip
     names = [n for n in kinds if n in columns]
     dtype = np.dtype([(n, kinds[n][0]) for n in names])
+    offsets = {n: dtype.fields[n][1] for n in names} if dtype.fields else {}
     packed = np.empty(height * width, dtype=dtype)
     fields = []
     for name in names:
         packed[name] = np.asarray(columns[name]).reshape(-1)
-        fields.append({"name": name, "offset": dtype.fields[name][1],
+        fields.append({"name": name, "offset": offsets[name],
                        "datatype": kinds[name][1], "count": 1})  # fmt: skip
     has_nan = any(np.isnan(packed[n]).any() for n in ("x", "y", "z") if n in names)
     return {
@@ -532,7 +533,7 @@ class RosExport:
         for event in events:
             by_step.setdefault(event["step"], []).append(event)
         for step in sorted(by_step):
-            t = nanoseconds(self.clock([step])[0])
+            t = nanoseconds(float(self.clock([step])[0]))
             statuses = []
             for event in by_step[step]:
                 name = (labels.get(event["label"]) or {}).get("name", f"label {event['label']}")
@@ -703,6 +704,7 @@ def write_ros(recording, out: Path, kind: str, bar, *, point_clouds: bool = True
     export = RosExport(recording, point_clouds=point_clouds, image_topics=image_topics,
                        rgb_codec=rgb_codec, jpeg_quality=jpeg_quality)  # fmt: skip
     topics = export.topics()
+    sink: McapSink | Rosbag2Sink
     if kind == "mcap":
         sink = McapSink(out, compression)
     else:

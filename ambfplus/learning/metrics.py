@@ -23,8 +23,8 @@ def disparity_metrics(
             f"shapes differ: predicted {predicted.shape}, truth {truth.shape}, mask {mask.shape}"
         )
     error = np.abs(predicted[mask] - truth[mask])
-    z_true = depth_from_disparity(truth[mask], focal, baseline, dcx).astype(np.float64)
-    z = depth_from_disparity(predicted[mask], focal, baseline, dcx).astype(np.float64)
+    z_true: np.ndarray = depth_from_disparity(truth[mask], focal, baseline, dcx).astype(np.float64)
+    z: np.ndarray = depth_from_disparity(predicted[mask], focal, baseline, dcx).astype(np.float64)
     # A disparity at or beyond infinity (d + dcx <= 0) has no depth: count it at 1 m, far
     # beyond the anatomy, rather than dropping it.
     z[z <= 0] = 1.0

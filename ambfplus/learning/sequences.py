@@ -57,6 +57,7 @@ def record_sequence(
     spec = sequence_spec(kind, frames, width, height, resolution, capture_every, seed)
     scene = drilling_phantom(resolution=resolution, width=width, height=height)
     seconds = frames * capture_every * scene.world.time_step
+    device: NullDevice | ScriptedDevice
     if kind == MOVING_CAMERA:
         device, motion = NullDevice(), orbit_view
     else:
@@ -65,8 +66,9 @@ def record_sequence(
             drill.volume, drill.goal[:3, 3], drill.burr_radius, np.random.default_rng(seed)
         )
         script.plunge_until(seconds)
-        device, motion = ScriptedDevice(), None
-        device.set_callback(script, every=10)
+        scripted = ScriptedDevice()
+        scripted.set_callback(script, every=10)
+        device, motion = scripted, None
     return record_session(
         scene, path, device, seconds, capture_every=capture_every, passes=PASSES,
         camera_motion=motion, metadata={"sequence": spec}, progress=progress,

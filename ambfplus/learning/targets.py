@@ -60,14 +60,18 @@ def occlusion_mask(
             f"{left_depth.shape} and {right_depth.shape}"
         )
     height, width = left_depth.shape
-    disparity = disparity_from_depth(left_depth, focal, baseline, dcx).astype(np.float64)
+    disparity: np.ndarray = disparity_from_depth(left_depth, focal, baseline, dcx).astype(
+        np.float64
+    )
     hit = left_depth > 0
     x_right = np.arange(width)[None, :] + 0.5 - disparity
     column = np.floor(x_right).astype(np.int64)
     inside = (column >= 0) & (column < width)
     rows = np.broadcast_to(np.arange(height)[:, None], (height, width))
     seen_depth = right_depth[rows, np.clip(column, 0, width - 1)]
-    seen_disparity = disparity_from_depth(seen_depth, focal, baseline, dcx).astype(np.float64)
+    seen_disparity: np.ndarray = disparity_from_depth(seen_depth, focal, baseline, dcx).astype(
+        np.float64
+    )
     nearer = (seen_depth > 0) & (seen_disparity > disparity + tolerance_px)
     return hit & (~inside | nearer)
 

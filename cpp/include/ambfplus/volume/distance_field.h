@@ -1,5 +1,6 @@
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -46,6 +47,12 @@ class AMBFPLUS_API DistanceField {
   /// structure voxels changed since, and returns the number of voxels recomputed (0 when no
   /// edit touched the structure).
   std::int64_t update();
+
+  /// Declares that the volume's edits up to `revision` changed none of the structure's voxels,
+  /// for a caller that knows what each edit removed (the skill metrics, told a tick's removed
+  /// voxels and their labels): the scan of those edits' boxes is skipped. An edit it vouches for
+  /// wrongly is not seen until the next full rebuild.
+  void skip_to(std::int64_t revision) { revision_ = std::max(revision_, revision); }
 
   /// The volume revision the field reflects.
   std::int64_t revision() const { return revision_; }

@@ -106,6 +106,14 @@ def cpp_hooks(path: Path):
             doc = []
 
 
+def _flush(group: list[tuple[str, str]], out: list[str]) -> None:
+    for doc, code in group:
+        out.append(f"```c\n{code}\n```\n")
+        if doc:
+            out.append(doc + "\n")
+    group.clear()
+
+
 def render(root: Path) -> str:
     out = []
     for header in HEADERS:
@@ -114,16 +122,9 @@ def render(root: Path) -> str:
         current = None
         group: list[tuple[str, str]] = []
 
-        def flush():
-            for doc, code in group:
-                out.append(f"```c\n{code}\n```\n")
-                if doc:
-                    out.append(doc + "\n")
-            group.clear()
-
         for section, doc, code in declarations(path):
             if section != current:
-                flush()
+                _flush(group, out)
                 if section:
                     out.append(f"### {section}\n")
                 current = section
@@ -133,7 +134,7 @@ def render(root: Path) -> str:
                 group[-1] = (prev_doc, prev_code + "\n" + code)
             else:
                 group.append((doc, code))
-        flush()
+        _flush(group, out)
     out.append("## C++ hooks: `ambfplus::plugin::Plugin`\n")
     out.append("| hook | when it runs |\n|---|---|")
     for signature, doc in cpp_hooks(root / HEADERS[0]):

@@ -7,6 +7,7 @@ A page marks a generated part with an HTML comment on a line of its own:
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 import tempfile
@@ -26,6 +27,7 @@ def _cli_reference() -> str:
         result = subprocess.run(
             [sys.executable, str(HERE / "cli_reference.py")],
             cwd=neutral,
+            env={**os.environ, "COLUMNS": "100"},  # usage lines wrap the same everywhere
             capture_output=True,
             text=True,
         )

@@ -25,7 +25,10 @@ from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
+# The checkout's root: the folder above this file that holds pyproject.toml (tests may be regrouped
+# into subfolders).
+HERE = Path(__file__).resolve()
+ROOT = next((p for p in HERE.parents if (p / "pyproject.toml").is_file()), HERE.parents[1])
 DOCS_MODULES = (
     "mkdocs",
     "material",

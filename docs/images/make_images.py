@@ -22,7 +22,8 @@ from PIL import Image
 
 ROOT = Path(__file__).resolve().parents[2]
 IMAGES = ROOT / "docs" / "images"
-sys.path.insert(0, str(ROOT / "tests"))
+# The launcher tests' X11 helpers (tests/x11.py, or tests/helpers/x11.py once tests are grouped).
+sys.path[:0] = [str(ROOT / "tests" / "helpers"), str(ROOT / "tests")]
 
 from x11 import finish, launch, screenshot, window_origin, xdo  # noqa: E402
 

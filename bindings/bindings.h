@@ -37,6 +37,7 @@ void declare_scene(pybind11::module_& m);
 void declare_physics(pybind11::module_& m);
 void declare_haptics(pybind11::module_& m);
 void declare_adf(pybind11::module_& m);
+void declare_training(pybind11::module_& m);
 
 void define_io(pybind11::module_& m);
 void define_render(pybind11::module_& m);
@@ -46,6 +47,7 @@ void define_scene(pybind11::module_& m);
 void define_physics(pybind11::module_& m);
 void define_haptics(pybind11::module_& m);
 void define_adf(pybind11::module_& m);
+void define_training(pybind11::module_& m);
 
 void register_plugin(pybind11::module_& m);
 
@@ -66,6 +68,11 @@ template <typename T>
 std::shared_ptr<T> handle(T* p) {
   return std::shared_ptr<T>(p->world().simulator().shared_from_this(), p);
 }
+
+/// Label ids of a structure named by a label name or id, or a list of them (resolve_label's
+/// rule; `what` names the caller in errors).
+std::vector<std::uint16_t> structure_labels(const VolumeData& data, const pybind11::handle& labels,
+                                            const std::string& what);
 
 /// ambfplus.PluginError, the Python class (set when the module is made).
 PyObject* plugin_error_type();

@@ -15,6 +15,7 @@
 #include "ambfplus/errors.h"
 #include "ambfplus/render/render_stats.h"
 #include "ambfplus/scene/simulator.h"
+#include "ambfplus/volume/distance_field.h"
 #include "ambfplus/volume/phantom.h"
 #include "ambfplus/volume/volume_io.h"
 #include "bindings.h"
@@ -138,6 +139,26 @@ void declare_volume(py::module_& m) {
   py::class_<VolumeData, std::shared_ptr<VolumeData>>(
       m, "VolumeData",
       "A segmented volume: label grid (a view, indexed [i, j, k]), label table, size, edits.");
+  py::class_<DistanceField, std::shared_ptr<DistanceField>>(
+      m, "DistanceField",
+      "The exact signed distance (metres) from every voxel centre of a volume to a structure, "
+      "clamped to a band; brought up to date by update() as the volume is edited.");
+}
+
+std::vector<std::uint16_t> structure_labels(const VolumeData& data, const py::handle& labels,
+                                            const std::string& what) {
+  std::vector<std::uint16_t> ids;
+  auto add = [&](const py::handle& item) {
+    const std::string name = py::isinstance<py::str>(item) ? item.cast<std::string>()
+                                                           : std::to_string(item.cast<long long>());
+    ids.push_back(resolve_label(data.label_table(), name, what));
+  };
+  if (py::isinstance<py::str>(labels) || py::isinstance<py::int_>(labels)) {
+    add(labels);
+  } else {
+    for (const py::handle item : labels) add(item);
+  }
+  return ids;
 }
 
 void define_volume(py::module_& m) {
@@ -438,6 +459,77 @@ void define_volume(py::module_& m) {
         write_label_table(path.string(), LabelTable(labels));
       },
       py::arg("path"), py::arg("labels"));
+
+  bound<DistanceField, std::shared_ptr<DistanceField>>(m, "DistanceField")
+      .def(py::init(
+               [](const std::shared_ptr<VolumeData>& data, const py::handle& labels, double band) {
+                 auto ids = structure_labels(*data, labels, "DistanceField");
+                 py::gil_scoped_release release;
+                 return std::make_shared<DistanceField>(*data, std::move(ids), band);
+               }),
+           py::arg("volume"), py::arg("labels"), py::arg("band") = 0.005, py::keep_alive<1, 2>(),
+           "The field of the structure made of `labels` (names or ids, one or a list) in "
+           "`volume`, clamped to `band` metres.")
+      .def(
+          "update",
+          [](DistanceField& f) {
+            py::gil_scoped_release release;
+            return f.update();
+          },
+          "Brings the field up to the volume's edits; returns the voxels recomputed.")
+      .def_property_readonly("revision", &DistanceField::revision)
+      .def_property_readonly("band", &DistanceField::band)
+      .def_property_readonly("labels", &DistanceField::labels)
+      .def_property_readonly("structure_voxels", &DistanceField::structure_voxels)
+      .def("at", &DistanceField::at, py::arg("i"), py::arg("j"), py::arg("k"),
+           "The signed distance at voxel (i, j, k)'s centre (metres).")
+      .def(
+          "sample",
+          [](const DistanceField& f,
+             const py::array_t<double, py::array::c_style | py::array::forcecast>& points)
+              -> py::object {
+            if (points.ndim() == 1 && points.shape(0) == 3) {
+              const DistanceSample s =
+                  f.sample(Eigen::Vector3d(points.at(0), points.at(1), points.at(2)));
+              py::array_t<double> g(3);
+              for (int a = 0; a < 3; ++a) g.mutable_at(a) = s.gradient[a];
+              return py::make_tuple(s.distance, g);
+            }
+            if (points.ndim() != 2 || points.shape(1) != 3) {
+              throw ArgumentError("DistanceField.sample: expected a point (3,) or points (N, 3)");
+            }
+            const py::ssize_t n = points.shape(0);
+            py::array_t<double> d(n), g({n, py::ssize_t(3)});
+            const double* p = points.data();
+            double* dp = d.mutable_data();
+            double* gp = g.mutable_data();
+            {
+              py::gil_scoped_release release;
+              for (py::ssize_t r = 0; r < n; ++r) {
+                const DistanceSample s =
+                    f.sample(Eigen::Vector3d(p[3 * r], p[3 * r + 1], p[3 * r + 2]));
+                dp[r] = s.distance;
+                for (int a = 0; a < 3; ++a) gp[3 * r + a] = s.gradient[a];
+              }
+            }
+            return py::make_tuple(d, g);
+          },
+          py::arg("points"),
+          "(distance, gradient) at a volume-frame point (3,), or arrays for points (N, 3): "
+          "trilinear in the voxel-centre values, with that interpolant's gradient.")
+      .def(
+          "values",
+          [](const DistanceField& f) {
+            auto values = std::make_unique<std::vector<float>>(f.values());
+            const auto& n = f.volume().shape();
+            float* data = values->data();
+            py::capsule owner(values.release(),
+                              [](void* v) { delete static_cast<std::vector<float>*>(v); });
+            const py::ssize_t s = sizeof(float);
+            return py::array_t<float>({py::ssize_t(n[0]), py::ssize_t(n[1]), py::ssize_t(n[2])},
+                                      {s, s * n[0], s * n[0] * n[1]}, data, owner);
+          },
+          "The signed distance of every voxel as a (nx, ny, nz) float32 array (a copy).");
 }
 
 }  // namespace ambfplus::bindings

@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "ambfplus/errors.h"
 #include "ambfplus/training/skill_metrics.h"
@@ -181,6 +183,55 @@ TEST(SkillMetrics, CuttingForceStatistics) {
   EXPECT_NEAR(sum.cutting_force_p95, 95.0, 1e-9);
   EXPECT_NEAR(sum.cutting_force_max, 100.0, 1e-9);
   EXPECT_NEAR(sum.time_above_excess_force, 0.020, 1e-12);
+}
+
+// Offline equals live: ticks replayed onto a fresh copy of the anatomy, the metrics removing
+// each tick's voxels themselves, give the summary the live metrics gave.
+TEST(SkillMetrics, ReplayOntoAFreshAnatomyEqualsLive) {
+  const auto live_block = bone_block(), fresh_block = bone_block();
+  VolumeData& live = *live_block;
+  VolumeData& fresh = *fresh_block;
+  for (VolumeData* v : {&live, &fresh}) v->set_region(VoxelBox{{20, 20, 0}, {22, 22, 40}}, 2);
+  MetricsConfig config;
+  config.protect = {{"facial nerve", {2}, 0.0008}};
+  config.target_labels = {1};
+  SkillMetrics online(live, config);
+  std::vector<ToolTick> ticks;
+  for (int s = 0; s < 300; ++s) {
+    // Down a column of bone beside the nerve, then into it.
+    const int i = 12 + s / 30;
+    ToolTick t = tick_at(s, live.voxel_center(i, 20, 20), s % 3 != 0, 1.0 + 0.01 * s);
+    if (t.removed.empty()) {
+      t.removed_labels.clear();
+    } else {
+      t.removed = {{i, 20, 20}, {i, 21, 20}};
+      t.removed_labels = live.remove_voxels(t.removed);
+    }
+    online.add(t);
+    ticks.push_back(t);
+  }
+  config.apply_removals = true;
+  SkillMetrics offline(fresh, config);
+  for (const ToolTick& t : ticks) offline.add(t);
+  const MetricsSummary a = online.summary(), b = offline.summary();
+  ASSERT_GT(a.structures.at(0).voxels_removed, 0);
+  EXPECT_EQ(a.structures[0].voxels_removed, b.structures[0].voxels_removed);
+  EXPECT_EQ(a.structures[0].contacts, b.structures[0].contacts);
+  EXPECT_EQ(a.structures[0].closest, b.structures[0].closest);
+  EXPECT_EQ(a.structures[0].closest_step, b.structures[0].closest_step);
+  EXPECT_EQ(a.structures[0].time_in_margin, b.structures[0].time_in_margin);
+  EXPECT_EQ(a.removed_by_label, b.removed_by_label);
+  EXPECT_EQ(a.strokes.size(), b.strokes.size());
+  EXPECT_EQ(a.cutting_force_p95, b.cutting_force_p95);
+  // Replaying onto an anatomy that differs is refused, naming the step and the voxel.
+  const auto other_block = bone_block();
+  SkillMetrics wrong(*other_block, config);
+  try {
+    for (const ToolTick& t : ticks) wrong.add(t);
+    FAIL() << "a replay onto another anatomy was accepted";
+  } catch (const StateError& e) {
+    EXPECT_NE(std::string(e.what()).find("another anatomy"), std::string::npos) << e.what();
+  }
 }
 
 TEST(SkillMetrics, RefusesContradictions) {

@@ -22,7 +22,7 @@ void check_non_negative(double value, const std::string& what) {
 
 }  // namespace
 
-SkillMetrics::SkillMetrics(const VolumeData& volume, MetricsConfig config)
+SkillMetrics::SkillMetrics(VolumeData& volume, MetricsConfig config)
     : volume_(volume), config_(std::move(config)), in_target_(65536, false) {
   check_non_negative(config_.excess_force, "excess_force");
   check_non_negative(config_.stroke_gap, "stroke_gap");
@@ -68,6 +68,19 @@ void SkillMetrics::close(OpenStroke& open, std::vector<Stroke>& strokes) {
 void SkillMetrics::add(const ToolTick& tick) {
   if (tick.removed.size() != tick.removed_labels.size()) {
     throw ArgumentError("SkillMetrics: a tick's removed voxels and their labels differ in count");
+  }
+  if (config_.apply_removals && !tick.removed.empty()) {
+    const std::vector<std::uint16_t> had = volume_.remove_voxels(tick.removed, "replay");
+    for (std::size_t r = 0; r < had.size(); ++r) {
+      if (had[r] == tick.removed_labels[r] || tick.removed_labels[r] == 0) continue;
+      const auto& v = tick.removed[r];
+      std::ostringstream message;
+      message << "SkillMetrics: step " << tick.step << " removed voxel (" << v[0] << ", " << v[1]
+              << ", " << v[2] << ") with label " << tick.removed_labels[r]
+              << ", but the volume holds " << had[r]
+              << " there: the recording was made on another anatomy";
+      throw StateError(message.str());
+    }
   }
   ++sum_.ticks;
   sum_.total_time += tick.dt;

@@ -44,6 +44,28 @@ const Label* LabelTable::find(const std::string& name) const {
   return nullptr;
 }
 
+std::uint16_t resolve_label(const LabelTable& table, const std::string& name,
+                            const std::string& what) {
+  if (const Label* l = table.find(name)) return l->id;
+  // An id written as a number.
+  if (!name.empty() && name.find_first_not_of("0123456789") == std::string::npos &&
+      name.size() < 6) {
+    const long id = std::stol(name);
+    if (id > 0 && id <= 65535 && table.find(static_cast<std::uint16_t>(id))) {
+      return static_cast<std::uint16_t>(id);
+    }
+  }
+  std::ostringstream message;
+  message << what << ": no label '" << name << "' in the volume's table; it has";
+  const char* sep = " ";
+  for (const Label& l : table.labels()) {
+    message << sep << l.id << " '" << l.name << "'";
+    sep = ", ";
+  }
+  if (table.empty()) message << " no labels";
+  throw NotFound(message.str());
+}
+
 std::uint16_t LabelTable::max_id() const {
   std::uint16_t m = 0;
   for (const Label& l : labels_) m = std::max(m, l.id);

@@ -38,6 +38,9 @@ struct AMBFPLUS_API MetricsConfig {
   double turn_angle = 0.7853981633974483;
   /// Distance fields reach this far (metres) beyond the largest margin.
   double field_band = 0.005;
+  /// Offline: the metrics remove each tick's voxels from their volume themselves (a copy of the
+  /// anatomy as the recording began), so that the fields follow the drilling as they did live.
+  bool apply_removals = false;
 };
 
 /// One haptic tick as the metrics see it.
@@ -119,9 +122,10 @@ class AMBFPLUS_API SkillMetrics {
  public:
   /// Throws ArgumentError for a structure without labels, a negative or non-finite margin or
   /// threshold, or two structures with one name.
-  SkillMetrics(const VolumeData& volume, MetricsConfig config);
+  SkillMetrics(VolumeData& volume, MetricsConfig config);
 
-  /// Adds one tick (ticks come in order of step).
+  /// Adds one tick (ticks come in order of step). With apply_removals, throws StateError when a
+  /// removed voxel's recorded label is not the one the volume holds (another anatomy).
   void add(const ToolTick& tick);
   /// The metrics so far (closes any stroke in progress in the copy it returns).
   MetricsSummary summary() const;
@@ -148,7 +152,7 @@ class AMBFPLUS_API SkillMetrics {
   };
   static void close(OpenStroke& open, std::vector<Stroke>& strokes);
 
-  const VolumeData& volume_;
+  VolumeData& volume_;
   MetricsConfig config_;
   std::vector<bool> in_target_;  // by label id
   std::vector<Watch> watches_;

@@ -57,6 +57,7 @@ class AMBFPLUS_API DistanceField {
   /// The volume revision the field reflects.
   std::int64_t revision() const { return revision_; }
   double band() const { return band_; }
+  const VolumeData& volume() const { return data_; }
   const std::vector<std::uint16_t>& labels() const { return labels_; }
   /// Structure voxels the field was last built or updated from.
   std::int64_t structure_voxels() const { return structure_voxels_; }

@@ -43,6 +43,12 @@ class AMBFPLUS_API LabelTable {
   std::vector<Label> labels_;
 };
 
+/// The id of a structure named by its label name or by its id written as a number ("3"), for
+/// every caller that lets users name structures (distance fields, metrics, tasks). Throws
+/// NotFound naming `what` and the table's names when there is no such label.
+AMBFPLUS_API std::uint16_t resolve_label(const LabelTable& table, const std::string& name,
+                                         const std::string& what);
+
 /// Reads a label table from CSV or YAML (by extension). CSV: a header row, then rows of
 /// `name,r,g,b` (ids 1, 2, ... in file order) or with an `id` column and optional `removable` and
 /// `critical` columns. YAML: a list (or `labels:` list) of {id, name, color: [r, g, b], removable,

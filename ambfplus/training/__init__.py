@@ -1,0 +1,28 @@
+"""Training: skill metrics, scripted trainees and (to come) tasks, assessment and reports.
+
+The metrics themselves are computed by the engine (``ambfplus.SkillMetrics``), live in the
+haptic loop and offline from a recording through the same code; the structures they watch are
+``ambfplus.DistanceField`` objects that follow the drilling.
+"""
+
+from .trainees import (
+    EXPERT,
+    NOVICE,
+    ProtectedField,
+    ScriptedTrainee,
+    TraineeStyle,
+    TrainingRegion,
+    expert_like,
+    novice_like,
+)
+
+__all__ = [
+    "EXPERT",
+    "NOVICE",
+    "ProtectedField",
+    "ScriptedTrainee",
+    "TraineeStyle",
+    "TrainingRegion",
+    "expert_like",
+    "novice_like",
+]

@@ -1,0 +1,313 @@
+"""Scripted trainees: seeded drilling policies that behave like a careful expert or like a
+novice, for tests, benchmarks and demos of the training tools.
+
+A trainee is a ``ScriptedDevice`` callback (``device.set_callback(trainee)``), like the
+scenes' ``DrillScript``: it returns the hand's position in the device frame (world axes, metres
+from the drill's start) and its buttons (bit 0 spins the burr). It plans the whole session up
+front from the anatomy as it is when planning starts:
+
+- **expert-like**: broad strokes across the target region, layer by layer, each layer a little
+  narrower than the one above (saucerisation), the burr centre kept clear of every protected
+  structure by its margin and a little more (checked on the structures' distance fields), and a
+  light touch (the hand leads the bone surface by a fraction of a millimetre);
+- **novice-like**: plunges at random sites, deep and narrow, pressing hard, with short wiggles
+  instead of strokes, and now and then drifting toward a protected structure, ignoring margins.
+
+Every parameter is drawn from the style's ranges with the trainee's random generator, so each
+seed gives its own session.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .._core import DistanceField
+
+
+@dataclass(frozen=True)
+class TraineeStyle:
+    """How a trainee drills: each value is a (low, high) range drawn once per trainee."""
+
+    name: str
+    #: Depth removed per pass (metres), and the burr's sink per plunge for a plunging style.
+    layer_depth: tuple[float, float]
+    #: Hand speed while cutting (metres per second).
+    speed: tuple[float, float]
+    #: How far the hand leads the bone surface into the bone (metres): the force it presses with.
+    press: tuple[float, float]
+    #: Extra clearance (metres) beyond each protected structure's margin; negative ignores it.
+    clearance: tuple[float, float]
+    #: Chance per stroke or plunge of aiming at the nearest protected structure.
+    drift: tuple[float, float]
+    #: Broad strokes across the region (True) or plunges at sites (False).
+    strokes: bool
+    #: Spacing of strokes as a fraction of the burr's radius.
+    spacing: tuple[float, float] = (0.8, 1.0)
+
+
+EXPERT = TraineeStyle(
+    name="expert",
+    layer_depth=(0.0003, 0.0005),
+    speed=(0.004, 0.007),
+    press=(0.0001, 0.0003),
+    clearance=(0.0003, 0.0006),
+    drift=(0.0, 0.0),
+    strokes=True,
+)
+
+NOVICE = TraineeStyle(
+    name="novice",
+    layer_depth=(0.0025, 0.0045),
+    speed=(0.010, 0.018),
+    press=(0.0008, 0.0015),
+    clearance=(-1.0, -1.0),
+    drift=(0.25, 0.45),
+    strokes=False,
+)
+
+
+@dataclass
+class ProtectedField:
+    """A structure the trainee keeps (or fails to keep) clear of."""
+
+    name: str
+    field: DistanceField
+    margin: float
+
+
+@dataclass
+class TrainingRegion:
+    """Where the trainee works, in the volume frame (metres): a box across the lateral surface
+    (x, y half-extents about a centre) down to `depth` below the surface, narrowing by `taper`
+    per metre of depth (saucerisation)."""
+
+    center: tuple[float, float] = (0.0, 0.0)
+    half_extent: tuple[float, float] = (0.006, 0.006)
+    depth: float = 0.004
+    taper: float = 0.8
+
+
+@dataclass
+class _Plan:
+    waypoints: list[tuple[float, np.ndarray, int]] = field(default_factory=list)
+
+    @property
+    def end(self) -> float:
+        return self.waypoints[-1][0] if self.waypoints else 0.0
+
+    def go(self, dt: float, where: np.ndarray, buttons: int) -> None:
+        self.waypoints.append((self.end + max(dt, 1e-3), np.asarray(where, float), buttons))
+
+
+class ScriptedTrainee:
+    """A seeded drilling policy over a volume (see the module's docstring).
+
+    `volume` is the world's volume (its ``raycast`` finds the surface), `drill_start` the burr
+    centre's starting point (world frame), `protect` the structures to keep clear of, `region`
+    where to drill. Call ``plan(seconds)`` once, then hand the trainee to a ScriptedDevice."""
+
+    def __init__(
+        self,
+        volume,
+        drill_start,
+        burr_radius: float,
+        style: TraineeStyle,
+        rng: np.random.Generator,
+        protect: list[ProtectedField] | None = None,
+        region: TrainingRegion | None = None,
+    ) -> None:
+        self.volume = volume
+        self.start = np.asarray(drill_start, dtype=float)
+        self.burr_radius = float(burr_radius)
+        self.style = style
+        self.rng = rng
+        self.protect = list(protect or [])
+        self.region = region or TrainingRegion()
+        pose = np.asarray(volume.pose, dtype=float)
+        self._world_from_volume = pose
+        self._volume_from_world = np.linalg.inv(pose)
+        draw = lambda r: float(rng.uniform(*r))  # noqa: E731 (one draw per parameter)
+        self.params = {
+            "layer_depth": draw(style.layer_depth),
+            "speed": draw(style.speed),
+            "press": draw(style.press),
+            "clearance": draw(style.clearance),
+            "drift": draw(style.drift),
+            "spacing": draw(style.spacing) * self.burr_radius,
+        }
+        self._plan = _Plan([(0.0, np.zeros(3), 0)])
+
+    # -- the callback -------------------------------------------------------------------------
+
+    def __call__(self, t: float) -> dict:
+        points = self._plan.waypoints
+        times = [w[0] for w in points]
+        i = int(np.searchsorted(times, t, side="right")) - 1
+        if i < 0:
+            return {"position": tuple(points[0][1]), "buttons": points[0][2]}
+        if i >= len(points) - 1:
+            return {"position": tuple(points[-1][1]), "buttons": points[-1][2]}
+        (t0, p0, buttons), (t1, p1, _) = points[i], points[i + 1]
+        s = (t - t0) / (t1 - t0)
+        return {"position": tuple(p0 + s * (p1 - p0)), "buttons": buttons}
+
+    @property
+    def busy_until(self) -> float:
+        return self._plan.end
+
+    # -- geometry -----------------------------------------------------------------------------
+
+    def _to_world(self, p_volume: np.ndarray) -> np.ndarray:
+        return (self._world_from_volume @ np.append(p_volume, 1.0))[:3]
+
+    def _device(self, p_volume: np.ndarray) -> np.ndarray:
+        """A volume-frame burr centre as the hand's device-frame position."""
+        return self._to_world(p_volume) - self.start
+
+    def _surface(self, x: float, y: float) -> float | None:
+        """The bone surface's height (volume z) above (x, y), or None where there is none."""
+        origin = self._to_world(np.array([x, y, 0.05]))
+        down = self._world_from_volume[:3, :3] @ np.array([0.0, 0.0, -1.0])
+        hit = self.volume.raycast(tuple(origin), tuple(down))
+        if hit is None:
+            return None
+        return float((self._volume_from_world @ np.append(hit["position"], 1.0))[2])
+
+    def _clear(self, p: np.ndarray) -> bool:
+        """Whether a burr centred at p (volume frame) keeps every margin, with the style's
+        extra clearance (a negative clearance ignores margins)."""
+        extra = self.params["clearance"]
+        if extra < 0:
+            return True
+        return all(
+            float(s.field.sample(p)[0]) - self.burr_radius >= s.margin + extra for s in self.protect
+        )
+
+    def _toward_structure(self) -> tuple[float, float] | None:
+        """A site on the surface above the protected structure nearest the region's centre."""
+        if not self.protect:
+            return None
+        cx, cy = self.region.center
+        best, site = math.inf, None
+        for dx, dy in self.rng.uniform(-1, 1, size=(24, 2)) * self.region.half_extent:
+            surface = self._surface(cx + dx, cy + dy)
+            if surface is None:
+                continue
+            below = np.array([cx + dx, cy + dy, surface - self.region.depth])
+            d = min(float(s.field.sample(below)[0]) for s in self.protect)
+            if d < best:
+                best, site = d, (cx + dx, cy + dy)
+        return site
+
+    # -- planning -----------------------------------------------------------------------------
+
+    def plan(self, seconds: float) -> None:
+        """Plans the session until `seconds` (from the end of what is planned)."""
+        end = self._plan.end + seconds
+        if self.style.strokes:
+            self._plan_strokes(end)
+        else:
+            self._plan_plunges(end)
+        self._plan.go(0.3, np.zeros(3), 0)  # back to the start, burr off
+
+    def _move_to(self, target: np.ndarray, buttons: int, speed: float) -> None:
+        last = self._plan.waypoints[-1][1]
+        distance = float(np.linalg.norm(target - last))
+        self._plan.go(distance / speed, target, buttons)
+
+    def _plan_strokes(self, end: float) -> None:
+        r, region, p = self.burr_radius, self.region, self.params
+        layer = 0
+        while self._plan.end < end:
+            layer += 1
+            depth = layer * p["layer_depth"]
+            if depth > region.depth:
+                break
+            shrink = max(0.0, 1.0 - region.taper * depth / max(region.depth, 1e-9))
+            hx, hy = (h * shrink for h in region.half_extent)
+            if hx < r or hy < r:
+                break
+            rows = max(1, int(2 * hy / p["spacing"]))
+            for row in range(rows + 1):
+                if self._plan.end >= end:
+                    break
+                y = region.center[1] - hy + 2 * hy * row / rows
+                xs = np.linspace(region.center[0] - hx, region.center[0] + hx, 24)
+                if row % 2:
+                    xs = xs[::-1]
+                self._stroke(xs, y, depth)
+
+    def _stroke(self, xs: np.ndarray, y: float, depth: float) -> None:
+        """One pass along x at height y, `depth` below the surface as it was first found."""
+        r, p = self.burr_radius, self.params
+        path = []
+        for x in xs:
+            surface = self._surface(float(x), y)
+            if surface is None:
+                continue
+            centre = np.array([x, y, self._floor(float(x), y) + r - depth - p["press"]])
+            # Lift the burr where it would come within a margin.
+            lifted = centre.copy()
+            while not self._clear(lifted) and lifted[2] < surface + r:
+                lifted[2] += 0.0002
+            if lifted[2] >= surface + r:
+                continue
+            path.append(lifted)
+        if len(path) < 2:
+            return
+        first = path[0]
+        above = first + np.array([0.0, 0.0, 0.003])
+        self._move_to(self._device(above), 0, 0.03)
+        self._plan.go(0.15, self._device(above), 1)  # spin up
+        self._move_to(self._device(first), 1, p["speed"])
+        for point in path[1:]:
+            self._move_to(self._device(point), 1, p["speed"])
+        self._move_to(self._device(path[-1] + np.array([0.0, 0.0, 0.003])), 1, 0.03)
+
+    def _floor(self, x: float, y: float) -> float:
+        """The surface height where planning first found it (later layers go down from there)."""
+        key = (round(x, 5), round(y, 5))
+        cache = self.__dict__.setdefault("_floors", {})
+        if key not in cache:
+            cache[key] = self._surface(x, y)
+        return cache[key]
+
+    def _plan_plunges(self, end: float) -> None:
+        r, region, p, rng = self.burr_radius, self.region, self.params, self.rng
+        while self._plan.end < end:
+            site = None
+            if rng.random() < p["drift"]:
+                site = self._toward_structure()
+            if site is None:
+                dx, dy = rng.uniform(-1, 1, size=2) * region.half_extent
+                site = (region.center[0] + dx, region.center[1] + dy)
+            surface = self._surface(*site)
+            if surface is None:
+                self._plan.go(0.05, self._plan.waypoints[-1][1], 0)
+                continue
+            sink = float(rng.uniform(*self.style.layer_depth)) + p["press"]
+            above = np.array([site[0], site[1], surface + r + 0.003])
+            bottom = np.array([site[0], site[1], surface + r - sink])
+            heading = rng.uniform(0, 2 * math.pi)
+            wiggle = rng.uniform(0.0008, 0.0018) * np.array(
+                [math.cos(heading), math.sin(heading), 0]
+            )
+            self._move_to(self._device(above), 0, 0.04)
+            self._plan.go(0.1, self._device(above), 1)
+            self._move_to(self._device(bottom), 1, p["speed"])
+            self._move_to(self._device(bottom + wiggle), 1, p["speed"])
+            self._move_to(self._device(bottom - wiggle), 1, p["speed"])
+            self._move_to(self._device(above), 1, 0.04)
+
+
+def expert_like(volume, drill_start, burr_radius, rng, **options) -> ScriptedTrainee:
+    """A careful expert-like trainee (see the module's docstring)."""
+    return ScriptedTrainee(volume, drill_start, burr_radius, EXPERT, rng, **options)
+
+
+def novice_like(volume, drill_start, burr_radius, rng, **options) -> ScriptedTrainee:
+    """A novice-like trainee (see the module's docstring)."""
+    return ScriptedTrainee(volume, drill_start, burr_radius, NOVICE, rng, **options)

@@ -5,6 +5,7 @@ haptic loop and offline from a recording through the same code; the structures t
 ``ambfplus.DistanceField`` objects that follow the drilling.
 """
 
+from .metrics import Protect, drill_ticks, session_metrics
 from .trainees import (
     EXPERT,
     NOVICE,
@@ -17,6 +18,9 @@ from .trainees import (
 )
 
 __all__ = [
+    "Protect",
+    "drill_ticks",
+    "session_metrics",
     "EXPERT",
     "NOVICE",
     "ProtectedField",

@@ -278,8 +278,8 @@ class ScriptedTrainee:
     def _plan_plunges(self, end: float) -> None:
         r, region, p, rng = self.burr_radius, self.region, self.params, self.rng
         while self._plan.end < end:
-            site = None
-            if rng.random() < p["drift"]:
+            site, drifting = None, rng.random() < p["drift"]
+            if drifting:
                 site = self._toward_structure()
             if site is None:
                 dx, dy = rng.uniform(-1, 1, size=2) * region.half_extent
@@ -289,6 +289,11 @@ class ScriptedTrainee:
                 self._plan.go(0.05, self._plan.waypoints[-1][1], 0)
                 continue
             sink = float(rng.uniform(*self.style.layer_depth)) + p["press"]
+            if drifting and self.protect:
+                # Down to the structure below, and a little into it.
+                top = np.array([site[0], site[1], surface])
+                reach = min(float(s.field.sample(top)[0]) for s in self.protect)
+                sink = max(sink, reach + float(rng.uniform(0.0, 0.0006)))
             above = np.array([site[0], site[1], surface + r + 0.003])
             bottom = np.array([site[0], site[1], surface + r - sink])
             heading = rng.uniform(0, 2 * math.pi)

@@ -30,7 +30,7 @@ def drill_session(make, seed: int, seconds: float = 12.0) -> dict:
     world, drill = scene.world, scene.drill
     fields = [
         ProtectedField(
-            p.name, ambfplus.DistanceField(drill.volume.data, p.labels[0], 0.006), p.margin
+            p.name, ambfplus.DistanceField(drill.volume.data, p.labels[0], 0.03), p.margin
         )
         for p in PROTECT
     ]

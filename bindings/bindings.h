@@ -15,9 +15,9 @@
 #include <utility>
 #include <vector>
 
-#include "ambfplus/render/shader.h"
 #include "ambfplus/scene/camera.h"
 #include "ambfplus/scene/options.h"
+#include "ambfplus/scene/shader_spec.h"
 #include "ambfplus/scene/simulator.h"
 #include "ambfplus/volume/volume_data.h"
 

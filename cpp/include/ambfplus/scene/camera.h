@@ -9,9 +9,9 @@
 
 #include "ambfplus/capture/capture.h"
 #include "ambfplus/capture/frame.h"
-#include "ambfplus/render/shader.h"
 #include "ambfplus/scene/object.h"
 #include "ambfplus/scene/options.h"
+#include "ambfplus/scene/shader_spec.h"
 
 namespace ambfplus {
 

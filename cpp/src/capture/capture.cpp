@@ -125,7 +125,7 @@ void Camera::capture(const CaptureBuffers& buffers, Frame& frame, const PoseRequ
     drawn.depth = depth.data();
   }
   drawn.points = nullptr;
-  world().renderer().render(*this, drawn, poses, frame);
+  render::renderer_of(world()).render(*this, drawn, poses, frame);
   if (buffers.points != nullptr) {
     capture::points_from_depth(drawn.depth, frame.intrinsics, width_, height_, buffers.points);
   }

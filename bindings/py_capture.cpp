@@ -1,5 +1,5 @@
-// ambfplus/capture: Frame (its images as views with the frame as owner), the pass table and
-// Camera.capture.
+// ambfplus/capture: Frame (its images as views with the frame as owner), the pass table and what
+// Camera.capture calls (capture_into, with the GIL released).
 
 #include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
@@ -126,10 +126,10 @@ py::object capture(Camera& camera, py::object out, py::object passes, py::object
   if (out.is_none()) {
     auto frame = std::make_shared<Frame>();
     // The frame's buffers decide what a capture makes.
-    if (!passes.is_none()) camera.allocate(*frame, parse_passes(passes));
+    if (!passes.is_none()) allocate_frame(camera, *frame, parse_passes(passes));
     {
       py::gil_scoped_release release;
-      camera.capture(*frame, request);
+      capture_into(camera, *frame, request);
     }
     return py::cast(frame);
   }
@@ -140,7 +140,7 @@ py::object capture(Camera& camera, py::object out, py::object passes, py::object
     Frame& frame = out.cast<Frame&>();
     {
       py::gil_scoped_release release;
-      camera.capture(frame, request);
+      capture_into(camera, frame, request);
     }
     return out;
   }
@@ -183,7 +183,7 @@ py::object capture(Camera& camera, py::object out, py::object passes, py::object
     result.attr("_out") = buffers;
     {
       py::gil_scoped_release release;
-      camera.capture(targets, *frame, request);
+      capture_into(camera, targets, *frame, request);
     }
     return result;
   }
@@ -300,10 +300,10 @@ void define_capture(py::module_& m) {
         {
           py::gil_scoped_release release;
           const CaptureBuffers buffers{rgb.data(), depth.data(), label.data()};
-          camera.capture(buffers, frame);  // warm-up: context, program, buffers
+          capture_into(camera, buffers, frame);  // warm-up: context, program, buffers
           const auto t0 = std::chrono::steady_clock::now();
           const double c0 = process_cpu_seconds();
-          for (int i = 0; i < iterations; ++i) camera.capture(buffers, frame);
+          for (int i = 0; i < iterations; ++i) capture_into(camera, buffers, frame);
           cpu = process_cpu_seconds() - c0;
           wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         }

@@ -43,12 +43,12 @@ TEST(Render, RemovingAModelReleasesItsResourcesOnly) {
   model.add_body(ball);
   spec.name = "cam2";
   model.add_camera(spec).look_at({0, 3, 0}, {0, 0, 0});
-  cam.capture();
-  static_cast<Camera&>(*world.find("cam2")).capture();
+  capture_frame(cam);
+  capture_frame(static_cast<Camera&>(*world.find("cam2")));
   auto& renderer = static_cast<render::SceneRenderer&>(render::renderer_of(world));
   EXPECT_EQ(renderer.resource_counts(), (std::array<std::size_t, 4>{2, 0, 2, 0}));
   world.remove_model(model);
-  const Frame frame = cam.capture();
+  const Frame frame = capture_frame(cam);
   EXPECT_EQ(&render::renderer_of(world), &renderer);
   EXPECT_EQ(renderer.resource_counts(), (std::array<std::size_t, 4>{1, 0, 1, 0}));
   EXPECT_NEAR(frame.depth.data()[12 * 32 + 16], 2.5f, 1e-5f);
@@ -72,7 +72,7 @@ TEST(Render, FrontalFaceHasExactDepthAndFrameCarriesTime) {
   Camera& cam = world.default_model().add_camera(spec);
   cam.look_at({0, 0, 1.1}, {0, 0, 0}, {0, 1, 0});
   world.step(7);
-  const Frame frame = cam.capture();
+  const Frame frame = capture_frame(cam);
   ASSERT_EQ(frame.depth.size(), 64u * 48u);
   EXPECT_EQ(frame.step, 7);
   EXPECT_DOUBLE_EQ(frame.time, 0.007);

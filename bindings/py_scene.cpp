@@ -30,6 +30,7 @@
 #include "ambfplus/scene/ghost.h"
 #include "ambfplus/scene/joint.h"
 #include "ambfplus/scene/model.h"
+#include "ambfplus/scene/names.h"
 #include "ambfplus/scene/proximity_sensor.h"
 #include "ambfplus/scene/rigid_body.h"
 #include "ambfplus/scene/simulator.h"
@@ -146,38 +147,12 @@ std::string repr_object(const Object& o) {
 
 std::optional<ObjectKind> parse_kind(const std::optional<std::string>& kind) {
   if (!kind) return std::nullopt;
-  for (ObjectKind k :
-       {ObjectKind::kRigidBody, ObjectKind::kJoint, ObjectKind::kCamera, ObjectKind::kLight,
-        ObjectKind::kVolume, ObjectKind::kDrill, ObjectKind::kSoftBody, ObjectKind::kSensor,
-        ObjectKind::kActuator, ObjectKind::kInputDevice}) {
-    if (*kind == object_kind_name(k)) return k;
-  }
-  throw ArgumentError("unknown kind '" + *kind +
-                      "': expected body, joint, camera, light, volume, drill, soft body, "
-                      "sensor, actuator or input device");
+  return parse_object_kind(*kind);
 }
 
-// One object for a name: exact name first, then AMBF's lookup; NotFound (a KeyError) says why not.
+// One object for a name (resolve_name: AMBF's rules); NotFound (a KeyError) says why not.
 py::object get(World& w, const std::string& name, const std::optional<std::string>& kind) {
-  const std::optional<ObjectKind> k = parse_kind(kind);
-  if (Object* o = w.find(name); o != nullptr && (!k || o->kind() == *k)) return to_python(o);
-  std::vector<Object*> found = w.lookup(name, k);
-  if (found.size() > 1 && !k) {
-    // AMBF's clients find bodies, cameras and lights; joints only when asked for.
-    std::vector<Object*> objects;
-    for (Object* o : found) {
-      if (o->kind() != ObjectKind::kJoint) objects.push_back(o);
-    }
-    if (objects.size() == 1) found = objects;
-  }
-  if (found.size() == 1) return to_python(found.front());
-  if (found.empty()) throw NotFound("no object named '" + name + "' in the world");
-  std::string names;
-  for (std::size_t i = 0; i < found.size() && i < 6; ++i) {
-    names += (i ? ", " : "") + found[i]->qualified_name();
-  }
-  throw NotFound("'" + name + "' is ambiguous: it matches " + std::to_string(found.size()) +
-                 " objects (" + names + (found.size() > 6 ? ", ..." : "") + ")");
+  return to_python(&resolve_name(w, name, parse_kind(kind)));
 }
 
 // ---- The add_* methods, shared by Model and World (which adds to its default model).

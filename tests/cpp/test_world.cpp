@@ -8,6 +8,7 @@
 
 #include "ambfplus/engine/engine.h"
 #include "ambfplus/errors.h"
+#include "ambfplus/scene/names.h"
 #include "ambfplus/scene/simulator.h"
 #include "ambfplus/scene/system.h"
 #include "ambfplus/scene/world.h"
@@ -143,6 +144,46 @@ TEST(World, SystemsAddStepLogColumns) {
   EXPECT_EQ(log.columns()[1].values, (std::vector<double>{2.0, 2.0}));
   StepLogColumns bad(a);
   EXPECT_THROW(bad.add("x", 0, [](const Object&, std::vector<double>&) {}), ArgumentError);
+}
+
+// AMBF's lookup, in one function for Python and plugins alike.
+TEST(Names, ResolveByAmbfRules) {
+  auto sim = engine::create_simulator();
+  World& world = sim->world();
+  RigidBody& base = world.default_model().add_body(sphere("base"));
+  base.set_name_space("/ambf/env/");
+  base.set_identifier("BODY base");
+  RigidBody& link = world.default_model().add_body(sphere("link"));
+  link.set_name_space("/ambf/env/");
+  JointSpec spec;
+  spec.name = "base-link";
+  spec.parent = &base;
+  spec.child = &link;
+  Joint& joint = world.default_model().add_joint(spec);
+  joint.set_name_space("/ambf/env/");
+
+  // An exact name, a qualified name, an identifier, namespace + identifier.
+  EXPECT_EQ(&resolve_name(world, "base"), &base);
+  EXPECT_EQ(&resolve_name(world, "/ambf/env/link"), &link);
+  EXPECT_EQ(&resolve_name(world, "BODY base"), &base);
+  EXPECT_EQ(&resolve_name(world, "/ambf/env/BODY base"), &base);
+  // A part of a name: "base" is in the joint's name too, but an exact name wins; "lin" is in
+  // the link's and the joint's, and joints only count when nothing else does.
+  EXPECT_EQ(&resolve_name(world, "lin"), &link);
+  EXPECT_EQ(name_candidates(world, "lin", ObjectKind::kJoint), (std::vector<Object*>{&joint}));
+  EXPECT_EQ(&resolve_name(world, "base-", ObjectKind::kJoint), &joint);
+  // A kind rules objects out; nothing, or several alike, is NotFound naming them.
+  EXPECT_THROW(resolve_name(world, "base", ObjectKind::kCamera), NotFound);
+  EXPECT_THROW(resolve_name(world, "nothing"), NotFound);
+  try {
+    resolve_name(world, "/ambf/env/");
+    FAIL() << "an ambiguous name resolved";
+  } catch (const NotFound& e) {
+    EXPECT_NE(std::string(e.what()).find("ambiguous"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("/ambf/env/base"), std::string::npos);
+  }
+  EXPECT_EQ(parse_object_kind("input device"), ObjectKind::kInputDevice);
+  EXPECT_THROW(parse_object_kind("widget"), ArgumentError);
 }
 
 TEST(World, ClockCountsFixedStepsWithoutDrift) {

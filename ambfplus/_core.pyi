@@ -2420,12 +2420,6 @@ class PluginInfo:
         """
         'simulator', 'world', 'model' or 'object'
         """
-def _benchmark_bare_capture(camera: Camera, iterations: typing.SupportsInt | typing.SupportsIndex) -> dict:
-    ...
-def _benchmark_collision(drill: Drill, cursor: typing.SupportsInt | typing.SupportsIndex = 0, iterations: typing.SupportsInt | typing.SupportsIndex = 20) -> dict:
-    ...
-def _benchmark_removal(drill: Drill, count: typing.SupportsInt | typing.SupportsIndex) -> dict:
-    ...
 def _register_plugin_support(arg0: typing.Any, arg1: typing.Any, arg2: typing.Any) -> None:
     """
     Called once by ambfplus.plugins: the Plugin base class and the functions making Python plugins from a file and from an entry-point name.

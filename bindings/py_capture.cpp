@@ -5,9 +5,6 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
-#include <time.h>
-
-#include <chrono>
 #include <sstream>
 #include <vector>
 
@@ -70,13 +67,6 @@ T* checked_output(const py::handle& value, const char* key,
                         (array.writeable() ? "" : " (read-only)"));
   }
   return static_cast<T*>(array.mutable_data());
-}
-
-// CPU seconds of the whole process (all threads, the rasteriser's included).
-double process_cpu_seconds() {
-  timespec t{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
 }  // namespace
@@ -285,34 +275,6 @@ void define_capture(py::module_& m) {
       "The capture passes, in order: dicts of name, dtype (NumPy's name), channels (1: an (H, "
       "W) image, 3: (H, W, 3)), rendered (drawn by the GPU, else computed from other passes), "
       "default (made when a camera is not told otherwise) and description");
-
-  // The baseline of the capture benchmark: the same draw and readback, in C++, into buffers
-  // allocated once, with no Python in the loop.
-  m.def(
-      "_benchmark_bare_capture",
-      [](Camera& camera, int iterations) {
-        std::vector<std::uint8_t> rgb(static_cast<std::size_t>(camera.width()) * camera.height() *
-                                      3);
-        std::vector<float> depth(static_cast<std::size_t>(camera.width()) * camera.height());
-        std::vector<std::uint16_t> label(depth.size());
-        Frame frame;
-        double wall = 0, cpu = 0;
-        {
-          py::gil_scoped_release release;
-          const CaptureBuffers buffers{rgb.data(), depth.data(), label.data()};
-          capture_into(camera, buffers, frame);  // warm-up: context, program, buffers
-          const auto t0 = std::chrono::steady_clock::now();
-          const double c0 = process_cpu_seconds();
-          for (int i = 0; i < iterations; ++i) capture_into(camera, buffers, frame);
-          cpu = process_cpu_seconds() - c0;
-          wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        }
-        py::dict d;
-        d["wall_seconds"] = wall / iterations;
-        d["cpu_seconds"] = cpu / iterations;
-        return d;
-      },
-      py::arg("camera"), py::arg("iterations"));
 }
 
 }  // namespace ambfplus::bindings

@@ -622,18 +622,6 @@ class World:
         """
         Gives the plugins a key event (GLFW's codes; action 0 release, 1 press, 2 repeat).
         """
-    def send_mouse_button(self, button: typing.SupportsInt | typing.SupportsIndex, action: typing.SupportsInt | typing.SupportsIndex = 1, mods: typing.SupportsInt | typing.SupportsIndex = 0) -> None:
-        """
-        Gives the plugins a mouse button event.
-        """
-    def send_mouse_move(self, x: typing.SupportsFloat | typing.SupportsIndex, y: typing.SupportsFloat | typing.SupportsIndex) -> None:
-        """
-        Gives the plugins a cursor position.
-        """
-    def send_mouse_scroll(self, dx: typing.SupportsFloat | typing.SupportsIndex, dy: typing.SupportsFloat | typing.SupportsIndex) -> None:
-        """
-        Gives the plugins a scroll event.
-        """
     def start_step_log(self, objects: collections.abc.Sequence[Object]) -> None:
         """
         Logs every step's state of these objects from now on (poses; drills: goal, force, on, burr; input devices: readings and force); take_step_log() drains it.
@@ -1082,59 +1070,6 @@ class Volume(Object):
     def world_from_voxel(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
         """
         4x4: voxel (i, j, k)'s centre is this times (i, j, k, 1)
-        """
-class _StateLock:
-    """
-    The world's state lock, held by a `with` block.
-    """
-    def __enter__(self) -> None:
-        """
-        Takes the world's state lock (waiting with the GIL released; the GIL is never waited for while the lock is held).
-        """
-    def __exit__(self, *args) -> bool:
-        """
-        Gives the lock back.
-        """
-class RealTimeLoop:
-    """
-    Steps a world in real time on its own thread (1 kHz by default, absolute deadlines, SCHED_FIFO where allowed), while other threads capture. Use as a context manager, or start()/stop(). Change the world from Python only inside `with loop.lock():`.
-    """
-    def __enter__(self) -> RealTimeLoop:
-        """
-        Starts stepping.
-        """
-    def __exit__(self, *args) -> bool:
-        """
-        Stops stepping.
-        """
-    def __init__(self, world: World, rate: typing.SupportsFloat | typing.SupportsIndex = 1000.0, fifo_priority: typing.SupportsInt | typing.SupportsIndex = 80, cpu: typing.SupportsInt | typing.SupportsIndex = -1, poll_rate: typing.SupportsFloat | typing.SupportsIndex = 100.0) -> None:
-        """
-        rate: steps per second; fifo_priority: SCHED_FIFO priority to ask for (0: none); cpu: pin to this CPU (-1: the last, only if SCHED_FIFO is refused; -2: never); poll_rate: Hz of the thread serving Python devices and plugins.
-        """
-    def lock(self) -> typing.Any:
-        """
-        A context manager holding the world's state lock (the loop waits meanwhile).
-        """
-    def start(self) -> None:
-        """
-        Starts stepping.
-        """
-    def stop(self) -> None:
-        """
-        Stops after the step in progress; re-raises an error that stopped a step.
-        """
-    @property
-    def running(self) -> bool:
-        ...
-    @property
-    def scheduling(self) -> str:
-        """
-        how the loop's thread is scheduled (SCHED_FIFO, or what it fell back to and why)
-        """
-    @property
-    def stats(self) -> dict:
-        """
-        steps, seconds, mean_rate (Hz), p99 and max period (s), over_2ms (count), step_cpu_p99 (s), lock waits (s), periods (array, s)
         """
 class ShapeKind:
     """
@@ -1938,6 +1873,59 @@ class ConstraintActuator(Object):
     @property
     def tau(self) -> float:
         ...
+class _StateLock:
+    """
+    The world's state lock, held by a `with` block.
+    """
+    def __enter__(self) -> None:
+        """
+        Takes the world's state lock (waiting with the GIL released; the GIL is never waited for while the lock is held).
+        """
+    def __exit__(self, *args) -> bool:
+        """
+        Gives the lock back.
+        """
+class RealTimeLoop:
+    """
+    Steps a world in real time on its own thread (1 kHz by default, absolute deadlines, SCHED_FIFO where allowed), while other threads capture. Use as a context manager, or start()/stop(). Change the world from Python only inside `with loop.lock():`.
+    """
+    def __enter__(self) -> RealTimeLoop:
+        """
+        Starts stepping.
+        """
+    def __exit__(self, *args) -> bool:
+        """
+        Stops stepping.
+        """
+    def __init__(self, world: World, rate: typing.SupportsFloat | typing.SupportsIndex = 1000.0, fifo_priority: typing.SupportsInt | typing.SupportsIndex = 80, cpu: typing.SupportsInt | typing.SupportsIndex = -1, poll_rate: typing.SupportsFloat | typing.SupportsIndex = 100.0) -> None:
+        """
+        rate: steps per second; fifo_priority: SCHED_FIFO priority to ask for (0: none); cpu: pin to this CPU (-1: the last, only if SCHED_FIFO is refused; -2: never); poll_rate: Hz of the thread serving Python devices and plugins.
+        """
+    def lock(self) -> typing.Any:
+        """
+        A context manager holding the world's state lock (the loop waits meanwhile).
+        """
+    def start(self) -> None:
+        """
+        Starts stepping.
+        """
+    def stop(self) -> None:
+        """
+        Stops after the step in progress; re-raises an error that stopped a step.
+        """
+    @property
+    def running(self) -> bool:
+        ...
+    @property
+    def scheduling(self) -> str:
+        """
+        how the loop's thread is scheduled (SCHED_FIFO, or what it fell back to and why)
+        """
+    @property
+    def stats(self) -> dict:
+        """
+        steps, seconds, mean_rate (Hz), p99 and max period (s), over_2ms (count), step_cpu_p99 (s), lock waits (s), periods (array, s)
+        """
 class RemovalMode:
     """
     How a drill's burr removes tissue.
@@ -2432,12 +2420,6 @@ class PluginInfo:
         """
         'simulator', 'world', 'model' or 'object'
         """
-def _benchmark_bare_capture(camera: Camera, iterations: typing.SupportsInt | typing.SupportsIndex) -> dict:
-    ...
-def _benchmark_collision(drill: Drill, cursor: typing.SupportsInt | typing.SupportsIndex = 0, iterations: typing.SupportsInt | typing.SupportsIndex = 20) -> dict:
-    ...
-def _benchmark_removal(drill: Drill, count: typing.SupportsInt | typing.SupportsIndex) -> dict:
-    ...
 def _register_plugin_support(arg0: typing.Any, arg1: typing.Any, arg2: typing.Any) -> None:
     """
     Called once by ambfplus.plugins: the Plugin base class and the functions making Python plugins from a file and from an entry-point name.

@@ -15,9 +15,9 @@
 #include <utility>
 #include <vector>
 
-#include "ambfplus/render/shader.h"
 #include "ambfplus/scene/camera.h"
 #include "ambfplus/scene/options.h"
+#include "ambfplus/scene/shader_spec.h"
 #include "ambfplus/scene/simulator.h"
 #include "ambfplus/volume/volume_data.h"
 
@@ -34,7 +34,7 @@ void declare_render(pybind11::module_& m);
 void declare_capture(pybind11::module_& m);
 void declare_volume(pybind11::module_& m);
 void declare_scene(pybind11::module_& m);
-void declare_physics(pybind11::module_& m);
+void declare_engine(pybind11::module_& m);
 void declare_haptics(pybind11::module_& m);
 void declare_adf(pybind11::module_& m);
 void declare_training(pybind11::module_& m);
@@ -44,12 +44,32 @@ void define_render(pybind11::module_& m);
 void define_capture(pybind11::module_& m);
 void define_volume(pybind11::module_& m);
 void define_scene(pybind11::module_& m);
-void define_physics(pybind11::module_& m);
+void define_engine(pybind11::module_& m);
 void define_haptics(pybind11::module_& m);
 void define_adf(pybind11::module_& m);
 void define_training(pybind11::module_& m);
 
 void register_plugin(pybind11::module_& m);
+
+// What World's and Simulator's plugin methods (py_scene.cpp) call (py_plugin.cpp).
+extern const char* const kLoadPluginDoc;
+/// World.load_plugin: scope_object None (this world), the simulator, a model or an object.
+pybind11::object load_plugin(World& world, const pybind11::object& plugin,
+                             const pybind11::object& scope_object,
+                             const std::optional<std::string>& name);
+/// Simulator.load_plugin: attached to the simulator.
+pybind11::object load_plugin(Simulator& simulator, const pybind11::object& plugin,
+                             const std::optional<std::string>& name);
+/// World.plugins: a PluginInfo per attached plugin, in call order.
+pybind11::list plugin_infos(World& world);
+/// World.reset_plugins and close_plugins.
+void reset_plugins(World& world);
+void close_plugins(World& world);
+/// The window's input events for the plugins (GLFW's codes), under the world's lock.
+void plugin_key(World& w, int key, int scancode, int action, int mods);
+void plugin_mouse_button(World& w, int button, int action, int mods);
+void plugin_mouse_move(World& w, double x, double y);
+void plugin_mouse_scroll(World& w, double dx, double dy);
 
 /// The class a declare_* pass made, to add methods to.
 template <typename... Ts>

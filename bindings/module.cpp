@@ -37,7 +37,7 @@ PYBIND11_MODULE(_core, m) {
   b::declare_capture(m);
   b::declare_volume(m);
   b::declare_scene(m);
-  b::declare_physics(m);
+  b::declare_engine(m);
   b::declare_haptics(m);
   b::declare_adf(m);
   b::declare_training(m);
@@ -46,7 +46,7 @@ PYBIND11_MODULE(_core, m) {
   b::define_capture(m);
   b::define_volume(m);
   b::define_scene(m);
-  b::define_physics(m);
+  b::define_engine(m);
   b::define_haptics(m);
   b::define_adf(m);
   b::define_training(m);

@@ -1,13 +1,10 @@
-// ambfplus/capture: Frame (its images as views with the frame as owner), the pass table and
-// Camera.capture.
+// ambfplus/capture: Frame (its images as views with the frame as owner), the pass table and what
+// Camera.capture calls (capture_into, with the GIL released).
 
 #include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
-#include <time.h>
-
-#include <chrono>
 #include <sstream>
 #include <vector>
 
@@ -72,13 +69,6 @@ T* checked_output(const py::handle& value, const char* key,
   return static_cast<T*>(array.mutable_data());
 }
 
-// CPU seconds of the whole process (all threads, the rasteriser's included).
-double process_cpu_seconds() {
-  timespec t{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
-
 }  // namespace
 
 unsigned parse_passes(const py::handle& names) {
@@ -126,10 +116,10 @@ py::object capture(Camera& camera, py::object out, py::object passes, py::object
   if (out.is_none()) {
     auto frame = std::make_shared<Frame>();
     // The frame's buffers decide what a capture makes.
-    if (!passes.is_none()) camera.allocate(*frame, parse_passes(passes));
+    if (!passes.is_none()) allocate_frame(camera, *frame, parse_passes(passes));
     {
       py::gil_scoped_release release;
-      camera.capture(*frame, request);
+      capture_into(camera, *frame, request);
     }
     return py::cast(frame);
   }
@@ -140,7 +130,7 @@ py::object capture(Camera& camera, py::object out, py::object passes, py::object
     Frame& frame = out.cast<Frame&>();
     {
       py::gil_scoped_release release;
-      camera.capture(frame, request);
+      capture_into(camera, frame, request);
     }
     return out;
   }
@@ -183,7 +173,7 @@ py::object capture(Camera& camera, py::object out, py::object passes, py::object
     result.attr("_out") = buffers;
     {
       py::gil_scoped_release release;
-      camera.capture(targets, *frame, request);
+      capture_into(camera, targets, *frame, request);
     }
     return result;
   }
@@ -285,34 +275,6 @@ void define_capture(py::module_& m) {
       "The capture passes, in order: dicts of name, dtype (NumPy's name), channels (1: an (H, "
       "W) image, 3: (H, W, 3)), rendered (drawn by the GPU, else computed from other passes), "
       "default (made when a camera is not told otherwise) and description");
-
-  // The baseline of the capture benchmark: the same draw and readback, in C++, into buffers
-  // allocated once, with no Python in the loop.
-  m.def(
-      "_benchmark_bare_capture",
-      [](Camera& camera, int iterations) {
-        std::vector<std::uint8_t> rgb(static_cast<std::size_t>(camera.width()) * camera.height() *
-                                      3);
-        std::vector<float> depth(static_cast<std::size_t>(camera.width()) * camera.height());
-        std::vector<std::uint16_t> label(depth.size());
-        Frame frame;
-        double wall = 0, cpu = 0;
-        {
-          py::gil_scoped_release release;
-          const CaptureBuffers buffers{rgb.data(), depth.data(), label.data()};
-          camera.capture(buffers, frame);  // warm-up: context, program, buffers
-          const auto t0 = std::chrono::steady_clock::now();
-          const double c0 = process_cpu_seconds();
-          for (int i = 0; i < iterations; ++i) camera.capture(buffers, frame);
-          cpu = process_cpu_seconds() - c0;
-          wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        }
-        py::dict d;
-        d["wall_seconds"] = wall / iterations;
-        d["cpu_seconds"] = cpu / iterations;
-        return d;
-      },
-      py::arg("camera"), py::arg("iterations"));
 }
 
 }  // namespace ambfplus::bindings

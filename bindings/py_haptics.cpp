@@ -7,7 +7,6 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
-#include <chrono>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -593,70 +592,6 @@ void define_drill(py::module_& m) {
           "thread CPU time of the same ticks, seconds");
 }
 
-void define_benchmarks(py::module_& m) {
-  m.def(
-      "_benchmark_removal",
-      [](Drill& d, int count) {
-        // Removes up to `count` voxels nearest the burr through the collider (bitmaps, volume,
-        // edit log), as a drilling step does, and times it.
-        auto& c = const_cast<VoxelCollider&>(d.collider());
-        const Eigen::Isometry3d vfw = d.volume().pose().inverse();
-        const Vec3 tip = vfw * d.cursor_proxy(0);
-        std::vector<std::array<int, 3>> voxels = c.solid_within(tip, d.burr_radius() * 1.5);
-        if (static_cast<int>(voxels.size()) > count) voxels.resize(count);
-        double seconds = 0;
-        {
-          py::gil_scoped_release release;
-          const auto t0 = std::chrono::steady_clock::now();
-          c.remove(voxels);
-          seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        }
-        py::dict out;
-        out["voxels"] = voxels.size();
-        out["seconds"] = seconds;
-        return out;
-      },
-      py::arg("drill"), py::arg("count"));
-
-  m.def(
-      "_benchmark_collision",
-      [](Drill& d, int cursor, int iterations) {
-        // The cursor's last sweep (proxy to goal) as a gather and as a full-cube scan.
-        const VoxelCollider& c = d.collider();
-        const Eigen::Isometry3d vfw = d.volume().pose().inverse();
-        const Vec3 a = vfw * d.cursor_proxy(cursor), b = vfw * d.cursor_goal(cursor);
-        const double r = d.cursor_radius(cursor);
-        SweepHit gather, full;
-        double gather_s = 0, full_s = 0;
-        std::int64_t gather_n = 0, full_n = 0;
-        {
-          py::gil_scoped_release release;
-          auto& counter = const_cast<VoxelCollider&>(c);
-          counter.reset_counters();
-          auto t0 = std::chrono::steady_clock::now();
-          for (int i = 0; i < iterations; ++i) gather = c.sweep(a, b, r);
-          gather_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() /
-                     iterations;
-          gather_n = c.voxels_tested() / iterations;
-          counter.reset_counters();
-          t0 = std::chrono::steady_clock::now();
-          for (int i = 0; i < iterations; ++i) full = c.sweep_full_cube(a, b, r);
-          full_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() /
-                   iterations;
-          full_n = c.voxels_tested() / iterations;
-        }
-        py::dict out;
-        out["gather_seconds"] = gather_s;
-        out["full_cube_seconds"] = full_s;
-        out["gather_voxels"] = gather_n;
-        out["full_cube_voxels"] = full_n;
-        out["hit"] = gather.hit;
-        out["same_hit"] = gather.hit == full.hit && std::abs(gather.t - full.t) < 1e-9;
-        return out;
-      },
-      py::arg("drill"), py::arg("cursor") = 0, py::arg("iterations") = 20);
-}
-
 }  // namespace
 
 void declare_haptics(py::module_& m) {
@@ -713,7 +648,6 @@ void define_haptics(py::module_& m) {
   define_devices(m);
   define_input_device(m);
   define_drill(m);
-  define_benchmarks(m);
 }
 
 }  // namespace ambfplus::bindings

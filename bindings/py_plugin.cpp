@@ -1,6 +1,7 @@
 // Plugins from Python: Python plugins (ambfplus.Plugin) behind a C++ adapter that takes the GIL
-// for each hook only, World/Simulator.load_plugin, the registry's hooks, and the Python language
-// the engine's loader uses for `.py` files and `ambfplus.plugins` entry points.
+// for each hook only, PluginSite and PluginInfo, what World's and Simulator's plugin methods call
+// (bound with the rest of those classes in py_scene.cpp), and the Python language the engine's
+// loader uses for `.py` files and `ambfplus.plugins` entry points.
 
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -217,7 +218,7 @@ PluginInfo info(World& world, PluginInstance& p) {
   out.name = p.name();
   out.file = p.file();
   out.scope = plugin_scope_name(p.scope());
-  out.enabled = world.plugins().enabled(p);
+  out.enabled = plugins_of(world).enabled(p);
   auto* python = dynamic_cast<PythonPlugin*>(&p);
   out.language = python != nullptr ? "python" : "c++";
   out.instance = python != nullptr ? python->instance() : py::none();
@@ -249,7 +250,7 @@ py::object load(World& world, const py::object& plugin, const PluginSite& site,
     spec.filename = os.attr("fspath")(plugin).cast<std::string>();
     spec.name = name.value_or("");
     py::gil_scoped_release release;
-    loaded = world.plugins().load(spec, site);
+    loaded = plugins_of(world).load(spec, site);
   } else {
     auto adapter = std::make_shared<PythonPlugin>(plugin);
     const std::string type = py::str(py::type::of(plugin).attr("__name__")).cast<std::string>();
@@ -260,7 +261,7 @@ py::object load(World& world, const py::object& plugin, const PluginSite& site,
       // Defined where Python keeps no file (an interactive session).
     }
     py::gil_scoped_release release;
-    loaded = world.plugins().attach(adapter, name.value_or(type), file, site, /*native=*/false);
+    loaded = plugins_of(world).attach(adapter, name.value_or(type), file, site, /*native=*/false);
   }
   if (loaded == nullptr) return py::none();
   return py::cast(info(world, *loaded));
@@ -279,29 +280,61 @@ PluginSite site_of(World& world, const py::object& scope_object) {
       "object of the world");
 }
 
+}  // namespace
+
 // Input events reach the plugins under the world's lock (a real-time loop may be stepping),
 // taken holding the GIL: a Python plugin then never waits for the GIL under the lock.
-void send_key(World& w, int key, int scancode, int action, int mods) {
+void plugin_key(World& w, int key, int scancode, int action, int mods) {
   auto lock = lock_holding_gil(w);
-  w.plugins().keyboard(key, scancode, action, mods);
+  plugins_of(w).keyboard(key, scancode, action, mods);
 }
 
-void send_mouse_button(World& w, int button, int action, int mods) {
+void plugin_mouse_button(World& w, int button, int action, int mods) {
   auto lock = lock_holding_gil(w);
-  w.plugins().mouse_button(button, action, mods);
+  plugins_of(w).mouse_button(button, action, mods);
 }
 
-void send_mouse_move(World& w, double x, double y) {
+void plugin_mouse_move(World& w, double x, double y) {
   auto lock = lock_holding_gil(w);
-  w.plugins().mouse_move(x, y);
+  plugins_of(w).mouse_move(x, y);
 }
 
-void send_mouse_scroll(World& w, double dx, double dy) {
+void plugin_mouse_scroll(World& w, double dx, double dy) {
   auto lock = lock_holding_gil(w);
-  w.plugins().mouse_scroll(dx, dy);
+  plugins_of(w).mouse_scroll(dx, dy);
 }
 
-}  // namespace
+const char* const kLoadPluginDoc =
+    "Loads a plugin and calls its init(): `plugin` is a C++ library (libx.so, or a name "
+    "searched in AMBFPLUS_PLUGIN_PATH, the package's plugin folder and the linker's path), a "
+    "Python file (x.py), an `ambfplus.plugins` entry-point name, or an ambfplus.Plugin "
+    "object. Returns its PluginInfo, or None when init() declined. Raises PluginError.";
+
+py::object load_plugin(World& world, const py::object& plugin, const py::object& scope_object,
+                       const std::optional<std::string>& name) {
+  return load(world, plugin, site_of(world, scope_object), name);
+}
+
+py::object load_plugin(Simulator& simulator, const py::object& plugin,
+                       const std::optional<std::string>& name) {
+  return load(simulator.world(), plugin, PluginSite::of(simulator), name);
+}
+
+py::list plugin_infos(World& world) {
+  py::list out;
+  for (PluginInstance* p : plugins_of(world).plugins()) out.append(info(world, *p));
+  return out;
+}
+
+void reset_plugins(World& world) {
+  auto lock = lock_holding_gil(world);
+  plugins_of(world).reset();
+}
+
+void close_plugins(World& world) {
+  py::gil_scoped_release release;
+  plugins_of(world).close_all();
+}
 
 void register_plugin(py::module_& m) {
   register_plugin_language({"python", ".py",
@@ -358,76 +391,6 @@ void register_plugin(py::module_& m) {
         return "<PluginInfo '" + i.name + "' " + i.language + " " + i.scope +
                (i.enabled ? "" : " disabled") + ">";
       });
-
-  const char* load_doc =
-      "Loads a plugin and calls its init(): `plugin` is a C++ library (libx.so, or a name "
-      "searched in AMBFPLUS_PLUGIN_PATH, the package's plugin folder and the linker's path), a "
-      "Python file (x.py), an `ambfplus.plugins` entry-point name, or an ambfplus.Plugin "
-      "object. Returns its PluginInfo, or None when init() declined. Raises PluginError.";
-  auto world = py::reinterpret_borrow<py::class_<World, std::shared_ptr<World>>>(m.attr("World"));
-  world
-      .def(
-          "load_plugin",
-          [](World& w, const py::object& plugin, const py::object& scope_object,
-             const std::optional<std::string>& name) {
-            return load(w, plugin, site_of(w, scope_object), name);
-          },
-          py::arg("plugin"), py::arg("scope_object") = py::none(), py::arg("name") = py::none(),
-          (std::string(load_doc) +
-           " scope_object: None (this world), the simulator, a model or an object.")
-              .c_str())
-      .def_property_readonly(
-          "plugins",
-          [](World& w) {
-            py::list out;
-            for (PluginInstance* p : w.plugins().plugins()) out.append(info(w, *p));
-            return out;
-          },
-          "The attached plugins in call order: simulator, world, model, then object scope, "
-          "each in the order attached.")
-      .def(
-          "reset_plugins",
-          [](World& w) {
-            auto lock = lock_holding_gil(w);
-            w.reset_plugins();
-          },
-          "Calls every plugin's reset() (the scene itself is not reset).")
-      .def(
-          "close_plugins",
-          [](World& w) {
-            py::gil_scoped_release release;
-            w.plugins().close_all();
-          },
-          "Calls close() on every plugin (reverse call order) and lets them go; the world "
-          "does it when it is destroyed.")
-      // The window's input (GLFW's codes), and the same with defaults for scripts.
-      .def("keyboard", &send_key, py::arg("key"), py::arg("scancode"), py::arg("action"),
-           py::arg("mods"), "Gives the plugins a key event (GLFW codes).")
-      .def("mouse_button", &send_mouse_button, py::arg("button"), py::arg("action"),
-           py::arg("mods"), "Gives the plugins a mouse button event (GLFW codes).")
-      .def("mouse_move", &send_mouse_move, py::arg("x"), py::arg("y"),
-           "Gives the plugins the mouse's position (pixels).")
-      .def("mouse_scroll", &send_mouse_scroll, py::arg("dx"), py::arg("dy"),
-           "Gives the plugins a scroll event.")
-      .def("send_key", &send_key, py::arg("key"), py::arg("scancode") = 0, py::arg("action") = 1,
-           py::arg("mods") = 0,
-           "Gives the plugins a key event (GLFW's codes; action 0 release, 1 press, 2 repeat).")
-      .def("send_mouse_button", &send_mouse_button, py::arg("button"), py::arg("action") = 1,
-           py::arg("mods") = 0, "Gives the plugins a mouse button event.")
-      .def("send_mouse_move", &send_mouse_move, py::arg("x"), py::arg("y"),
-           "Gives the plugins a cursor position.")
-      .def("send_mouse_scroll", &send_mouse_scroll, py::arg("dx"), py::arg("dy"),
-           "Gives the plugins a scroll event.");
-
-  auto simulator = py::reinterpret_borrow<py::class_<Simulator, std::shared_ptr<Simulator>>>(
-      m.attr("Simulator"));
-  simulator.def(
-      "load_plugin",
-      [](Simulator& s, const py::object& plugin, const std::optional<std::string>& name) {
-        return load(s.world(), plugin, PluginSite::of(s), name);
-      },
-      py::arg("plugin"), py::arg("name") = py::none(),
-      (std::string(load_doc) + " The plugin is attached to the simulator.").c_str());
 
   m.attr("PLUGIN_ABI_VERSION") = AMBFPLUS_PLUGIN_ABI_VERSION;
   m.def("plugin_search_path", &plugin_search_path,

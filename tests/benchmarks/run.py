@@ -24,8 +24,29 @@ from pathlib import Path  # noqa: E402
 import numpy as np  # noqa: E402
 
 import ambfplus  # noqa: E402
-from ambfplus import _core  # noqa: E402
 from ambfplus.scenes import demo_scene  # noqa: E402
+
+# The C++ baselines (bench_module.cpp): a test-only extension module that the build with tests
+# on puts in build/cmake/benchmarks (another folder: AMBFPLUS_BENCH_DIR), never in the package.
+BENCH_DIR = Path(
+    os.environ.get(
+        "AMBFPLUS_BENCH_DIR", Path(__file__).resolve().parents[2] / "build" / "cmake" / "benchmarks"
+    )
+)
+
+
+def baselines():
+    """The module ambfplus_bench, imported after ambfplus (it shares the engine's library)."""
+    if str(BENCH_DIR) not in sys.path:
+        sys.path.insert(0, str(BENCH_DIR))
+    try:
+        return importlib.import_module("ambfplus_bench")
+    except ImportError as error:
+        sys.exit(
+            f"the C++ baselines are not built: no ambfplus_bench in {BENCH_DIR} ({error}); "
+            "build with tests on (pip install . does) or set AMBFPLUS_BENCH_DIR"
+        )
+
 
 FIXTURES = Path(
     os.environ.get("AMBFPLUS_FIXTURES", Path(__file__).resolve().parents[3] / "shared" / "fixtures")
@@ -58,7 +79,7 @@ def capture(args) -> Iterator[dict]:
             frame.rgb, frame.depth  # noqa: B018 (the views are part of the cost)
         python_wall.append((time.perf_counter() - t0) / per_round)
         python_cpu.append((time.process_time() - c0) / per_round)
-        bare = _core._benchmark_bare_capture(camera, per_round)
+        bare = baselines().bare_capture(camera, per_round)
         bare_wall.append(bare["wall_seconds"])
         bare_cpu.append(bare["cpu_seconds"])
     info = ambfplus.gl_info()
@@ -244,7 +265,7 @@ def haptics(args) -> Iterator[dict]:
             "voxels_removed": len(drill.removed["step"]),
             "what": f"8 cursors, 6 mm burr pressed 0.5 mm, sweeping at {name.replace('_', '/')}",
         }
-    query = _core._benchmark_collision(drill, 0, 20 if args.quick else 100)
+    query = baselines().collision(drill, 0, 20 if args.quick else 100)
     yield {
         "bench": "haptic_query_512_gather",
         "value": round(query["gather_seconds"] * 1e6, 2),
@@ -260,7 +281,7 @@ def haptics(args) -> Iterator[dict]:
     }
     # Removal capacity: what removing voxels costs (collider bitmaps, volume, edit log), and so
     # how many fit in a 1 ms tick beside the median tick's other work.
-    removal = _core._benchmark_removal(drill, 2000)
+    removal = baselines().removal(drill, 2000)
     per_voxel_us = removal["seconds"] * 1e6 / max(removal["voxels"], 1)
     spare_us = 1000.0 - float(np.median(cpu))
     yield {

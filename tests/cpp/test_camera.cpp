@@ -2,8 +2,9 @@
 
 #include <cmath>
 
-#include "ambfplus//scene/simulator.h"
+#include "ambfplus/engine/engine.h"
 #include "ambfplus/errors.h"
+#include "ambfplus/scene/simulator.h"
 
 namespace ambfplus {
 namespace {
@@ -20,7 +21,7 @@ Camera& make_camera(World& world, int w, int h, double fov) {
 }
 
 TEST(Camera, IntrinsicsFollowThePaper) {
-  auto sim = Simulator::create();
+  auto sim = engine::create_simulator();
   Camera& cam = make_camera(sim->world(), 640, 480, 0.7);
   const Eigen::Matrix3d k = cam.intrinsics();
   EXPECT_DOUBLE_EQ(k(0, 0), 480 / (2 * std::tan(0.35)));
@@ -32,7 +33,7 @@ TEST(Camera, IntrinsicsFollowThePaper) {
 // The projection matrix must agree with K: window coordinates equal continuous pixel coordinates,
 // and the reversed depth runs from 1 at near to 0 at far.
 TEST(Camera, ProjectionAgreesWithIntrinsics) {
-  auto sim = Simulator::create();
+  auto sim = engine::create_simulator();
   Camera& cam = make_camera(sim->world(), 320, 200, 1.1);
   const Eigen::Matrix3d k = cam.intrinsics();
   const Eigen::Matrix4d p = cam.projection();
@@ -50,7 +51,7 @@ TEST(Camera, ProjectionAgreesWithIntrinsics) {
 }
 
 TEST(Camera, LookAtPointsTheOpticalAxisAndKeepsUpUp) {
-  auto sim = Simulator::create();
+  auto sim = engine::create_simulator();
   Camera& cam = make_camera(sim->world(), 64, 48, 0.7);
   cam.look_at({1, 2, 3}, {1, 5, 3}, {0, 0, 1});
   const Eigen::Isometry3d pose = cam.pose();
@@ -64,7 +65,7 @@ TEST(Camera, LookAtPointsTheOpticalAxisAndKeepsUpUp) {
 }
 
 TEST(Camera, RejectsBadSpecs) {
-  auto sim = Simulator::create();
+  auto sim = engine::create_simulator();
   CameraSpec spec;
   spec.name = "bad";
   spec.near = 1;

@@ -8,7 +8,8 @@
 #include <chrono>
 #include <thread>
 
-#include "ambfplus/scene/realtime.h"
+#include "ambfplus/engine/engine.h"
+#include "ambfplus/engine/realtime.h"
 #include "ambfplus/scene/simulator.h"
 #include "ambfplus/scene/state_mutex.h"
 
@@ -63,7 +64,7 @@ TEST(ScopedPriority, RaisesForItsLifetimeAndRestores) {
 }
 
 TEST(World, LocksForACopyJustBelowARunningLoop) {
-  auto sim = Simulator::create();
+  auto sim = engine::create_simulator();
   World& world = sim->world();
   std::thread([&] {
     // No loop: an ordinary lock.
@@ -87,7 +88,7 @@ TEST(World, LocksForACopyJustBelowARunningLoop) {
 // A thread holding the world's lock for 5 ms delays one step: the period it begins is long
 // because that step waited for the lock (its wall time), not because a wake-up came late.
 TEST(RealTimeLoop, LatePeriodsSayWhetherTheStepOrTheWakeUpWasLate) {
-  auto sim = Simulator::create();
+  auto sim = engine::create_simulator();
   World& world = sim->world();
   RealTimeLoop loop(world);
   const double before = monotonic();
@@ -136,7 +137,7 @@ TEST(RealTimeLoop, LatePeriodsSayWhetherTheStepOrTheWakeUpWasLate) {
 // that was no lock wait.
 TEST(RealTimeLoop, ACpuTakenAwayShowsAsTimeOffTheCpu) {
   if (!fifo_allowed()) GTEST_SKIP() << "no right to SCHED_FIFO here";
-  auto sim = Simulator::create();
+  auto sim = engine::create_simulator();
   World& world = sim->world();
   RealTimeOptions options;
   options.cpu = 0;

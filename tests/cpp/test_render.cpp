@@ -3,6 +3,7 @@
 #include <cmath>
 #include <fstream>
 
+#include "ambfplus/engine/engine.h"
 #include "ambfplus/errors.h"
 #include "ambfplus/render/gl_info.h"
 #include "ambfplus/scene/simulator.h"
@@ -22,7 +23,7 @@ TEST(Render, ContextReportsOpenGL45) {
 // Removing a model frees the GL objects only it used, and the renderer (with the resources of
 // what stays) carries on: it is not thrown away and rebuilt.
 TEST(Render, RemovingAModelReleasesItsResourcesOnly) {
-  auto sim = Simulator::create();
+  auto sim = engine::create_simulator();
   World& world = sim->world();
   RigidBodySpec box;
   box.name = "box";
@@ -42,13 +43,13 @@ TEST(Render, RemovingAModelReleasesItsResourcesOnly) {
   model.add_body(ball);
   spec.name = "cam2";
   model.add_camera(spec).look_at({0, 3, 0}, {0, 0, 0});
-  cam.capture();
-  static_cast<Camera&>(*world.find("cam2")).capture();
-  auto& renderer = static_cast<render::SceneRenderer&>(world.renderer());
+  capture_frame(cam);
+  capture_frame(static_cast<Camera&>(*world.find("cam2")));
+  auto& renderer = static_cast<render::SceneRenderer&>(render::renderer_of(world));
   EXPECT_EQ(renderer.resource_counts(), (std::array<std::size_t, 4>{2, 0, 2, 0}));
   world.remove_model(model);
-  const Frame frame = cam.capture();
-  EXPECT_EQ(&world.renderer(), &renderer);
+  const Frame frame = capture_frame(cam);
+  EXPECT_EQ(&render::renderer_of(world), &renderer);
   EXPECT_EQ(renderer.resource_counts(), (std::array<std::size_t, 4>{1, 0, 1, 0}));
   EXPECT_NEAR(frame.depth.data()[12 * 32 + 16], 2.5f, 1e-5f);
 }
@@ -56,7 +57,7 @@ TEST(Render, RemovingAModelReleasesItsResourcesOnly) {
 // A box face parallel to the image plane has one depth everywhere it covers, and the capture
 // stamps the clock and the camera's geometry.
 TEST(Render, FrontalFaceHasExactDepthAndFrameCarriesTime) {
-  auto sim = Simulator::create();
+  auto sim = engine::create_simulator();
   World& world = sim->world();
   RigidBodySpec box;
   box.name = "box";
@@ -71,7 +72,7 @@ TEST(Render, FrontalFaceHasExactDepthAndFrameCarriesTime) {
   Camera& cam = world.default_model().add_camera(spec);
   cam.look_at({0, 0, 1.1}, {0, 0, 0}, {0, 1, 0});
   world.step(7);
-  const Frame frame = cam.capture();
+  const Frame frame = capture_frame(cam);
   ASSERT_EQ(frame.depth.size(), 64u * 48u);
   EXPECT_EQ(frame.step, 7);
   EXPECT_DOUBLE_EQ(frame.time, 0.007);

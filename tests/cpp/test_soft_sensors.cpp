@@ -4,8 +4,9 @@
 #include <fstream>
 #include <string>
 
-#include "ambfplus//scene/simulator.h"
+#include "ambfplus/engine/engine.h"
 #include "ambfplus/errors.h"
+#include "ambfplus/scene/simulator.h"
 
 namespace ambfplus {
 namespace {
@@ -30,7 +31,7 @@ RigidBodySpec box(const std::string& name, double mass, double x) {
 }
 
 TEST(SoftSensors, RemovingAModelReleasesWhatItsBodiesWereHeldBy) {
-  auto sim = Simulator::create();
+  auto sim = engine::create_simulator();
   World& world = sim->world();
   RigidBody& hand = world.default_model().add_body(box("hand", 0, 0));
   ConstraintActuatorSpec grip;
@@ -66,7 +67,7 @@ TEST(SoftSensors, RemovingAModelReleasesWhatItsBodiesWereHeldBy) {
 }
 
 TEST(SoftSensors, AWorldWithHoldsAndSoftBodiesGoesAwayCleanly) {
-  auto sim = Simulator::create();
+  auto sim = engine::create_simulator();
   World& world = sim->world();
   RigidBody& hand = world.default_model().add_body(box("hand", 0, 0));
   RigidBody& held = world.default_model().add_body(box("held", 0.1, 0.1));

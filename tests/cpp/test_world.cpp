@@ -6,9 +6,12 @@
 #include <string>
 #include <vector>
 
-#include "ambfplus//scene/simulator.h"
+#include "ambfplus/engine/engine.h"
 #include "ambfplus/errors.h"
+#include "ambfplus/scene/names.h"
+#include "ambfplus/scene/simulator.h"
 #include "ambfplus/scene/system.h"
+#include "ambfplus/scene/world.h"
 
 namespace ambfplus {
 namespace {
@@ -22,7 +25,7 @@ RigidBodySpec sphere(const std::string& name) {
 }
 
 TEST(World, NamesAreUniqueAcrossModels) {
-  auto sim = Simulator::create();
+  auto sim = engine::create_simulator();
   World& world = sim->world();
   world.default_model().add_body(sphere("a"));
   Model& other = world.add_model("other");
@@ -34,7 +37,7 @@ TEST(World, NamesAreUniqueAcrossModels) {
 }
 
 TEST(World, IdsAreStableAndNotReusedAfterAFailedAdd) {
-  auto sim = Simulator::create();
+  auto sim = engine::create_simulator();
   World& world = sim->world();
   const int a = world.default_model().add_body(sphere("a")).id();
   RigidBodySpec bad = sphere("bad");
@@ -73,7 +76,7 @@ class Recorder : public System {
 // A step prepares every system, advances the clock, then runs the stages in their stated
 // order; an object a system refuses is not kept and the systems that took it let it go.
 TEST(World, StepRunsSystemsStageByStageAndObjectsAreAnnounced) {
-  auto sim = Simulator::create();
+  auto sim = engine::create_simulator();
   World& world = sim->world();
   std::vector<std::string> log;
   world.add_system(std::make_unique<Recorder>(
@@ -93,14 +96,100 @@ TEST(World, StepRunsSystemsStageByStageAndObjectsAreAnnounced) {
   EXPECT_EQ(log, (std::vector<std::string>{"removed gone"}));
   std::vector<std::string> names;
   for (System* s : world.systems()) names.push_back(s->name());
-  EXPECT_EQ(names, (std::vector<std::string>{"physics", "devices", "drills", "attachments",
-                                             "renderer", "step log", "plugins", "recorder"}));
+  EXPECT_EQ(names, (std::vector<std::string>{"attachments", "step log", "physics", "devices",
+                                             "drills", "renderer", "plugins", "recorder"}));
+}
+
+// The scene alone is a world that steps: its own systems only, no physics, renderer or plugins.
+TEST(World, SceneAloneHasOnlyItsOwnSystems) {
+  auto sim = Simulator::create();
+  World& world = sim->world();
+  std::vector<std::string> names;
+  for (System* s : world.systems()) names.push_back(s->name());
+  EXPECT_EQ(names, (std::vector<std::string>{"attachments", "step log"}));
+  RigidBody& body = world.default_model().add_body(sphere("a"));
+  world.start_step_log({&body});
+  world.step(3);
+  const StepLog log = world.take_step_log();
+  EXPECT_EQ(log.rows(), 3);
+  ASSERT_EQ(log.columns().size(), 1u);
+  EXPECT_EQ(log.columns()[0].name, "a.pose");
+  EXPECT_THROW(engine::install_systems(world), StateError);
+}
+
+// A system adds its own step-log columns; one may drop the pose.
+class Columns : public System {
+ public:
+  const char* name() const override { return "columns"; }
+  unsigned stages() const override { return 0; }
+  void add_step_log_columns(const Object& object, StepLogColumns& columns) const override {
+    if (object.name() != "b") return;
+    columns.drop_pose();
+    columns.add("id", 1, [](const Object& o, std::vector<double>& out) { out.push_back(o.id()); });
+  }
+};
+
+TEST(World, SystemsAddStepLogColumns) {
+  auto sim = Simulator::create();
+  World& world = sim->world();
+  world.add_system(std::make_unique<Columns>());
+  RigidBody& a = world.default_model().add_body(sphere("a"));
+  RigidBody& b = world.default_model().add_body(sphere("b"));
+  world.start_step_log({&a, &b});
+  world.step(2);
+  const StepLog log = world.take_step_log();
+  ASSERT_EQ(log.columns().size(), 2u);
+  EXPECT_EQ(log.columns()[0].name, "a.pose");
+  EXPECT_EQ(log.columns()[1].name, "b.id");
+  EXPECT_EQ(log.columns()[1].values, (std::vector<double>{2.0, 2.0}));
+  StepLogColumns bad(a);
+  EXPECT_THROW(bad.add("x", 0, [](const Object&, std::vector<double>&) {}), ArgumentError);
+}
+
+// AMBF's lookup, in one function for Python and plugins alike.
+TEST(Names, ResolveByAmbfRules) {
+  auto sim = engine::create_simulator();
+  World& world = sim->world();
+  RigidBody& base = world.default_model().add_body(sphere("base"));
+  base.set_name_space("/ambf/env/");
+  base.set_identifier("BODY base");
+  RigidBody& link = world.default_model().add_body(sphere("link"));
+  link.set_name_space("/ambf/env/");
+  JointSpec spec;
+  spec.name = "base-link";
+  spec.parent = &base;
+  spec.child = &link;
+  Joint& joint = world.default_model().add_joint(spec);
+  joint.set_name_space("/ambf/env/");
+
+  // An exact name, a qualified name, an identifier, namespace + identifier.
+  EXPECT_EQ(&resolve_name(world, "base"), &base);
+  EXPECT_EQ(&resolve_name(world, "/ambf/env/link"), &link);
+  EXPECT_EQ(&resolve_name(world, "BODY base"), &base);
+  EXPECT_EQ(&resolve_name(world, "/ambf/env/BODY base"), &base);
+  // A part of a name: "base" is in the joint's name too, but an exact name wins; "lin" is in
+  // the link's and the joint's, and joints only count when nothing else does.
+  EXPECT_EQ(&resolve_name(world, "lin"), &link);
+  EXPECT_EQ(name_candidates(world, "lin", ObjectKind::kJoint), (std::vector<Object*>{&joint}));
+  EXPECT_EQ(&resolve_name(world, "base-", ObjectKind::kJoint), &joint);
+  // A kind rules objects out; nothing, or several alike, is NotFound naming them.
+  EXPECT_THROW(resolve_name(world, "base", ObjectKind::kCamera), NotFound);
+  EXPECT_THROW(resolve_name(world, "nothing"), NotFound);
+  try {
+    resolve_name(world, "/ambf/env/");
+    FAIL() << "an ambiguous name resolved";
+  } catch (const NotFound& e) {
+    EXPECT_NE(std::string(e.what()).find("ambiguous"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("/ambf/env/base"), std::string::npos);
+  }
+  EXPECT_EQ(parse_object_kind("input device"), ObjectKind::kInputDevice);
+  EXPECT_THROW(parse_object_kind("widget"), ArgumentError);
 }
 
 TEST(World, ClockCountsFixedStepsWithoutDrift) {
   SimulatorOptions options;
   options.time_step = 0.001;
-  auto sim = Simulator::create(options);
+  auto sim = engine::create_simulator(options);
   for (int i = 0; i < 1000; ++i) sim->step();
   EXPECT_EQ(sim->world().step_index(), 1000);
   EXPECT_DOUBLE_EQ(sim->world().time(), 1.0);
@@ -110,7 +199,7 @@ TEST(World, ClockCountsFixedStepsWithoutDrift) {
 TEST(World, RejectsBadTimeStep) {
   SimulatorOptions options;
   options.time_step = 0.0;
-  EXPECT_THROW(Simulator::create(options), ArgumentError);
+  EXPECT_THROW(engine::create_simulator(options), ArgumentError);
 }
 
 TEST(Object, CheckedPoseRejectsNonRigidMatrices) {

@@ -10,7 +10,7 @@
 #include "adf/adf_yaml.h"
 #include "ambfplus/adf/adf.h"
 #include "ambfplus/adf/volume_adf.h"
-#include "ambfplus/render/shader.h"
+#include "ambfplus/scene/shader_spec.h"
 
 namespace ambfplus {
 

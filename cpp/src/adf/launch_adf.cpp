@@ -11,6 +11,7 @@
 
 #include "adf/adf_internal.h"
 #include "ambfplus/log.h"
+#include "ambfplus/physics/physics.h"
 #include "ambfplus/plugin/registry.h"
 #include "ambfplus/scene/simulator.h"
 #include "ambfplus/scene/world.h"
@@ -66,7 +67,7 @@ void adf::load_plugins(const std::vector<AdfPlugin>& plugins, const PluginSite& 
                        const std::string& file, const std::string& where, Context& ctx) {
   for (const AdfPlugin& p : plugins) {
     try {
-      if (site.world->plugins().load(PluginSpec{p.name, p.filename, p.path}, site) == nullptr) {
+      if (plugins_of(*site.world).load(PluginSpec{p.name, p.filename, p.path}, site) == nullptr) {
         ctx.diag->warn(file, where + ": plugin '" + (p.name.empty() ? p.filename : p.name) +
                                  "' is not kept: its init() returned less than 1");
       }
@@ -176,7 +177,7 @@ void load_world(World& world, const std::string& path, adf::Context& ctx) {
   const std::string ns =
       adf::join_ns(ctx.prefix, "/ambf/env/",
                    root["namespace"] ? adf::text(doc, root["namespace"], where, "namespace") : "");
-  Eigen::Vector3d gravity = world.gravity();
+  Eigen::Vector3d gravity = physics::physics_of(world).gravity();
   gravity = adf::xyz(doc, root["gravity"], where, "gravity", gravity);
   // AMBF's cap on fixed sub-steps per real-time update (Bullet's maxSubSteps); a fixed-step
   // world takes exactly the steps asked for, so it is only checked.
@@ -196,7 +197,7 @@ void load_world(World& world, const std::string& path, adf::Context& ctx) {
   const std::vector<AdfPlugin> plugins = adf::read_plugins(doc, root["plugins"], where);
 
   world.set_name_space(ns);
-  world.set_gravity(gravity);
+  physics::physics_of(world).set_gravity(gravity);
   // Lights and cameras may ride on bodies of the environment, so it comes first.
   std::vector<std::pair<std::string, RigidBody*>> own;
   if (!environment.empty()) {

@@ -8,6 +8,7 @@
 #include <filesystem>
 
 #include "adf/model_blocks.h"
+#include "ambfplus/haptics/drill.h"
 #include "ambfplus/log.h"
 #include "ambfplus/scene/world.h"
 
@@ -186,7 +187,7 @@ std::vector<Volume*> adf::add_adf_volumes(
         if (spec.volume == nullptr) return false;
       }
       try {
-        target->add_drill(spec).set_identifier(d.identifier);
+        add_drill(*target, spec).set_identifier(d.identifier);
       } catch (const ArgumentError& e) {
         throw ConfigError(path, d.identifier + ": " + e.what());
       }

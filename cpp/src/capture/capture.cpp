@@ -1,4 +1,4 @@
-// Captures: the pass table, Camera's capture calls, and the passes computed from others.
+// Captures: the pass table, capturing a camera's view, and the passes computed from others.
 
 #include <stdexcept>
 #include <string>
@@ -62,14 +62,14 @@ unsigned CaptureBuffers::passes() const {
          (segmentation ? kPassSegmentation : 0u) | (points ? kPassPoints : 0u);
 }
 
-Frame Camera::capture(const PoseRequest& poses) {
+Frame capture_frame(const Camera& camera, const PoseRequest& poses) {
   Frame frame;
-  capture(frame, poses);
+  capture_into(camera, frame, poses);
   return frame;
 }
 
-void Camera::allocate(Frame& frame, unsigned passes) const {
-  const int h = height_, w = width_;
+void allocate_frame(const Camera& camera, Frame& frame, unsigned passes) {
+  const int h = camera.height(), w = camera.width();
   if (passes & kPassRgb) frame.rgb.allocate(h, w, 3);
   if (passes & kPassDepth) frame.depth.allocate(h, w, 1);
   if (passes & kPassLabel) frame.label.allocate(h, w, 1);
@@ -79,14 +79,15 @@ void Camera::allocate(Frame& frame, unsigned passes) const {
   if (passes & kPassPoints) frame.points.allocate(h, w, 3);
 }
 
-void Camera::capture(Frame& frame, const PoseRequest& poses) {
+void capture_into(const Camera& camera, Frame& frame, const PoseRequest& poses) {
+  const int h = camera.height(), w = camera.width();
   auto check = [&](const auto& buffer, int want_c, const char* what) {
     if (!buffer.empty() &&
-        (buffer.height() != height_ || buffer.width() != width_ || buffer.channels() != want_c)) {
-      throw ArgumentError("camera '" + name() + "': the frame's " + what + " is " +
+        (buffer.height() != h || buffer.width() != w || buffer.channels() != want_c)) {
+      throw ArgumentError("camera '" + camera.name() + "': the frame's " + what + " is " +
                           std::to_string(buffer.height()) + "x" + std::to_string(buffer.width()) +
                           "x" + std::to_string(buffer.channels()) + ", the camera makes " +
-                          std::to_string(height_) + "x" + std::to_string(width_) + "x" +
+                          std::to_string(h) + "x" + std::to_string(w) + "x" +
                           std::to_string(want_c));
     }
   };
@@ -101,7 +102,7 @@ void Camera::capture(Frame& frame, const PoseRequest& poses) {
   const bool fresh = frame.rgb.empty() && frame.depth.empty() && frame.label.empty() &&
                      frame.instance.empty() && frame.voxel.empty() && frame.segmentation.empty() &&
                      frame.points.empty();
-  if (fresh) allocate(frame, passes_);
+  if (fresh) allocate_frame(camera, frame, camera.passes());
   CaptureBuffers buffers;
   buffers.rgb = frame.rgb.data();
   buffers.depth = frame.depth.data();
@@ -110,24 +111,26 @@ void Camera::capture(Frame& frame, const PoseRequest& poses) {
   buffers.voxel = frame.voxel.data();
   buffers.segmentation = frame.segmentation.data();
   buffers.points = frame.points.data();
-  capture(buffers, frame, poses);
+  capture_into(camera, buffers, frame, poses);
 }
 
-void Camera::capture(const CaptureBuffers& buffers, Frame& frame, const PoseRequest& poses) {
+void capture_into(const Camera& camera, const CaptureBuffers& buffers, Frame& frame,
+                  const PoseRequest& poses) {
   if ((buffers.passes() & kAllPasses) == 0) {
-    throw ArgumentError("camera '" + name() + "': a capture needs at least one pass");
+    throw ArgumentError("camera '" + camera.name() + "': a capture needs at least one pass");
   }
+  const int h = camera.height(), w = camera.width();
   // Points follow from depth: render it into scratch memory when not asked for.
   CaptureBuffers drawn = buffers;
   std::vector<float> depth;
   if (buffers.points != nullptr && buffers.depth == nullptr) {
-    depth.resize(static_cast<std::size_t>(width_) * height_);
+    depth.resize(static_cast<std::size_t>(w) * h);
     drawn.depth = depth.data();
   }
   drawn.points = nullptr;
-  world().renderer().render(*this, drawn, poses, frame);
+  render::renderer_of(camera.world()).render(camera, drawn, poses, frame);
   if (buffers.points != nullptr) {
-    capture::points_from_depth(drawn.depth, frame.intrinsics, width_, height_, buffers.points);
+    capture::points_from_depth(drawn.depth, frame.intrinsics, w, h, buffers.points);
   }
 }
 

@@ -27,6 +27,11 @@ constexpr double kPi = 3.14159265358979323846;
 
 }  // namespace
 
+Drill& add_drill(Model& model, const DrillSpec& spec) {
+  const int id = model.claim_name(spec.name, "drill");
+  return model.adopt(std::unique_ptr<Drill>(new Drill(model, spec, id)));
+}
+
 Drill::Drill(Model& model, const DrillSpec& spec, int id)
     : Object(model, spec.name, id), volume_(spec.volume), spec_(spec), burr_(spec.burr) {
   const std::string who = "drill '" + spec.name + "': ";

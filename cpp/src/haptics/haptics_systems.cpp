@@ -4,6 +4,7 @@
 #include "ambfplus/haptics/drill.h"
 #include "ambfplus/haptics/input_device.h"
 #include "ambfplus/haptics/systems.h"
+#include "ambfplus/scene/step_log.h"
 
 namespace ambfplus::haptics {
 namespace {
@@ -12,6 +13,21 @@ template <typename T>
 void erase(std::vector<T*>& list, const Object& object) {
   list.erase(std::remove(list.begin(), list.end(), &object), list.end());
 }
+
+void push(std::vector<double>& out, const Eigen::Vector3d& v) {
+  out.insert(out.end(), {v.x(), v.y(), v.z()});
+}
+
+// The 4x4 matrix, row after row: exactly the pose (a replay sets it back bit for bit).
+void push_pose(std::vector<double>& out, const Eigen::Isometry3d& pose) {
+  const Eigen::Matrix4d& m = pose.matrix();
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) out.push_back(m(r, c));
+  }
+}
+
+const Drill& as_drill(const Object& o) { return static_cast<const Drill&>(o); }
+const InputDevice& as_device(const Object& o) { return static_cast<const InputDevice&>(o); }
 
 class DeviceSystem : public System {
  public:
@@ -26,6 +42,24 @@ class DeviceSystem : public System {
   }
   void object_removed(Object& object) override { erase(devices_, object); }
   void detach_all() override { devices_.clear(); }
+
+  // A device has no pose of its own: its reading and the force sent back are its state.
+  void add_step_log_columns(const Object& object, StepLogColumns& columns) const override {
+    if (object.kind() != ObjectKind::kInputDevice) return;
+    columns.drop_pose();
+    columns.add("position", 3, [](const Object& o, std::vector<double>& out) {
+      push(out, as_device(o).state().position);
+    });
+    columns.add("orientation", 4, [](const Object& o, std::vector<double>& out) {
+      const Eigen::Quaterniond& q = as_device(o).state().orientation;
+      out.insert(out.end(), {q.x(), q.y(), q.z(), q.w()});
+    });
+    columns.add("buttons", 1, [](const Object& o, std::vector<double>& out) {
+      out.push_back(as_device(o).state().buttons);
+    });
+    columns.add("force", 3,
+                [](const Object& o, std::vector<double>& out) { push(out, as_device(o).force()); });
+  }
 
   // Polled devices sample before anything changes, so a sampler that throws leaves the world
   // as it was.
@@ -69,6 +103,28 @@ class DrillSystem : public System {
     }
   }
   void detach_all() override { drills_.clear(); }
+
+  void add_step_log_columns(const Object& object, StepLogColumns& columns) const override {
+    if (object.kind() != ObjectKind::kDrill) return;
+    columns.add("goal", 16, [](const Object& o, std::vector<double>& out) {
+      push_pose(out, as_drill(o).goal());
+    });
+    columns.add("force", 3,
+                [](const Object& o, std::vector<double>& out) { push(out, as_drill(o).force()); });
+    columns.add("total_force", 3, [](const Object& o, std::vector<double>& out) {
+      push(out, as_drill(o).total_force());
+    });
+    columns.add("on", 1, [](const Object& o, std::vector<double>& out) {
+      out.push_back(as_drill(o).on() ? 1.0 : 0.0);
+    });
+    columns.add("burr", 1, [](const Object& o, std::vector<double>& out) {
+      out.push_back(as_drill(o).burr());
+    });
+    columns.add("leading", 1, [](const Object& o, std::vector<double>& out) {
+      out.push_back(as_drill(o).leading_cursor());
+    });
+  }
+
   void run(StepStage, const StepContext& context) override {
     for (Drill* d : drills_) d->tick(context.dt, context.step);
   }

@@ -6,8 +6,18 @@
 
 #include "ambfplus/haptics/drill.h"
 #include "ambfplus/scene/camera.h"
+#include "ambfplus/scene/model.h"
+#include "ambfplus/scene/world.h"
 
 namespace ambfplus {
+
+InputDevice& add_input_device(Model& model, const InputDeviceSpec& spec) {
+  if (spec.drill != nullptr && &spec.drill->world() != &model.world()) {
+    throw ArgumentError("input device '" + spec.name + "': its drill is in another world");
+  }
+  const int id = model.claim_name(spec.name, "input device");
+  return model.adopt(std::unique_ptr<InputDevice>(new InputDevice(model, spec, id)));
+}
 
 InputDevice::InputDevice(Model& model, const InputDeviceSpec& spec, int id)
     : Object(model, spec.name, id), spec_(spec) {

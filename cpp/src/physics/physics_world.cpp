@@ -122,8 +122,13 @@ PhysicsWorld::~PhysicsWorld() { detach_all(); }
 
 std::unique_ptr<Physics> make_physics(World&) { return std::make_unique<PhysicsWorld>(); }
 
+Physics& physics_of(const World& world) {
+  if (auto* physics = world.find_system<Physics>()) return *physics;
+  throw StateError("world '" + world.name() + "' has no physics (make it with the engine)");
+}
+
 PhysicsWorld& physics_of(const Object& object) {
-  return static_cast<PhysicsWorld&>(object.world().physics());
+  return static_cast<PhysicsWorld&>(physics_of(object.world()));
 }
 
 void PhysicsWorld::object_added(Object& object) {

@@ -14,6 +14,7 @@
 #include "ambfplus/haptics/drill.h"
 #include "ambfplus/log.h"
 #include "ambfplus/scene/ghost.h"
+#include "ambfplus/scene/names.h"
 #include "ambfplus/scene/simulator.h"
 #include "ambfplus/scene/world.h"
 #include "plugin/plugin_options.h"
@@ -384,7 +385,8 @@ int ambfplus_world_lookup(const AmbfplusWorld* world, const char* query, int kin
   return guarded(-1, [&] {
     std::optional<ambfplus::ObjectKind> want;
     if (kind >= 0) want = static_cast<ambfplus::ObjectKind>(kind);
-    const auto found = ambfplus::world_of(world).lookup(query != nullptr ? query : "", want);
+    const auto found =
+        ambfplus::name_candidates(ambfplus::world_of(world), query != nullptr ? query : "", want);
     for (int i = 0; i < capacity && i < static_cast<int>(found.size()); ++i) {
       ids[i] = found[static_cast<std::size_t>(i)]->id();
     }

@@ -68,7 +68,7 @@ Object& add_object(Model& model, const std::string& kind, const std::string& nam
       throw ArgumentError("drill '" + name + "': option 'volume' (a volume's name) is needed");
     }
     drill_options().apply(spec, rest);
-    return model.add_drill(spec);
+    return add_drill(model, spec);
   }
   throw ArgumentError("ambfplus_world_add makes a 'body', a 'ghost' or a 'drill', not '" + kind +
                       "'");

@@ -67,6 +67,11 @@ PluginInstance::~PluginInstance() = default;
 
 PluginRegistry::PluginRegistry(World& world) : world_(&world) {}
 
+PluginRegistry& plugins_of(const World& world) {
+  if (auto* plugins = world.find_system<PluginRegistry>()) return *plugins;
+  throw StateError("world '" + world.name() + "' has no plugins (make it with the engine)");
+}
+
 PluginRegistry::~PluginRegistry() = default;
 
 void PluginRegistry::check_site(const std::string& name, const PluginSite& site) const {

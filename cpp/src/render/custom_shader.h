@@ -4,8 +4,8 @@
 
 #include <Eigen/Geometry>
 
-#include "ambfplus/render/shader.h"
 #include "ambfplus/scene/rigid_body.h"
+#include "ambfplus/scene/shader_spec.h"
 #include "render/gl_program.h"
 
 namespace ambfplus {

@@ -509,7 +509,7 @@ std::vector<Frame> OpenXrSession::end_frame(const std::vector<const Camera*>& ca
   frames.resize(cameras.size());
   for (std::size_t i = 0; i < cameras.size(); ++i) {
     const render::RenderTarget& target =
-        static_cast<render::SceneRenderer&>(cameras[i]->world().renderer())
+        static_cast<render::SceneRenderer&>(render::renderer_of(cameras[i]->world()))
             .render_to_target(*cameras[i], kPassRgb, frames[i]);
     State::Eye& eye = s.eyes[i];
     render::Context::Scope scope;

@@ -35,6 +35,11 @@ std::unique_ptr<Renderer> make_renderer(World& world) {
   return std::make_unique<SceneRenderer>(world);
 }
 
+Renderer& renderer_of(const World& world) {
+  if (auto* renderer = world.find_system<Renderer>()) return *renderer;
+  throw StateError("world '" + world.name() + "' has no renderer (make it with the engine)");
+}
+
 SceneRenderer::SceneRenderer(World& world) : world_(world) {}
 
 SceneRenderer::~SceneRenderer() { release_all(); }

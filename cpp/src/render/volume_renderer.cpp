@@ -432,7 +432,7 @@ namespace ambfplus {
 VolumeUploadStats last_volume_upload(const Volume& volume) {
   VolumeUploadStats stats;
   const auto upload =
-      static_cast<render::SceneRenderer&>(volume.world().renderer()).last_upload(volume);
+      static_cast<render::SceneRenderer&>(render::renderer_of(volume.world())).last_upload(volume);
   if (!upload) return stats;
   stats.rendered = true;
   stats.full = upload->full;

@@ -120,7 +120,7 @@ std::vector<Frame> Window::present(const std::vector<const Camera*>& cameras, in
   std::vector<const render::RenderTarget*> targets;
   for (std::size_t i = 0; i < cameras.size(); ++i) {
     render::SceneRenderer& renderer =
-        static_cast<render::SceneRenderer&>(cameras[i]->world().renderer());
+        static_cast<render::SceneRenderer&>(render::renderer_of(cameras[i]->world()));
     if (!rendered) {
       targets.push_back(&renderer.render_to_target(*cameras[i], kPassRgb, frames[i]));
       continue;

@@ -12,11 +12,17 @@ Model::Model(World& world, std::string name) : world_(&world), name_(std::move(n
 
 Model::~Model() = default;
 
+int Model::claim_name(const std::string& name, const char* what) {
+  return world_->claim_name(name, what);
+}
+
 // The world's systems hear of the object (physics builds its Bullet side and may refuse it);
 // only an object they all took is kept.
-template <typename T>
-T& Model::adopt(std::unique_ptr<T> object) {
-  T& ref = *object;
+Object& Model::adopt(std::unique_ptr<Object> object) {
+  if (!object || &object->model() != this) {
+    throw ArgumentError("model '" + name_ + "': adopt needs an object built for it");
+  }
+  Object& ref = *object;
   objects_.push_back(object.get());
   try {
     world_->register_object(object.get());
@@ -59,19 +65,6 @@ Light& Model::add_light(const LightSpec& spec) {
 Volume& Model::add_volume(const VolumeSpec& spec) {
   const int id = world_->claim_name(spec.name, "volume");
   return adopt(std::unique_ptr<Volume>(new Volume(*this, spec, id)));
-}
-
-Drill& Model::add_drill(const DrillSpec& spec) {
-  const int id = world_->claim_name(spec.name, "drill");
-  return adopt(std::unique_ptr<Drill>(new Drill(*this, spec, id)));
-}
-
-InputDevice& Model::add_input_device(const InputDeviceSpec& spec) {
-  if (spec.drill != nullptr && &spec.drill->world() != world_) {
-    throw ArgumentError("input device '" + spec.name + "': its drill is in another world");
-  }
-  const int id = world_->claim_name(spec.name, "input device");
-  return adopt(std::unique_ptr<InputDevice>(new InputDevice(*this, spec, id)));
 }
 
 SoftBody& Model::add_soft_body(const SoftBodySpec& spec) {

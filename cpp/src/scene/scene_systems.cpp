@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "ambfplus/scene/object.h"
+#include "ambfplus/scene/world.h"
 
 namespace ambfplus::scene {
 
@@ -33,9 +34,14 @@ void StepLogger::run(StepStage, const StepContext& context) {
 }
 
 void StepLogger::start(const std::vector<const Object*>& objects) {
-  log_ = std::make_unique<StepLog>(objects);
+  std::vector<StepLogColumns> columns;
+  for (const Object* o : objects) {
+    columns.emplace_back(*o);
+    for (System* s : world_.systems()) s->add_step_log_columns(*o, columns.back());
+  }
+  log_ = std::make_unique<StepLog>(std::move(columns));
 }
 
-StepLog StepLogger::take() { return log_ ? log_->take() : StepLog(std::vector<const Object*>{}); }
+StepLog StepLogger::take() { return log_ ? log_->take() : StepLog(std::vector<StepLogColumns>{}); }
 
 }  // namespace ambfplus::scene

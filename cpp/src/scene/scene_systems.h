@@ -31,6 +31,8 @@ class Attachments : public System {
 /// (and counted), so a log nobody drains cannot grow without end.
 class StepLogger : public System {
  public:
+  /// Logs the objects of this world, with the columns its systems add.
+  explicit StepLogger(const World& world) : world_(world) {}
   /// About 16 MB of doubles: 5 minutes of a drill and a device at 1 kHz.
   static constexpr std::size_t kMaxValues = std::size_t{1} << 21;
   const char* name() const override { return "step log"; }
@@ -45,6 +47,7 @@ class StepLogger : public System {
   bool logging() const { return static_cast<bool>(log_); }
 
  private:
+  const World& world_;
   std::unique_ptr<StepLog> log_;
 };
 

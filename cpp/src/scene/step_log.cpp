@@ -4,8 +4,8 @@
 
 #include <Eigen/Geometry>
 
-#include "ambfplus/haptics/drill.h"
-#include "ambfplus/haptics/input_device.h"
+#include "ambfplus/errors.h"
+#include "ambfplus/scene/object.h"
 
 namespace ambfplus {
 namespace {
@@ -18,32 +18,22 @@ void push_pose(std::vector<double>& out, const Eigen::Isometry3d& pose) {
   }
 }
 
-void push(std::vector<double>& out, const Eigen::Vector3d& v) {
-  out.insert(out.end(), {v.x(), v.y(), v.z()});
-}
-
 }  // namespace
 
-StepLog::StepLog(std::vector<const Object*> objects) : objects_(std::move(objects)) {
-  for (const Object* o : objects_) {
-    const std::string& n = o->name();
-    // An input device has no pose of its own: its reading is its state.
-    if (o->kind() != ObjectKind::kInputDevice) columns_.push_back({n + ".pose", 16, {}});
-    if (o->kind() == ObjectKind::kDrill) {
-      for (const auto& [field, width] : std::vector<std::pair<const char*, int>>{{"goal", 16},
-                                                                                 {"force", 3},
-                                                                                 {"total_force", 3},
-                                                                                 {"on", 1},
-                                                                                 {"burr", 1},
-                                                                                 {"leading", 1}}) {
-        columns_.push_back({n + "." + field, width, {}});
-      }
-    } else if (o->kind() == ObjectKind::kInputDevice) {
-      for (const auto& [field, width] : std::vector<std::pair<const char*, int>>{
-               {"position", 3}, {"orientation", 4}, {"buttons", 1}, {"force", 3}}) {
-        columns_.push_back({n + "." + field, width, {}});
-      }
-    }
+void StepLogColumns::add(std::string name, int width, Recorder record) {
+  if (width < 1 || !record) {
+    throw ArgumentError("step log column '" + object_->name() + "." + name +
+                        "' needs a width of at least 1 and a recorder");
+  }
+  fields_.push_back({std::move(name), width, std::move(record)});
+}
+
+StepLog::StepLog(std::vector<StepLogColumns> objects) : objects_(std::move(objects)) {
+  for (const StepLogColumns& o : objects_) {
+    const std::string& n = o.object().name();
+    if (o.pose()) columns_.push_back({n + ".pose", 16, {}});
+    for (const StepLogColumns::Field& f : o.fields())
+      columns_.push_back({n + "." + f.name, f.width, {}});
   }
 }
 
@@ -51,23 +41,9 @@ void StepLog::record(std::int64_t step, double time) {
   steps_.push_back(step);
   times_.push_back(time);
   std::size_t c = 0;
-  for (const Object* o : objects_) {
-    if (o->kind() != ObjectKind::kInputDevice) push_pose(columns_[c++].values, o->pose());
-    if (const auto* drill = dynamic_cast<const Drill*>(o)) {
-      push_pose(columns_[c++].values, drill->goal());
-      push(columns_[c++].values, drill->force());
-      push(columns_[c++].values, drill->total_force());
-      columns_[c++].values.push_back(drill->on() ? 1.0 : 0.0);
-      columns_[c++].values.push_back(drill->burr());
-      columns_[c++].values.push_back(drill->leading_cursor());
-    } else if (const auto* device = dynamic_cast<const InputDevice*>(o)) {
-      const DeviceState& s = device->state();
-      push(columns_[c++].values, s.position);
-      const Eigen::Quaterniond& q = s.orientation;
-      columns_[c++].values.insert(columns_[c - 1].values.end(), {q.x(), q.y(), q.z(), q.w()});
-      columns_[c++].values.push_back(s.buttons);
-      push(columns_[c++].values, device->force());
-    }
+  for (const StepLogColumns& o : objects_) {
+    if (o.pose()) push_pose(columns_[c++].values, o.object().pose());
+    for (const StepLogColumns::Field& f : o.fields()) f.record(o.object(), columns_[c++].values);
   }
 }
 
@@ -97,7 +73,8 @@ void StepLog::drop_oldest(std::int64_t n) {
 }
 
 bool StepLog::logs(const Object& object) const {
-  return std::find(objects_.begin(), objects_.end(), &object) != objects_.end();
+  return std::any_of(objects_.begin(), objects_.end(),
+                     [&](const StepLogColumns& o) { return &o.object() == &object; });
 }
 
 }  // namespace ambfplus

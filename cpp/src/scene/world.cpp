@@ -5,10 +5,6 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "ambfplus/haptics/systems.h"
-#include "ambfplus/physics/physics.h"
-#include "ambfplus/plugin/registry.h"
-#include "ambfplus/render/renderer.h"
 #include "scene/scene_systems.h"
 
 namespace ambfplus {
@@ -43,31 +39,19 @@ System::~System() = default;
 World::World(Simulator& simulator, std::string name, double time_step)
     : simulator_(&simulator), name_(std::move(name)), time_step_(time_step) {
   models_.push_back(std::unique_ptr<Model>(new Model(*this, name_)));
-  // The order objects are announced in: physics first (it may refuse one), plugins last (they
-  // hear of an object once everything else has taken it).
-  auto physics = physics::make_physics(*this);
-  physics_ = physics.get();
-  add_system(std::move(physics));
-  add_system(haptics::make_device_system());
-  add_system(haptics::make_drill_system());
+  // The scene's own systems; the engine adds the others after them (engine::install_systems).
   auto attachments = std::make_unique<scene::Attachments>();
   attachments_ = attachments.get();
   add_system(std::move(attachments));
-  auto renderer = render::make_renderer(*this);
-  renderer_ = renderer.get();
-  add_system(std::move(renderer));
-  auto logger = std::make_unique<scene::StepLogger>();
+  auto logger = std::make_unique<scene::StepLogger>(*this);
   step_logger_ = logger.get();
   add_system(std::move(logger));
-  auto plugins = std::make_unique<PluginRegistry>(*this);
-  plugins_ = plugins.get();
-  add_system(std::move(plugins));
 }
 
-// Plugins close first, while all is intact; then every system lets go of the objects (the
-// renderer its GL objects, Bullet its bodies and joints) before they are deleted.
+// What needs the world whole finishes first (plugins close); then every system lets go of the
+// objects (the renderer its GL objects, Bullet its bodies and joints) before they are deleted.
 World::~World() {
-  plugins_->close_all();
+  for (auto it = systems_.rbegin(); it != systems_.rend(); ++it) (*it)->world_closing();
   for (auto it = systems_.rbegin(); it != systems_.rend(); ++it) (*it)->detach_all();
   models_.clear();
 }
@@ -85,10 +69,6 @@ std::vector<System*> World::systems() const {
   for (const auto& s : systems_) out.push_back(s.get());
   return out;
 }
-
-void World::set_gravity(const Eigen::Vector3d& g) { physics_->set_gravity(g); }
-
-Eigen::Vector3d World::gravity() const { return physics_->gravity(); }
 
 Model& World::add_model(const std::string& name) {
   for (const auto& m : models_) {
@@ -168,7 +148,7 @@ void World::remove_model(Model& model) {
   const auto it = std::find_if(models_.begin(), models_.end(),
                                [&](const auto& m) { return m.get() == &model; });
   if (it == models_.end()) throw ArgumentError("the model is not in this world");
-  plugins_->close_model(model);
+  for (auto sys = systems_.rbegin(); sys != systems_.rend(); ++sys) (*sys)->model_removing(model);
   deferred_.erase(std::remove_if(deferred_.begin(), deferred_.end(),
                                  [&](const DeferredLink& l) { return l.model == &model; }),
                   deferred_.end());
@@ -287,15 +267,11 @@ StepLog World::take_step_log() {
 
 bool World::logging_steps() const { return step_logger_->logging(); }
 
-PluginRegistry& World::plugins() { return *plugins_; }
-
-void World::reset_plugins() { plugins_->reset(); }
-
 void World::graphics_update() {
   auto lock = lock_state();
   if (graphics_step_ != step_index_) {
     graphics_step_ = step_index_;
-    plugins_->graphics_update();
+    for (const auto& system : systems_) system->graphics_update();
   }
 }
 

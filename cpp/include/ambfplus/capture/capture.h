@@ -8,10 +8,13 @@
 #include <string>
 #include <vector>
 
+#include "ambfplus/capture/frame.h"
 #include "ambfplus/capture/passes.h"
 #include "ambfplus/export.h"
 
 namespace ambfplus {
+
+class Camera;
 
 /// Where a capture writes its images; null pointers are not captured.
 struct AMBFPLUS_API CaptureBuffers {
@@ -38,5 +41,19 @@ struct AMBFPLUS_API PoseRequest {
     return r;
   }
 };
+
+/// Renders a camera's view into a new frame that owns its images (the camera's passes).
+AMBFPLUS_API Frame capture_frame(const Camera& camera, const PoseRequest& poses = {});
+/// Renders into an existing frame: its buffers are reused (filled in place) and must match the
+/// camera's size. A frame without buffers gets the camera's passes; one with buffers is refilled
+/// with exactly those. Throws ArgumentError on a mismatch.
+AMBFPLUS_API void capture_into(const Camera& camera, Frame& frame, const PoseRequest& poses = {});
+/// Renders into caller-owned memory and fills frame's metadata and poses (its buffers are left
+/// alone).
+AMBFPLUS_API void capture_into(const Camera& camera, const CaptureBuffers& buffers, Frame& frame,
+                               const PoseRequest& poses = {});
+/// Allocates in an empty frame the buffers of these passes (CapturePass bits) at the camera's
+/// size.
+AMBFPLUS_API void allocate_frame(const Camera& camera, Frame& frame, unsigned passes);
 
 }  // namespace ambfplus

@@ -89,6 +89,11 @@ struct AMBFPLUS_API DrillWaypoint {
   double speed = 1.0;
 };
 
+class Drill;
+/// Creates a drill in a model, working on a volume of the same world. Throws ArgumentError for a
+/// bad spec or a taken name.
+AMBFPLUS_API Drill& add_drill(Model& model, const DrillSpec& spec);
+
 /// The paper's drill: a tip cursor of the burr's radius and shaft cursors along the axis, each
 /// a finger proxy against the volume. The cursor with the largest proxy-goal error drives the
 /// drill's pose and the force fed back; only the tip removes tissue, and only when it leads, the
@@ -185,7 +190,7 @@ class AMBFPLUS_API Drill : public Object {
   const MeshCollider& mesh_collider() const { return meshes_; }
 
  private:
-  friend class Model;
+  friend Drill& add_drill(Model& model, const DrillSpec& spec);
   Drill(Model& model, const DrillSpec& spec, int id);
   void follow_waypoints();
   // Brings the mesh collider up to date with the world's bodies and their poses.

@@ -42,6 +42,11 @@ struct AMBFPLUS_API InputDeviceSpec {
 /// burr_button, max_force, force_scale.
 AMBFPLUS_API const OptionTable<InputDeviceSpec>& input_device_options();
 
+class InputDevice;
+/// Creates an input device in a model, bound to a drill of the same world. Throws ArgumentError
+/// for a bad spec, a drill of another world or a taken name.
+AMBFPLUS_API InputDevice& add_input_device(Model& model, const InputDeviceSpec& spec);
+
 /// A device bound to a drill, as a surgeon holds it: each step, before physics, the device's
 /// motion since the previous reading moves the drill's goal, scaled by the workspace scale and
 /// turned into the reference's current axes (so a camera moving alone does not move the drill);
@@ -75,7 +80,7 @@ class AMBFPLUS_API InputDevice : public Object {
   const Eigen::Vector3d& force() const { return force_; }
 
  private:
-  friend class Model;
+  friend InputDevice& add_input_device(Model& model, const InputDeviceSpec& spec);
   InputDevice(Model& model, const InputDeviceSpec& spec, int id);
   Eigen::Matrix3d reference_rotation() const;
   bool held(int button) const {

@@ -29,6 +29,9 @@ class AMBFPLUS_API Physics : public System {
 
 /// The physics of a world (AMBF's default gravity, 0, 0, -9.8).
 AMBFPLUS_API std::unique_ptr<Physics> make_physics(World& world);
+/// A world's physics system (engine::install_systems adds it). Throws StateError for a world
+/// without one.
+AMBFPLUS_API Physics& physics_of(const World& world);
 
 }  // namespace physics
 }  // namespace ambfplus

@@ -92,7 +92,9 @@ AMBFPLUS_API AmbfplusId ambfplus_world_object(const AmbfplusWorld* world, int in
 /** The object with exactly this name (of this kind, or AMBFPLUS_ANY), else 0. */
 AMBFPLUS_API AmbfplusId ambfplus_world_find(const AmbfplusWorld* world, const char* name, int kind);
 /** Objects a name refers to as AMBF finds them ("l1", "/ambf/env/l1", "BODY l1", a unique part
- * of a name): writes up to capacity ids and returns how many match. */
+ * of a name; an exact name first; of several, joints dropped when no kind is asked for and that
+ * leaves one), by the same rules as Python's World.get (ambfplus/scene/names.h): writes up to
+ * capacity ids and returns how many match. */
 AMBFPLUS_API int ambfplus_world_lookup(const AmbfplusWorld* world, const char* query, int kind,
                                        AmbfplusId* ids, int capacity);
 /** Creates an object of kind "body", "ghost" (a ghost object: a body's options, no collision

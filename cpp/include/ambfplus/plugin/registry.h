@@ -147,7 +147,7 @@ class AMBFPLUS_API PluginRegistry : public System {
   /// physics_update(dt) of the plugins of other languages alone (a real-time loop calls it at a
   /// lower rate, with the time since the last call).
   void foreign_physics_update(double dt);
-  void graphics_update();
+  void graphics_update() override;
   void keyboard(int key, int scancode, int action, int mods);
   void mouse_button(int button, int action, int mods);
   void mouse_move(double x, double y);
@@ -162,6 +162,8 @@ class AMBFPLUS_API PluginRegistry : public System {
   void run(StepStage stage, const StepContext& context) override {
     physics_update(context.dt, /*native_only=*/context.realtime);
   }
+  void model_removing(Model& model) override { close_model(model); }
+  void world_closing() override { close_all(); }
   /// Calls close() on every plugin in the reverse of call order, then destroys them.
   void close_all();
   /// Closes (reverse order) and destroys the plugins of a model and of its objects.
@@ -179,5 +181,9 @@ class AMBFPLUS_API PluginRegistry : public System {
   World* world_;
   std::vector<std::shared_ptr<Entry>> entries_[4];  // by PluginScope
 };
+
+/// The plugins of a world (its PluginRegistry system, which engine::install_systems adds).
+/// Throws StateError for a world without one.
+AMBFPLUS_API PluginRegistry& plugins_of(const World& world);
 
 }  // namespace ambfplus

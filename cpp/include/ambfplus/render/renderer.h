@@ -31,6 +31,9 @@ class AMBFPLUS_API Renderer : public System {
 
 /// The renderer of a world (nothing touches the GPU before its first render).
 AMBFPLUS_API std::unique_ptr<Renderer> make_renderer(World& world);
+/// A world's renderer (engine::install_systems adds it). Throws StateError for a world without
+/// one.
+AMBFPLUS_API Renderer& renderer_of(const World& world);
 
 }  // namespace render
 }  // namespace ambfplus

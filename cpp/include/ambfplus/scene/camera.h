@@ -7,11 +7,10 @@
 
 #include <Eigen/Core>
 
-#include "ambfplus/capture/capture.h"
-#include "ambfplus/capture/frame.h"
-#include "ambfplus/render/shader.h"
+#include "ambfplus/capture/passes.h"
 #include "ambfplus/scene/object.h"
 #include "ambfplus/scene/options.h"
+#include "ambfplus/scene/shader_spec.h"
 
 namespace ambfplus {
 
@@ -47,6 +46,7 @@ struct AMBFPLUS_API CameraSpec {
 AMBFPLUS_API const OptionTable<CameraSpec>& camera_options();
 
 /// A pinhole camera in the OpenCV frame (x right, y down, z forward). pose() is world from camera.
+/// The camera describes a view; capture/capture.h renders it (capture_frame, capture_into).
 class AMBFPLUS_API Camera : public Object {
  public:
   ObjectKind kind() const override { return ObjectKind::kCamera; }
@@ -84,19 +84,6 @@ class AMBFPLUS_API Camera : public Object {
 
   /// OpenGL clip from camera (OpenCV frame), mapping image row 0 to the first row read back.
   Eigen::Matrix4d projection() const;
-
-  /// Renders and returns a new frame that owns its images (the camera's passes).
-  Frame capture(const PoseRequest& poses = {});
-  /// Renders into an existing frame: its buffers are reused (filled in place) and must match
-  /// this camera's size. A frame without buffers gets the camera's passes; one with buffers is
-  /// refilled with exactly those. Throws ArgumentError on a mismatch.
-  void capture(Frame& frame, const PoseRequest& poses = {});
-  /// Renders into caller-owned memory and fills frame's metadata and poses (its buffers are
-  /// left alone).
-  void capture(const CaptureBuffers& buffers, Frame& frame, const PoseRequest& poses = {});
-  /// Allocates in an empty frame the buffers of these passes (CapturePass bits) at this
-  /// camera's size.
-  void allocate(Frame& frame, unsigned passes) const;
 
  private:
   friend class Model;

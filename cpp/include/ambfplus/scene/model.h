@@ -6,8 +6,6 @@
 #include <vector>
 
 #include "ambfplus/export.h"
-#include "ambfplus/haptics/drill.h"
-#include "ambfplus/haptics/input_device.h"
 #include "ambfplus/scene/camera.h"
 #include "ambfplus/scene/constraint_actuator.h"
 #include "ambfplus/scene/joint.h"
@@ -51,11 +49,6 @@ class AMBFPLUS_API Model {
   Light& add_light(const LightSpec& spec);
   /// Places a volume. Throws ArgumentError for a bad spec or a taken name.
   Volume& add_volume(const VolumeSpec& spec);
-  /// Creates a drill working on a volume of the same world.
-  Drill& add_drill(const DrillSpec& spec);
-  /// Binds a device to a drill of the same world. Throws ArgumentError for a bad spec
-  /// or a taken name.
-  InputDevice& add_input_device(const InputDeviceSpec& spec);
   /// Creates a soft body from a mesh file. Throws ArgumentError for a bad spec or a taken
   /// name, AssetNotFound or ConfigError for a mesh that cannot be read.
   SoftBody& add_soft_body(const SoftBodySpec& spec);
@@ -66,11 +59,24 @@ class AMBFPLUS_API Model {
   /// a bad spec or a taken name.
   ConstraintActuator& add_actuator(const ConstraintActuatorSpec& spec);
 
+  /// For objects of kinds defined above the scene (haptics' drills and input devices): the id
+  /// an object named `name` gets. Throws ArgumentError if the name is empty or taken (`what`
+  /// names the kind in the message).
+  int claim_name(const std::string& name, const char* what);
+  /// Keeps an object built for this model with claim_name's id: the world's systems hear of it
+  /// (physics may refuse it: the error is passed on and the object is not kept).
+  Object& adopt(std::unique_ptr<Object> object);
+  /// adopt, giving the object back as its own type.
+  template <typename T>
+  T& adopt(std::unique_ptr<T> object) {
+    T& ref = *object;
+    adopt(std::unique_ptr<Object>(std::move(object)));
+    return ref;
+  }
+
  private:
   friend class World;
   Model(World& world, std::string name);
-  template <typename T>
-  T& adopt(std::unique_ptr<T> object);
 
   World* world_;
   std::string name_;

@@ -11,9 +11,9 @@
 #include <Eigen/Core>
 
 #include "ambfplus/io/mesh.h"
-#include "ambfplus/render/shader.h"
 #include "ambfplus/scene/object.h"
 #include "ambfplus/scene/options.h"
+#include "ambfplus/scene/shader_spec.h"
 
 namespace ambfplus {
 

@@ -22,7 +22,9 @@ struct AMBFPLUS_API SimulatorOptions {
 /// the bindings give out keeps the simulator alive.
 class AMBFPLUS_API Simulator : public std::enable_shared_from_this<Simulator> {
  public:
-  /// Creates a simulator with an empty world. Throws ArgumentError for bad options.
+  /// Creates a simulator with an empty world that has only the scene's own systems (what the
+  /// scene's unit tests need); engine::create_simulator adds physics, haptics, rendering and
+  /// plugins. Throws ArgumentError for bad options.
   static std::shared_ptr<Simulator> create(const SimulatorOptions& options = {});
   ~Simulator();
   Simulator(const Simulator&) = delete;

@@ -2,8 +2,10 @@
 
 // Systems: the parts of the engine that take part in a world's steps (physics, devices, drills,
 // attachments, actuators, sensors, plugins, the step log) and in its objects' lives (the
-// renderer). World::step runs them stage by stage in the order below; cpp/README.md ("World
-// steps") says what each stage sees.
+// renderer). The scene defines the interface, runs it and has two systems of its own (the
+// attachments and the step log); the others live in the areas above it, and ambfplus/engine adds
+// them to a world. World::step runs them stage by stage in the order below; cpp/README.md
+// ("World steps") says what each stage sees.
 
 #include <cstdint>
 
@@ -11,7 +13,9 @@
 
 namespace ambfplus {
 
+class Model;
 class Object;
+class StepLogColumns;
 class World;
 
 /// The stages of a world step, in the order they run.
@@ -66,6 +70,17 @@ class AMBFPLUS_API System {
   virtual void prepare(const StepContext& context) {}
   /// Its part of a step in one of its stages.
   virtual void run(StepStage stage, const StepContext& context) {}
+  /// A model is about to be removed (World::remove_model), before any of its objects: let go of
+  /// what belongs to the model as a whole (plugins of model scope close).
+  virtual void model_removing(Model& model) {}
+  /// Before a render copies the world, at most once per step (World::graphics_update).
+  virtual void graphics_update() {}
+  /// Adds what it logs of an object to a step log (World::start_step_log): columns after the
+  /// object's pose, or the pose left out (an input device has none of its own).
+  virtual void add_step_log_columns(const Object& object, StepLogColumns& columns) const {}
+  /// The world is going away, still whole: finish what needs it whole (plugins close). Every
+  /// system hears this, in the reverse of the order they were added, before any detach_all.
+  virtual void world_closing() {}
   /// The world is going away: let go of every object (they are destroyed next).
   virtual void detach_all() {}
 };

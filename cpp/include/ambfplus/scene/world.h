@@ -11,8 +11,6 @@
 
 #include <functional>
 
-#include <Eigen/Core>
-
 #include "ambfplus/export.h"
 #include "ambfplus/scene/model.h"
 #include "ambfplus/scene/state_mutex.h"
@@ -22,13 +20,6 @@
 namespace ambfplus {
 
 class Simulator;
-class PluginRegistry;
-namespace render {
-class Renderer;
-}
-namespace physics {
-class Physics;
-}
 namespace scene {
 class Attachments;
 class StepLogger;
@@ -49,8 +40,10 @@ struct AMBFPLUS_API DeferredLink {
 ///
 /// A step runs the world's systems stage by stage (StepStage: device input, physics, haptics,
 /// device output, attachments, actuators, sensors, plugins, logging), each stage's systems in
-/// the order they were added. The world holds a physics system, devices and drills systems, the
-/// attachments of objects riding on others, a renderer, the step log and the plugin registry.
+/// the order they were added. The world itself holds only the scene's own systems (the
+/// attachments of objects riding on others, and the step log); the layer above it
+/// (ambfplus/engine/engine.h) adds physics, devices, drills, the renderer and the plugins, which
+/// other areas reach through find_system.
 class AMBFPLUS_API World {
  public:
   ~World();
@@ -105,6 +98,9 @@ class AMBFPLUS_API World {
   void add_system(std::unique_ptr<System> system);
   /// The systems in the order they hear of objects and run within a stage.
   std::vector<System*> systems() const;
+  /// The first system that is a T (physics::Physics, render::Renderer, ...), or nullptr.
+  template <typename T>
+  T* find_system() const;
   /// Fixed step, seconds.
   double time_step() const { return time_step_; }
   /// Simulation time, seconds (step_index * time_step, without accumulated rounding).
@@ -116,29 +112,20 @@ class AMBFPLUS_API World {
   const std::string& name_space() const { return name_space_; }
   void set_name_space(std::string ns) { name_space_ = std::move(ns); }
 
-  /// Gravity, m/s^2 (AMBF's default: 0, 0, -9.8).
-  void set_gravity(const Eigen::Vector3d& g);
-  Eigen::Vector3d gravity() const;
-
   /// The shader of bodies whose model and material name none (AMBF's world `shaders`); unset:
   /// the engine's own.
   const std::optional<ShaderSpec>& shader() const { return shader_; }
   void set_shader(std::optional<ShaderSpec> shader) { shader_ = std::move(shader); }
 
-  /// Starts logging every step's state of these objects (replacing a log in progress); the
-  /// log's rows are taken with take_step_log(). Throws ArgumentError for an object of
-  /// another world.
+  /// Starts logging every step's state of these objects (replacing a log in progress): each
+  /// object's pose and the columns its systems add (System::add_step_log_columns); the log's
+  /// rows are taken with take_step_log(). Throws ArgumentError for an object of another world.
   void start_step_log(const std::vector<const Object*>& objects);
   /// Stops logging; rows not taken are dropped.
   void stop_step_log();
   /// The rows since the last take (empty without a log). Takes the state lock.
   StepLog take_step_log();
   bool logging_steps() const;
-
-  /// The plugins of this world, its simulator, models and objects (cpp/README.md, "Plugins").
-  PluginRegistry& plugins();
-  /// Calls every plugin's reset(). There is no scene reset yet: only plugins are reset.
-  void reset_plugins();
 
   /// Serialises changes to the scene with reads of it from other threads: each step runs under
   /// it (a real-time loop's physics thread steps while cameras capture from others), and a
@@ -173,13 +160,9 @@ class AMBFPLUS_API World {
   int realtime_priority() const { return realtime_priority_; }
   void set_realtime_priority(int priority) { realtime_priority_ = priority; }
 
-  /// The world's renderer (its GPU resources; a capture draws through it).
-  render::Renderer& renderer() { return *renderer_; }
-  /// Gives plugins their graphics update, once per step; every render calls it first, under
-  /// lock_state() (internal to the engine).
+  /// Gives the systems their graphics update (System::graphics_update: plugins' hook), once per
+  /// step; every render calls it first, under lock_state() (internal to the engine).
   void graphics_update();
-  /// The world's physics.
-  physics::Physics& physics() { return *physics_; }
 
  private:
   friend class Simulator;
@@ -200,9 +183,6 @@ class AMBFPLUS_API World {
   // Before the models: systems outlive the objects they hold state for.
   std::vector<std::unique_ptr<System>> systems_;
   std::vector<System*> schedule_[kStepStageCount];  // the systems of each stage, in order
-  physics::Physics* physics_ = nullptr;
-  render::Renderer* renderer_ = nullptr;
-  PluginRegistry* plugins_ = nullptr;
   scene::Attachments* attachments_ = nullptr;
   scene::StepLogger* step_logger_ = nullptr;
   std::vector<std::unique_ptr<Model>> models_;
@@ -215,6 +195,14 @@ class AMBFPLUS_API World {
   std::atomic<bool> realtime_{false};
   std::atomic<int> realtime_priority_{0};
 };
+
+template <typename T>
+T* World::find_system() const {
+  for (const auto& s : systems_) {
+    if (auto* t = dynamic_cast<T*>(s.get())) return t;
+  }
+  return nullptr;
+}
 
 template <typename T>
 std::vector<T*> World::objects_of_kind() const {

@@ -1,4 +1,4 @@
-#include "ambfplus/scene/realtime.h"
+#include "ambfplus/engine/realtime.h"
 #include "ambfplus/errors.h"
 
 #include <pthread.h>
@@ -14,7 +14,6 @@
 
 #include "ambfplus/haptics/input_device.h"
 #include "ambfplus/log.h"
-#include "ambfplus/plugin/registry.h"
 #include "ambfplus/scene/world.h"
 
 namespace ambfplus {

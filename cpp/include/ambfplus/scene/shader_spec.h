@@ -1,5 +1,8 @@
 #pragma once
 
+// A shader a body, model, world or camera asks to be drawn with: plain scene data, which the
+// render area compiles (the scene itself draws nothing).
+
 #include <string>
 
 #include "ambfplus/export.h"

@@ -29,7 +29,7 @@ class OutOfRange(Error, IndexError):
     """An index outside what it indexes."""
 class ArgumentTypeError(ArgumentError, TypeError):
     """A value of the wrong type, or a keyword option that does not exist."""
-__all__: list[str] = ['ActuatorHold', 'ArgumentError', 'ArgumentTypeError', 'AssetNotFound', 'Axis', 'Camera', 'ConfigError', 'ConstraintActuator', 'ControlOutput', 'Device', 'Drill', 'Error', 'Frame', 'InputDevice', 'Joint', 'JointType', 'JoystickDevice', 'JoystickMapping', 'KeyboardDevice', 'Label', 'Light', 'LightType', 'LoadReport', 'MergedDevice', 'MeshCollision', 'Model', 'NetworkDevice', 'NotFound', 'NullDevice', 'Object', 'OpenXrSession', 'OutOfRange', 'PLUGIN_ABI_VERSION', 'PluginError', 'PluginInfo', 'PluginSite', 'ProximitySensor', 'RealTimeLoop', 'RemovalMode', 'RenderError', 'ReplayDevice', 'ResourceError', 'RigidBody', 'ScriptedDevice', 'ShapeKind', 'SimulatedDevice', 'Simulator', 'SoftBody', 'StateError', 'Volume', 'VolumeData', 'Window', 'World', 'capture_passes', 'gl_info', 'load_nrrd', 'load_slice_stack', 'openxr_built', 'phantom', 'plugin_search_path', 'read_colors', 'read_input_devices', 'read_label_table', 'read_launch', 'use_x11_display', 'write_image', 'write_label_table']
+__all__: list[str] = ['ActuatorHold', 'ArgumentError', 'ArgumentTypeError', 'AssetNotFound', 'Axis', 'Camera', 'ConfigError', 'ConstraintActuator', 'ControlOutput', 'Device', 'DistanceField', 'Drill', 'Error', 'Frame', 'InputDevice', 'Joint', 'JointType', 'JoystickDevice', 'JoystickMapping', 'KeyboardDevice', 'Label', 'Light', 'LightType', 'LoadReport', 'MergedDevice', 'MeshCollision', 'Model', 'NetworkDevice', 'NotFound', 'NullDevice', 'Object', 'OpenXrSession', 'OutOfRange', 'PLUGIN_ABI_VERSION', 'PluginError', 'PluginInfo', 'PluginSite', 'ProximitySensor', 'RealTimeLoop', 'RemovalMode', 'RenderError', 'ReplayDevice', 'ResourceError', 'RigidBody', 'ScriptedDevice', 'ShapeKind', 'SimulatedDevice', 'Simulator', 'SkillMetrics', 'SoftBody', 'StateError', 'Volume', 'VolumeData', 'Window', 'World', 'capture_passes', 'gl_info', 'load_nrrd', 'load_slice_stack', 'openxr_built', 'phantom', 'plugin_search_path', 'read_colors', 'read_input_devices', 'read_label_table', 'read_launch', 'use_x11_display', 'write_image', 'write_label_table']
 class Window:
     """
     An X11 window (GLFW's, made without a client API) showing cameras.
@@ -320,6 +320,42 @@ class VolumeData:
         ...
     @property
     def voxel_size(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+class DistanceField:
+    """
+    The exact signed distance (metres) from every voxel centre of a volume to a structure, clamped to a band; brought up to date by update() as the volume is edited.
+    """
+    def __init__(self, volume: VolumeData, labels: typing.Any, band: typing.SupportsFloat | typing.SupportsIndex = 0.005) -> None:
+        """
+        The field of the structure made of `labels` (names or ids, one or a list) in `volume`, clamped to `band` metres.
+        """
+    def at(self, i: typing.SupportsInt | typing.SupportsIndex, j: typing.SupportsInt | typing.SupportsIndex, k: typing.SupportsInt | typing.SupportsIndex) -> float:
+        """
+        The signed distance at voxel (i, j, k)'s centre (metres).
+        """
+    def sample(self, points: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> typing.Any:
+        """
+        (distance, gradient) at a volume-frame point (3,), or arrays for points (N, 3): trilinear in the voxel-centre values, with that interpolant's gradient.
+        """
+    def update(self) -> int:
+        """
+        Brings the field up to the volume's edits; returns the voxels recomputed.
+        """
+    def values(self) -> numpy.typing.NDArray[numpy.float32]:
+        """
+        The signed distance of every voxel as a (nx, ny, nz) float32 array (a copy).
+        """
+    @property
+    def band(self) -> float:
+        ...
+    @property
+    def labels(self) -> list[int]:
+        ...
+    @property
+    def revision(self) -> int:
+        ...
+    @property
+    def structure_voxels(self) -> int:
         ...
 class LightType:
     """
@@ -2345,6 +2381,30 @@ class LoadReport:
     def warnings(self) -> list:
         """
         (file, message) for everything loaded with a caveat (unknown keys, dangling references, defaults taken)
+        """
+class SkillMetrics:
+    """
+    Skill metrics of a drilling session, fed tick by tick (live) or from a recording (offline) through the same code.
+    """
+    def __init__(self, volume: VolumeData, *, protect: list = [], target_labels: typing.Any = None, excess_force: typing.SupportsFloat | typing.SupportsIndex = 3.0, stroke_gap: typing.SupportsFloat | typing.SupportsIndex = 0.05, turn_step: typing.SupportsFloat | typing.SupportsIndex = 0.0005, turn_angle: typing.SupportsFloat | typing.SupportsIndex = 0.7853981633974483, field_band: typing.SupportsFloat | typing.SupportsIndex = 0.005, apply_removals: bool = False) -> None:
+        """
+        Metrics of drilling `volume` (the volume being drilled, which the structures' distance fields follow). protect: [{'name', 'labels': names or ids, 'margin': metres}]; target_labels: the labels of the target region; excess_force: N; stroke_gap: s; turn_step: m; turn_angle: rad; field_band: m beyond the margins; apply_removals: remove each tick's voxels from `volume` (offline, on a fresh copy of the anatomy).
+        """
+    def add(self, step: typing.SupportsInt | typing.SupportsIndex, time: typing.SupportsFloat | typing.SupportsIndex, dt: typing.SupportsFloat | typing.SupportsIndex, tip: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], force: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], burr_radius: typing.SupportsFloat | typing.SupportsIndex, burr_on: bool, removed: typing.Annotated[numpy.typing.ArrayLike, numpy.int32] | None = None, removed_labels: typing.Annotated[numpy.typing.ArrayLike, numpy.uint16] | None = None) -> None:
+        """
+        Adds one tick: the burr centre `tip` (volume frame), the force on the hand, and the voxels removed during it (M, 3) with the labels they had (M,).
+        """
+    def add_ticks(self, steps: typing.Annotated[numpy.typing.ArrayLike, numpy.int64], times: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], dt: typing.SupportsFloat | typing.SupportsIndex, tips: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], forces: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], burr_radii: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], burr_on: typing.Annotated[numpy.typing.ArrayLike, numpy.bool], removed_tick: typing.Annotated[numpy.typing.ArrayLike, numpy.int64], removed: typing.Annotated[numpy.typing.ArrayLike, numpy.int32], removed_labels: typing.Annotated[numpy.typing.ArrayLike, numpy.uint16]) -> None:
+        """
+        Adds N ticks at once (a recording's): steps (N,), times (N,), tips and forces (N, 3), burr radii and burr on (N,), and the removed voxels (M, 3) with their labels (M,) and the index of the tick that removed each (M,), sorted.
+        """
+    def clearance(self, structure: typing.SupportsInt | typing.SupportsIndex, point: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], radius: typing.SupportsFloat | typing.SupportsIndex) -> float:
+        """
+        Distance (metres) from a sphere at `point` (volume frame) to the protected structure with this index, from its field as of the last tick.
+        """
+    def summary(self) -> dict:
+        """
+        Everything measured so far, as a dict (distances in metres, times in seconds, forces in newtons, volumes as voxel counts with voxel_volume in cubic metres).
         """
 class PluginSite:
     """

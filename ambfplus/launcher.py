@@ -71,8 +71,8 @@ from . import (
     __version__,
 )
 from ._core import OpenXrSession, RenderError, Window, use_x11_display
+from .fileio import write_text
 from .hmd import HmdError, HmdView, OpenHMD, XrView
-from .recording_schema import replace_text
 from .stereo import StereoRig
 
 # GLFW's codes for the keys and buttons the launcher handles itself.
@@ -646,7 +646,7 @@ def run_window(glfw, args: argparse.Namespace, plugin_args: list[str]) -> int:
                            "stereo": views.describe(width, height)}  # fmt: skip
                 if current != last_status:
                     # Atomically: whoever reads the status never sees it half written.
-                    replace_text(args.status, json.dumps(current))
+                    write_text(args.status, json.dumps(current))
                     last_status = current
     session.stop_live()
     session.drain()

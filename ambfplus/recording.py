@@ -144,6 +144,7 @@ import hdf5plugin  # registers the Blosc filter with HDF5
 import numpy as np
 
 from . import __version__
+from .fileio import temporary_name, write_bytes
 from .recording_reader import (
     CameraStream,
     Column,
@@ -174,7 +175,6 @@ from .recording_schema import (
     check_text,
     find_parts,
     part_name,
-    temporary_name,
     text_attribute,
     text_column,
     to_json,
@@ -802,14 +802,7 @@ def _store(file: h5py.File, path: Path) -> None:
     file.flush()
     image = file.id.get_file_image()
     file.close()
-    tmp = temporary_name(path)
-    try:
-        with open(tmp, "wb") as out:
-            out.write(image)
-    except OSError:
-        tmp.unlink(missing_ok=True)
-        raise
-    os.replace(tmp, path)
+    write_bytes(path, image)
 
 
 class _GuardedFile:

@@ -5,7 +5,6 @@ shared by the writer (``recording``), the reader (``recording_reader``) and the 
 from __future__ import annotations
 
 import json
-import os
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -127,19 +126,6 @@ def check_text(text: str, where: str) -> str:
 def part_name(head: Path, number: int) -> Path:
     """``name.h5`` -> ``name.h5.part0001`` (the n-th closed segment)."""
     return head.with_name(f"{head.name}.part{number:0{PART_DIGITS}d}")
-
-
-def temporary_name(path: Path) -> Path:
-    """Where a file is written before it is renamed into place (atomic on POSIX)."""
-    return path.with_name(path.name + ".tmp")
-
-
-def replace_text(path: Path, text: str) -> None:
-    """Writes text to path atomically: to its temporary name, then renamed into place, so that
-    a reader sees the old file or the new one, never a partial one."""
-    tmp = temporary_name(Path(path))
-    tmp.write_text(text)
-    os.replace(tmp, path)
 
 
 def part_number(head: Path, candidate: Path) -> int | None:

@@ -30,9 +30,10 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ..fileio import written_whole
 from ..recording_reader import open_recording
 from ..recording_schema import RecordingError
-from ._common import ExportError, MissingExtra, check_output, progress_bar, whole_output
+from ._common import ExportError, MissingExtra, check_output, progress_bar
 
 FORMATS = ("mcap", "rosbag2", "original-h5", "coco")
 # What each format's output is called beside the shard or recording it comes from.
@@ -117,7 +118,7 @@ def export(source, out, to: str, *, force: bool = False, progress: bool | None =
                           f"{source.parent} (every shard) or one shard's head file")  # fmt: skip
     check_output(out, force)
     _writer(to)  # the extra's modules are imported before anything is opened
-    with open_recording(source) as recording, whole_output(out, force) as temporary:
+    with open_recording(source) as recording, written_whole(out) as temporary:
         return _export_one(recording, temporary, out, to, progress, options)
 
 
@@ -214,7 +215,7 @@ def export_dataset(folder: Path, out: Path, to: str, *, force: bool = False,
     verify_shards(folder, entries)
     _writer(to)
     results = []
-    with whole_output(out, force) as temporary:
+    with written_whole(out) as temporary:
         temporary.mkdir()
         for extra in ("spec.yaml", "environment.json"):
             if (folder / extra).is_file():

@@ -4,7 +4,7 @@ steps, removed voxels and events, written by a background thread and safe agains
     from ambfplus.recording import Recorder, open_recording, validate
 
     with Recorder("session.h5", metadata={"scene": "ear.yaml", "seed": 0}) as rec:
-        rec.set_legend(world)                       # or ambfplus.stereo.legend(world)
+        rec.set_legend(world)                       # or ambfplus.labels.legend(world)
         for _ in range(100):
             world.step(10)
             rec.add_stereo("rig", rig.capture(passes=["rgb", "depth", "label", "voxel"]))
@@ -145,6 +145,7 @@ import numpy as np
 
 from . import __version__
 from .fileio import temporary_name, write_bytes
+from .labels import legend as object_legend
 from .recording_reader import (
     CameraStream,
     Column,
@@ -180,7 +181,6 @@ from .recording_schema import (
     to_json,
 )
 from .recording_validate import Check, ValidationReport, leftover_files, validate
-from .stereo import legend as object_legend
 
 __all__ = [
     "CameraStream",
@@ -388,7 +388,7 @@ class Recorder:
                 self._submit([rows])
 
     def set_legend(self, legend) -> None:
-        """Stores the id legend: a dict as ``ambfplus.stereo.legend(world)`` gives it, or a
+        """Stores the id legend: a dict as ``ambfplus.labels.legend(world)`` gives it, or a
         ``World`` (then volumes also record their shape, which the voxel checks need)."""
         if hasattr(legend, "objects"):
             legend = world_legend(legend)
@@ -1175,7 +1175,7 @@ def repair(path) -> Recording:
 
 
 def world_legend(world) -> dict:
-    """``ambfplus.stereo.legend(world)`` plus each volume's grid shape, dimensions and voxel
+    """``ambfplus.labels.legend(world)`` plus each volume's grid shape, dimensions and voxel
     size, which map a ``voxel`` image's index to (i, j, k), and its pose (world-from-volume,
     as the recording starts), which places removed voxels in the world; drills add their burr
     diameters (m), which give the ``burr`` index of the step log a size."""

@@ -9,15 +9,14 @@ import pytest
 from conftest import pixel_rays
 
 import ambfplus
+from ambfplus.labels import legend, segmentation
 from ambfplus.stereo import (
     StereoRig,
     ambf_to_opencv,
     depth_to_disparity,
     disparity_agreement,
     disparity_to_depth,
-    legend,
     opencv_to_ambf,
-    segmentation,
 )
 
 FOCAL = 1135.0  # the paper's rig: 640x480, f about 1135 px, 65 mm baseline, about 250 mm away

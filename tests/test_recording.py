@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 
 import ambfplus
+import ambfplus.labels
 from ambfplus.cli import main as cli_main
 from ambfplus.recording import (
     Recorder,
@@ -464,7 +465,7 @@ def test_a_recording_without_volume_shapes_skips_the_visibility_check(tmp_path):
     world, volume, rig = ear_scene()
     path = tmp_path / "s.h5"
     with Recorder(path) as rec:
-        rec.set_legend(ambfplus.stereo.legend(world))  # no shapes
+        rec.set_legend(ambfplus.labels.legend(world))  # no shapes
         world.step(1)
         pair = rig.capture(passes=PASSES)
         rec.add_frame("left", pair.left)

@@ -266,7 +266,7 @@ def run_validate(args: argparse.Namespace) -> int:
 def run_export(args: argparse.Namespace) -> int:
     """Exports a recording or a dataset folder; errors are one line naming what is wrong."""
     from .export import ExportError, MissingExtra, export
-    from .recording_schema import RecordingError
+    from .recording import RecordingError
 
     options = {}
     if args.to in ("mcap", "rosbag2"):

@@ -31,7 +31,7 @@ def test_every_corpus_input_is_accepted_or_a_typed_error(target):
 
 
 # Every reader, the recording reader included: libhdf5 loops forever on a damaged global heap,
-# which the reader no longer meets unchecked (ambfplus/recording_hdf5.py).
+# which the reader no longer meets unchecked (ambfplus/recording/hdf5.py).
 FUZZED_IN_CI = TARGETS
 
 

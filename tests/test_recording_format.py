@@ -15,7 +15,7 @@ import pytest
 
 import ambfplus.recording as recording_module
 from ambfplus.recording import Recorder, RecordingError, open_recording, repair, validate
-from ambfplus.recording_hdf5 import collection_problem
+from ambfplus.recording.hdf5 import collection_problem
 
 CORPUS = Path(__file__).resolve().parent / "fuzz" / "corpus" / "recording"
 # A recording written by the format 1.0 writer (variable-length strings), kept as a fuzz seed.

@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import NullDevice, ScriptedDevice, __version__, gl_info
-from ..recording_schema import find_parts
+from ..recording.schema import find_parts
 from ..scenarios import DrillScript
 from ..scenes import anatomy_data, drilling_scene
 from ..session import record_session

@@ -31,8 +31,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..fileio import written_whole
-from ..recording_reader import open_recording
-from ..recording_schema import RecordingError
+from ..recording import RecordingError, open_recording
 from ._common import ExportError, MissingExtra, check_output, progress_bar
 
 FORMATS = ("mcap", "rosbag2", "original-h5", "coco")
@@ -176,7 +175,7 @@ def read_manifest(folder: Path) -> list[dict]:
 def shard_digests(head: Path) -> set[str]:
     """SHA-256 of a shard as a manifest may state it: of its head file, and of the head
     followed by its parts in order (the same when it has no parts)."""
-    from ..recording_schema import find_parts
+    from ..recording.schema import find_parts
 
     whole, alone = hashlib.sha256(), hashlib.sha256()
     with open(head, "rb") as f:

@@ -1,6 +1,6 @@
 """The recording file format's constants: names, dtypes, conventions and the part-file naming
-shared by the writer (``recording``), the reader (``recording_reader``) and the validator
-(``recording_validate``). The format itself is described in ``ambfplus.recording``."""
+shared by the writer (``writer``), the reader (``reader``) and the validator
+(``validation``). The format itself is described in ``ambfplus.recording``."""
 
 from __future__ import annotations
 
@@ -11,13 +11,13 @@ from pathlib import Path
 
 import numpy as np
 
-from ._core import ConfigError
+from .._core import ConfigError
 
 FORMAT = "ambfplus.recording"
 VERSION = 1
 VERSION_ATTR = "ambfplus_recording_version"
 # 1.1: text (attributes, string columns) is stored as fixed-length UTF-8 strings, never
-# variable-length, so that reading needs no global heap (see ``recording_hdf5``). Files without
+# variable-length, so that reading needs no global heap (see ``hdf5``). Files without
 # this attribute are 1.0. Readers of 1.0 read 1.1 files (fixed-length strings come back as bytes).
 MINOR_VERSION = 1
 MINOR_VERSION_ATTR = "ambfplus_recording_minor_version"

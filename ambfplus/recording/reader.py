@@ -16,7 +16,8 @@ import h5py
 import hdf5plugin  # noqa: F401 (registers the Blosc filter recordings use)
 import numpy as np
 
-from .recording_hdf5 import (
+from ..stereo import StereoFrame
+from .hdf5 import (
     CheckedFile,
     check_dataset_type,
     open_checked,
@@ -24,7 +25,7 @@ from .recording_hdf5 import (
     read_attributes,
     text_value,
 )
-from .recording_schema import (
+from .schema import (
     EVENT_COLUMNS,
     FORMAT,
     FRAME_COLUMNS,
@@ -42,7 +43,6 @@ from .recording_schema import (
     legend_from_json,
     part_name,
 )
-from .stereo import StereoFrame
 
 # Parts kept open at once while reading (a long session has many).
 MAX_OPEN_PARTS = 32
@@ -93,7 +93,7 @@ class RecordedFrame:
 
 # What h5py raises where a file is damaged: HDF5's errors surface as any of these, depending on
 # where the damage is met (metadata, chunk index, attributes, data).
-_DAMAGE = (OSError, RuntimeError, KeyError, ValueError, TypeError, AttributeError, IndexError)
+DAMAGE = (OSError, RuntimeError, KeyError, ValueError, TypeError, AttributeError, IndexError)
 
 
 @contextmanager
@@ -103,7 +103,7 @@ def _damage_is_an_error(path, what: str):
         yield
     except RecordingError:
         raise
-    except _DAMAGE as error:
+    except DAMAGE as error:
         raise RecordingError(
             f"{path}: damaged file: {what} failed ({type(error).__name__}: {error})"
         ) from error

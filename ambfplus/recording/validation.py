@@ -8,10 +8,10 @@ from pathlib import Path
 
 import numpy as np
 
-from .recording_hdf5 import check_global_heaps
-from .recording_reader import _DAMAGE, CameraStream, Recording, RigStream, open_recording
-from .recording_schema import RecordingError, find_parts, glob_escape
-from .stereo import disparity_agreement
+from ..stereo import disparity_agreement
+from .hdf5 import check_global_heaps
+from .reader import DAMAGE, CameraStream, Recording, RigStream, open_recording
+from .schema import RecordingError, find_parts, glob_escape
 
 POINTS_RELATIVE_TOLERANCE = 1e-4
 BASELINE_TOLERANCE_M = 1e-6
@@ -84,7 +84,7 @@ def validate(path, match_images: bool = True) -> ValidationReport:
     points, rig geometry, removed labels against the legend, removed voxels not seen later.
     `match_images` also block-matches three stereo pairs against their depth and baseline (the
     costliest check: about as much CPU as rendering the recording took). Before it opens the
-    recording, it checks the global heaps of every file (see ``ambfplus.recording_hdf5``)."""
+    recording, it checks the global heaps of every file (see ``ambfplus.recording.hdf5``)."""
     path = Path(path)
     try:
         heaps = _heaps_check(path)
@@ -103,7 +103,7 @@ def validate(path, match_images: bool = True) -> ValidationReport:
             checks += _log_order_checks(recording)
             for name, stream in recording.cameras.items():
                 checks.append(_removed_visibility_check(f"cameras/{name}", stream, recording))
-        except (RecordingError, *_DAMAGE) as error:
+        except (RecordingError, *DAMAGE) as error:
             # Data that cannot be read or does not have the layout's shapes and types.
             checks.append(Check("read", "fail", f"{type(error).__name__}: {error}"))
     return ValidationReport(path, checks)

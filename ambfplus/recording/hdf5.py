@@ -36,7 +36,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from .recording_schema import MINOR_VERSION_ATTR, RecordingError
+from .schema import MINOR_VERSION_ATTR, RecordingError
 
 # A global heap collection starts with this signature and its version (1, the only one).
 GLOBAL_HEAP_START = b"GCOL\x01"

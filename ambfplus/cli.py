@@ -97,8 +97,7 @@ def run_demo(out: Path, width: int, height: int, resolution: int, every: int) ->
     """A headless drilling session on the built-in phantom: scripted plunges at three sites
     while the stereo rig circles, recorded, validated, and previewed as PNG files."""
     from .recording import open_recording, validate
-    from .scenes import drilling_phantom, orbit_view
-    from .session import record_session
+    from .scenes import drilling_phantom, orbit_view, record_session
 
     out.mkdir(parents=True, exist_ok=True)
     path = out / "session.h5"
@@ -160,7 +159,7 @@ def run_demo(out: Path, width: int, height: int, resolution: int, every: int) ->
 
 def run_replay(args: argparse.Namespace) -> int:
     """Re-simulates a recording from its device readings, optionally re-rendering it."""
-    from .session import replay
+    from .scenes import replay
 
     report = replay(
         args.recording,

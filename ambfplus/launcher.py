@@ -396,9 +396,9 @@ class Session:
         """Hands what the steps logged to the recorder."""
         if self.recorder is None:
             return
-        from .session import _drain
+        from .scenes import drain
 
-        _drain(self.world, self.drill, self.recorder)
+        drain(self.world, self.drill, self.recorder)
 
     def reset_volumes(self) -> None:
         with self.world.lock():

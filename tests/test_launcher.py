@@ -61,7 +61,7 @@ def test_keys_move_the_drill_and_the_window_shows_the_scene(fixtures, display, t
 
 
 def test_a_recorded_interactive_session_replays_to_the_same_removal(fixtures, display, tmp_path):
-    from ambfplus.session import replay
+    from ambfplus.scenes import replay
 
     launch_file = fixtures / "volumetric_drilling" / "launch.yaml"
     record = tmp_path / "session.h5"

@@ -55,7 +55,7 @@ def test_importing_ambfplus_never_imports_torch():
     out = run_python(
         """
         import sys
-        import ambfplus, ambfplus.scenes, ambfplus.session, ambfplus.recording, ambfplus.stereo
+        import ambfplus, ambfplus.scenes, ambfplus.recording, ambfplus.stereo, ambfplus.labels
         assert "torch" not in sys.modules, "ambfplus imported torch"
         print("ok")
         """

@@ -18,9 +18,7 @@ import numpy as np
 
 from .. import NullDevice, ScriptedDevice
 from ..recording import open_recording
-from ..scenarios import DrillScript
-from ..scenes import drilling_phantom, orbit_view
-from ..session import record_session
+from ..scenes import DrillScript, drilling_phantom, orbit_view, record_session
 
 PASSES = ("rgb", "depth", "label", "instance", "segmentation")
 MOVING_CAMERA, MOVING_DRILL = "moving camera", "moving drill"

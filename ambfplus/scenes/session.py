@@ -13,6 +13,10 @@ capturing each with the same rig or another (``baseline``, ``width``, ``height``
 ``working_distance``; the rig keeps the recorded pose of its centre) into a new recording. It
 reports whether the removal log and the forces came out identical, and, with the same rig,
 whether every re-rendered image equals the recorded one.
+
+Both live with the scenes, not with ``ambfplus.recording``: replaying rebuilds a scene from a
+recording's metadata, and the recording package stays below the scenes (it stores what any
+script hands it and imports nothing of them).
 """
 
 from __future__ import annotations
@@ -24,10 +28,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ._core import Device, ReplayDevice
-from .recording import Recorder, open_recording
-from .scenes import Scene, build_scene
-from .transforms import make_pose
+from .._core import Device, ReplayDevice
+from ..recording import Recorder, open_recording
+from ..transforms import make_pose
+from .builders import Scene, build_scene
 
 PASSES = ("rgb", "depth", "label", "instance", "voxel", "segmentation")
 RIG = "rig"
@@ -45,8 +49,9 @@ def _bind(scene: Scene, device: Device, options: dict | None = None):
     return scene.world.add_input_device(scene.device_name, device, scene.drill, **options)
 
 
-def _drain(world, drill, recorder: Recorder | None) -> tuple[dict, dict, list]:
-    """Hands the step log, removed voxels and events gathered so far to the recorder."""
+def drain(world, drill, recorder: Recorder | None) -> tuple[dict, dict, list]:
+    """Hands the step log, removed voxels and events gathered so far to the recorder (if any)
+    and returns them; the launcher drains its live recording through this too."""
     steps = world.take_step_log()
     removed = drill.take_removed()
     events = drill.take_events()
@@ -115,7 +120,7 @@ def record_session(
             pair = rig.capture(passes)
             recorder.add_stereo(RIG, pair if transform is None else transform(pair))
             frames += 1
-            _, r, e = _drain(world, drill, recorder)
+            _, r, e = drain(world, drill, recorder)
             removed, events = removed + len(r["step"]), events + len(e)
             if world.step_index / total >= next_report:
                 _progress(progress, world.step_index, total, started,
@@ -225,7 +230,7 @@ def replay(
                         recorder.add_stereo(RIG, pair)
                     if same_rig and recorded is not None:
                         identical_frames += _same_images(pair, recorded[i], passes)
-                s, r, _ = _drain(world, drill, recorder)
+                s, r, _ = drain(world, drill, recorder)
                 new_forces.append(s[f"{drill.name}.force"])
                 new_removed.append(r)
                 if progress is not None and (i + 1) % max(1, len(plan) // 10) == 0:
@@ -233,7 +238,7 @@ def replay(
                               f"{i + 1}/{len(plan)} frames")  # fmt: skip
             last = int(steps["step"][-1]) if len(steps["step"]) else world.step_index
             step_to(last)
-            s, r, _ = _drain(world, drill, recorder)
+            s, r, _ = drain(world, drill, recorder)
             new_forces.append(s[f"{drill.name}.force"])
             new_removed.append(r)
         finally:

@@ -9,10 +9,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._core import Drill, Label, VolumeData, World, phantom
+from .._core import Drill, Label, VolumeData, World, phantom
+from ..stereo import StereoRig
+from ..transforms import make_pose, rotation_between
 from .scenarios import CameraPath
-from .stereo import StereoRig
-from .transforms import make_pose, rotation_between
 
 # The paper's stereo camera: focal length about 1135 px at 640x480, about 250 mm from the anatomy.
 PAPER_FOCAL_PX = 1135.0
@@ -262,7 +262,7 @@ def _load_anatomy(anatomy: dict) -> VolumeData:
     if set(anatomy) == {"phantom"}:
         return phantom(**anatomy["phantom"])
     if "file" in anatomy and "phantom" not in anatomy:
-        from .volumes import load_volume
+        from ..volumes import load_volume
 
         options = {k: v for k, v in anatomy.items() if k != "file"}
         return load_volume(anatomy["file"], **options)
@@ -300,7 +300,7 @@ def launch_scene(
     """An AMBF launch file loaded as ambfplus-launch loads it, with the drill its plugins make
     (the first drill) driven by a device named "keyboard"; the stereo rig of its stereoL and
     stereoR cameras when it has them."""
-    from ._core import Simulator
+    from .._core import Simulator
 
     sim = Simulator.from_launch(
         file,

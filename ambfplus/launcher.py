@@ -28,7 +28,7 @@ of view from the runtime, the images into its swapchains) with the window mirror
 says why it falls back to OpenHMD where there is no runtime or headset.
 
 ``--device`` chooses what moves the drill: the keyboard, ``network[:PORT]`` (poses from a
-bridge process over UDP on loopback, forces sent back every step; see ``ambfplus.network`` and
+bridge process over UDP on loopback, forces sent back every step; see ``ambfplus.devices.network`` and
 ``examples/network_bridge.py``) or ``joystick[:PATH]`` (a gamepad's sticks); ``--pedal PATH``
 adds a foot pedal's buttons (``--pedal-map drill=0,clutch=1,burr=2``: held spins the burr, held
 clutches, pressed takes the next burr). The keyboard's Space and C keep working with any device.
@@ -71,8 +71,8 @@ from . import (
     __version__,
 )
 from ._core import OpenXrSession, RenderError, Window, use_x11_display
+from .devices.hmd import HmdError, HmdView, OpenHMD, XrView
 from .fileio import write_text
-from .hmd import HmdError, HmdView, OpenHMD, XrView
 from .stereo import StereoRig
 
 # GLFW's codes for the keys and buttons the launcher handles itself.

@@ -22,7 +22,7 @@ import pytest
 from test_devices import drill_over_slab
 
 import ambfplus
-from ambfplus.network import Bridge, pack_pose
+from ambfplus.devices.network import Bridge, pack_pose
 
 BRIDGE = Path(__file__).resolve().parents[1] / "examples" / "network_bridge.py"
 BUTTON, AXIS, INIT = 0x01, 0x02, 0x80

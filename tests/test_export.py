@@ -18,8 +18,7 @@ import pytest
 
 import ambfplus
 from ambfplus.recording import Recorder, open_recording
-from ambfplus.scenes import drilling_phantom, orbit_view
-from ambfplus.scenes import record_session
+from ambfplus.scenes import drilling_phantom, orbit_view, record_session
 
 pytest.importorskip("mcap_ros2", reason='needs pip install "ambfplus[export]"')
 pytest.importorskip("rosbags", reason='needs pip install "ambfplus[export]"')

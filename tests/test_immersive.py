@@ -17,7 +17,7 @@ import pytest
 from x11 import finish, launch, screenshot, window_origin, xdo
 
 import ambfplus
-from ambfplus.hmd import HmdError, HmdView, OpenHMD, quaternion_matrix
+from ambfplus.devices.hmd import HmdError, HmdView, OpenHMD, quaternion_matrix
 from ambfplus.stereo import block_match
 
 

@@ -21,7 +21,7 @@ import pytest
 from x11 import finish, launch, screenshot, window_origin
 
 import ambfplus
-from ambfplus.hmd import XrView, xr_eye_geometry
+from ambfplus.devices.hmd import XrView, xr_eye_geometry
 
 SOURCE = Path(__file__).parent / "openxr" / "test_runtime.cpp"
 

@@ -261,8 +261,7 @@ def test_leftover_temporary_files_are_reported_and_repair_removes_them(tmp_path)
 
 
 def test_replay_reproduces_every_step_column_and_names_its_device(tmp_path):
-    from ambfplus.scenes import drilling_phantom
-    from ambfplus.scenes import record_session, replay
+    from ambfplus.scenes import drilling_phantom, record_session, replay
 
     scene = drilling_phantom(resolution=40, width=64, height=48)
     hand = ambfplus.SimulatedDevice()

@@ -8,8 +8,7 @@ import pytest
 
 import ambfplus
 from ambfplus.recording import open_recording, validate
-from ambfplus.scenes import drilling_phantom, orbit_view
-from ambfplus.scenes import record_session, replay
+from ambfplus.scenes import drilling_phantom, orbit_view, record_session, replay
 from ambfplus.stereo import disparity_agreement
 
 

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from ._core import World
+from .._core import World
 
 _BUTTONS = {"a1": "drill_button", "a2": "clutch_button", "next mode": "burr_button"}
 

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from . import PluginError, ScriptedDevice, Simulator, __version__, gl_info, write_image
-from .plugins import cmake_dir
+from .plugin import cmake_dir
 from .volumes import convert_volume
 
 # The demo fails when the anatomy covers less than this share of the view (at the paper's
@@ -197,7 +197,7 @@ def indices(text: str) -> list[int]:
 
 def run_check_plugins(args: argparse.Namespace) -> int:
     """Loads each plugin file in a probe process; exit code 1 if any is refused."""
-    from .plugin_probe import probe_plugin
+    from .plugin import probe_plugin
 
     refused = 0
     for plugin in args.plugins:
@@ -217,7 +217,7 @@ def run_launch(args: argparse.Namespace) -> int:
     extra = [Path(p) for p in args.a.split(",") if p] if args.a else []
     plugins = [p for p in args.plugins.split(",") if p] if args.plugins else []
     if args.check_plugins:
-        from .plugin_probe import check_plugin, resolve
+        from .plugin import check_plugin, resolve
 
         for plugin in plugins:
             if resolve(plugin) is not None:

@@ -13,7 +13,7 @@ import pytest
 
 import ambfplus
 from ambfplus.cli import main
-from ambfplus.plugin_probe import probe_plugin
+from ambfplus.plugin import probe_plugin
 
 GOOD_CPP = r"""
 #include "ambfplus/plugin/plugin.h"

@@ -1,29 +1,5 @@
-"""Plugins in Python, and where to find what C++ plugins build against.
-
-A Python plugin is a subclass of :class:`Plugin` overriding the hooks it needs, the same hooks
-C++ plugins have (``ambfplus/plugin/plugin.h``). It is declared in an ADF file by its ``.py``
-file (``plugins: [{name: logger, filename: logger.py, path: .}]``), given to
-``world.load_plugin(...)`` / ``sim.load_plugin(...)`` as a file or an object, or installed as an
-entry point of the group ``ambfplus.plugins`` and named by its entry-point name.
-
-From a file, the plugin is what the module's ``create_plugin()`` returns, else an instance of the
-first :class:`Plugin` subclass the file defines. The engine calls its hooks with the GIL held for
-each call only (``World.step`` releases it). A hook that raises is logged once with its traceback
-and the plugin is disabled; the simulation goes on. ``init`` raising is a :class:`PluginError`.
-
-Trust: a plugin runs inside the process that loads it. A C++ plugin's static initialisers (global
-objects' constructors) run during ``dlopen``, before the engine can check its entry point, and a
-Python plugin's module-level code runs on import: one that throws or crashes there takes the
-process down, whatever the engine does. For a plugin you do not trust, ``load_plugin(path,
-probe=True)`` (or ``ambfplus check-plugins FILE...``, ``ambfplus launch --check-plugins``) loads
-it in a probe process first and refuses it with the probe's output when that process fails.
-
-Handles (``self.world``, ``self.object``, ...) are made on each access and each keeps the
-simulator alive, as every handle does. The simulator keeps its plugins, so a handle stored on a
-plugin is a cycle the garbage collector cannot see (the simulator then lives until the process
-ends): keep names and look objects up in the hooks, or drop stored handles in ``close()`` and
-call ``world.close_plugins()`` when done.
-"""
+"""Python plugins (the ``Plugin`` base class and how the engine makes one from a file or an
+entry point), and the folders C++ plugins build against (``cmake_dir``, ``plugin_dir``)."""
 
 from __future__ import annotations
 
@@ -37,8 +13,8 @@ from pathlib import Path
 from types import ModuleType
 from typing import Any
 
-from . import _core
-from ._core import PluginError
+from .. import _core
+from .._core import PluginError
 
 # Entry points of this group name Python plugins (a class or a factory returning a plugin).
 ENTRY_POINT_GROUP = "ambfplus.plugins"
@@ -148,7 +124,7 @@ def _module_from_file(path: str) -> ModuleType:
     return module
 
 
-def _from_file(path: str):
+def plugin_from_file(path: str):
     """The plugin a Python file defines (the engine's loader calls this for ``.py`` files)."""
     module = _module_from_file(path)
     factory = getattr(module, "create_plugin", None)
@@ -168,7 +144,7 @@ def _from_file(path: str):
     )
 
 
-def _from_entry_point(name: str):
+def plugin_from_entry_point(name: str):
     """The plugin an ``ambfplus.plugins`` entry point of this name gives, or None."""
     if sys.version_info >= (3, 10):
         found = importlib.metadata.entry_points(group=ENTRY_POINT_GROUP, name=name)
@@ -185,30 +161,7 @@ def _from_entry_point(name: str):
 
 
 # The engine makes Python plugins through these (it never imports this package itself).
-_core._register_plugin_support(Plugin, _from_file, _from_entry_point)
-
-
-def _with_probe(native):
-    """World/Simulator.load_plugin with ``probe=``: a plugin file is first loaded in a probe
-    process (``ambfplus.plugin_probe``) and refused with the probe's message unless that ends
-    cleanly, since a C++ plugin's static initialisers run inside the process that loads it."""
-
-    def load_plugin(self, plugin, *args, probe: bool = False, **kwargs):
-        if probe and isinstance(plugin, (str, os.PathLike)):
-            from .plugin_probe import check_plugin
-
-            check_plugin(plugin)
-        return native(self, plugin, *args, **kwargs)
-
-    load_plugin.__doc__ = (native.__doc__ or "") + (
-        "\n\nprobe=True loads a plugin file in a probe process first and raises PluginError "
-        "with the probe's output when that process crashes, hangs or fails."
-    )
-    return load_plugin
-
-
-_core.World.load_plugin = _with_probe(_core.World.load_plugin)
-_core.Simulator.load_plugin = _with_probe(_core.Simulator.load_plugin)
+_core._register_plugin_support(Plugin, plugin_from_file, plugin_from_entry_point)
 
 
 def cmake_dir() -> str:
@@ -216,7 +169,7 @@ def cmake_dir() -> str:
     ``cmake -Dambfplus_DIR=$(python -m ambfplus --cmake-dir)``. In an installed package it is
     ``<package>/cmake`` (headers in ``<package>/include``); in a build tree's package mirror it
     is the same folder there, pointing at the source tree's headers."""
-    folder = Path(__file__).resolve().parent / "cmake"
+    folder = Path(__file__).resolve().parents[1] / "cmake"
     if not (folder / "ambfplusConfig.cmake").is_file():
         # The package folder may hold links into a build tree: look beside the engine itself.
         folder = Path(_core.__file__).resolve().parent / "cmake"
@@ -228,6 +181,4 @@ def cmake_dir() -> str:
 def plugin_dir() -> str:
     """The package's own plugin folder (``plugins`` beside libambfplus), searched after
     ``AMBFPLUS_PLUGIN_PATH``."""
-    from . import _core
-
     return str(Path(_core.__file__).resolve().parent / "plugins")

@@ -19,7 +19,8 @@ import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
-from ._core import PluginError, plugin_search_path
+from .._core import PluginError, plugin_search_path
+from .loader import plugin_from_file
 
 PROBE_TIMEOUT_S = 60.0
 # Stages the child prints as it passes them, so a crash says where it happened.
@@ -83,7 +84,7 @@ def probe_plugin(plugin, timeout: float = PROBE_TIMEOUT_S) -> ProbeResult:
     path = resolve(plugin)
     if path is None:
         raise PluginError(f"{plugin}: no plugin file of that name to probe")
-    command = [sys.executable, "-m", "ambfplus.plugin_probe", str(path.resolve())]
+    command = [sys.executable, "-m", "ambfplus.plugin.probe", str(path.resolve())]
     try:
         # From a neutral folder: a source tree's ambfplus/ in the caller's folder would shadow
         # the installed package.
@@ -112,6 +113,23 @@ def check_plugin(plugin, timeout: float = PROBE_TIMEOUT_S) -> Path:
     return result.path
 
 
+def with_probe(native):
+    """World/Simulator.load_plugin with ``probe=``: a plugin file is first loaded in a probe
+    process (see the module) and refused with the probe's message unless that ends
+    cleanly, since a C++ plugin's static initialisers run inside the process that loads it."""
+
+    def load_plugin(self, plugin, *args, probe: bool = False, **kwargs):
+        if probe and isinstance(plugin, (str, os.PathLike)):
+            check_plugin(plugin)
+        return native(self, plugin, *args, **kwargs)
+
+    load_plugin.__doc__ = (native.__doc__ or "") + (
+        "\n\nprobe=True loads a plugin file in a probe process first and raises PluginError "
+        "with the probe's output when that process crashes, hangs or fails."
+    )
+    return load_plugin
+
+
 def _text(data) -> str:
     if data is None:
         return ""
@@ -128,11 +146,9 @@ def _probe_here(path: str) -> int:
         print(f"ambfplus-probe: {name}", flush=True)
 
     if path.endswith(".py"):
-        from .plugins import _from_file
-
         stage("opened")
         stage("entry")
-        _from_file(path)
+        plugin_from_file(path)
         stage("made")
         return 0
     library = ctypes.CDLL(path, mode=os.RTLD_NOW | os.RTLD_LOCAL)

@@ -230,7 +230,7 @@ def test_a_joystick_device_file_is_read_on_its_own_thread(tmp_path):
 
 
 def test_launcher_device_options():
-    from ambfplus.launcher import make_device, pedal_mapping
+    from ambfplus.launcher.inputs import make_device, pedal_mapping
 
     mapping = pedal_mapping("drill=3, burr=6")
     assert (mapping.drill, mapping.clutch, mapping.burr, tuple(mapping.axes)) == (

@@ -80,7 +80,7 @@ def test_a_recorded_interactive_session_replays_to_the_same_removal(fixtures, di
 
 
 def test_mouse_navigation_turns_about_the_target_pans_and_zooms():
-    from ambfplus.launcher import MOUSE_LEFT, MOUSE_RIGHT, Orbit
+    from ambfplus.launcher.navigation import MOUSE_LEFT, MOUSE_RIGHT, Orbit
 
     world = ambfplus.World()
     camera = world.add_camera("cam", 64, 48, fov_y=0.8, near=0.01, far=5.0)

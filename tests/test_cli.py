@@ -9,7 +9,8 @@ import zlib
 
 import numpy as np
 
-from ambfplus.cli import DEPTH_PNG_SCALE, main
+from ambfplus.cli import main
+from ambfplus.cli.demo import DEPTH_PNG_SCALE
 
 
 def read_png(path) -> np.ndarray:

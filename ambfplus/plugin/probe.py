@@ -137,10 +137,10 @@ def _text(data) -> str:
 
 
 def _probe_here(path: str) -> int:
-    """The child's side: load as the engine would, printing each stage reached."""
+    """The child's side: load as the engine would, printing each stage reached. Run as
+    ``python -m ambfplus.plugin.probe``, the child has imported the package first, and with it
+    libambfplus, which native plugins link against."""
     import ctypes
-
-    import ambfplus  # noqa: F401 (loads libambfplus, which native plugins link against)
 
     def stage(name: str) -> None:
         print(f"ambfplus-probe: {name}", flush=True)

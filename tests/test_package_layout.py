@@ -243,3 +243,13 @@ def test_the_checks_find_a_cycle_through_a_function_and_a_private_import(tmp_pat
     # The package's own __init__ gathering _shared, and the engine's names, are fine.
     assert not any("pkg/__init__.py" in b or "_engine" in b for b in bad), bad
     assert len(bad) == 2, bad
+
+
+def test_test_files_have_unique_names():
+    """Test folders have no __init__.py: pytest imports a test file by its name (its default
+    "prepend" import mode), so two test files of one name in two folders would collide."""
+    seen: dict[str, list[str]] = {}
+    for path in sorted((ROOT / "tests").rglob("test_*.py")):
+        seen.setdefault(path.name, []).append(str(path.relative_to(ROOT)))
+    twice = {name: paths for name, paths in seen.items() if len(paths) > 1}
+    assert not twice, f"test files sharing a name: {twice}"

@@ -25,9 +25,9 @@ from ambfplus.recording import (
     RecordingError,
     open_recording,
     repair,
-    scan_parts,
     validate,
 )
+from ambfplus.recording.reader import scan_parts
 
 # Writes frames until the disk is full, then closes the recorder the way argv[2] says and
 # prints what happened as JSON. With argv[3] == "engine" the frames are real captures. Frames

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 import pytest
-from conftest import pixel_rays
+from helpers.rays import pixel_rays
 
 import ambfplus
 

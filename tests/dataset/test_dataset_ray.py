@@ -1,9 +1,9 @@
 """Datasets on a real Ray cluster: a head and a second node started with `ray start` on this
-machine (tests/ray_cluster.py). The same spec gives the same shards as the local executor, Ray
-workers killed on either node are replaced and their episodes redone, a lost node's episodes
-are redone on the other, and a killed driver resumes. Skipped without the ray extra (pip
-install "ambfplus[ray]"), except under CI (the environment variable CI set), which installs
-it: there its absence fails."""
+machine (tests/helpers/ray_cluster.py). The same spec gives the same shards as the local
+executor, Ray workers killed on either node are replaced and their episodes redone, a lost
+node's episodes are redone on the other, and a killed driver resumes. Skipped without the ray
+extra (pip install "ambfplus[ray]"), except under CI (the environment variable CI set), which
+installs it: there its absence fails."""
 
 from __future__ import annotations
 
@@ -20,6 +20,9 @@ import threading
 import time
 
 import pytest
+
+# Starts a Ray cluster of two nodes on this machine.
+pytestmark = pytest.mark.cluster
 
 
 def _need(module: str) -> None:
@@ -38,7 +41,7 @@ _need("ray")
 _need("psutil")
 
 import psutil  # noqa: E402
-from ray_cluster import NODE_IP, RayCluster  # noqa: E402
+from helpers.ray_cluster import NODE_IP, RayCluster  # noqa: E402
 from test_dataset import manifest, shard_bytes  # noqa: E402
 
 from ambfplus.dataset import generate, read_manifest, validate_dataset  # noqa: E402

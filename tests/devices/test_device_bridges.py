@@ -15,16 +15,16 @@ import struct
 import subprocess
 import sys
 import time
-from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers import EXAMPLES
 from test_devices import drill_over_slab
 
 import ambfplus
 from ambfplus.devices.network import Bridge, pack_pose
 
-BRIDGE = Path(__file__).resolve().parents[1] / "examples" / "network_bridge.py"
+BRIDGE = EXAMPLES / "network_bridge.py"
 BUTTON, AXIS, INIT = 0x01, 0x02, 0x80
 
 

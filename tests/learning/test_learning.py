@@ -10,10 +10,10 @@ import json
 import subprocess
 import sys
 import textwrap
-from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers import EXAMPLES  # noqa: E402
 
 torch = pytest.importorskip(
     "torch", reason="ambfplus.learning needs PyTorch (pip install 'ambfplus[torch]')"
@@ -38,7 +38,6 @@ from ambfplus.learning.stereo_transformer import (  # noqa: E402
 )
 from ambfplus.stereo import StereoRig  # noqa: E402
 
-EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 # One thread: these networks are tiny, and spinning threads on a busy machine only slow them.
 torch.set_num_threads(1)
 SMALL = {"width": 96, "height": 72, "resolution": 48}

@@ -12,12 +12,13 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
+from helpers import TESTS
 
-import ambfplus.recording as recording_module
+import ambfplus.recording.writer as writer_module
 from ambfplus.recording import Recorder, RecordingError, open_recording, repair, validate
 from ambfplus.recording.hdf5 import collection_problem
 
-CORPUS = Path(__file__).resolve().parent / "fuzz" / "corpus" / "recording"
+CORPUS = TESTS / "fuzz" / "corpus" / "recording"
 # A recording written by the format 1.0 writer (variable-length strings), kept as a fuzz seed.
 FORMAT_1_0 = CORPUS / "seed-complete-v1.0"
 # A format 1.0 head whose global heap a fuzzer damaged: libhdf5 looped forever reading it.
@@ -107,7 +108,7 @@ def test_a_recording_written_now_holds_no_variable_length_data(tmp_path):
 
 
 def test_longer_text_widens_a_text_column_within_a_part(tmp_path, monkeypatch):
-    monkeypatch.setattr(recording_module, "BUFFER_BYTES", 1)  # every row written at once
+    monkeypatch.setattr(writer_module, "BUFFER_BYTES", 1)  # every row written at once
     path = tmp_path / "w.h5"
     with Recorder(path) as rec:
         for kind in ("a", LONG_KIND, "bb"):

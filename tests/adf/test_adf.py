@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from conftest import backproject
+from helpers.rays import backproject
 
 import ambfplus
 

@@ -24,7 +24,7 @@ pytest.importorskip("mcap_ros2", reason='needs pip install "ambfplus[export]"')
 pytest.importorskip("rosbags", reason='needs pip install "ambfplus[export]"')
 pytest.importorskip("pycocotools", reason='needs pip install "ambfplus[export]"')
 
-from conftest import pixel_rays  # noqa: E402
+from helpers.rays import pixel_rays  # noqa: E402
 from mcap.reader import make_reader  # noqa: E402
 from mcap_ros2.decoder import DecoderFactory  # noqa: E402
 from rosbags.highlevel import AnyReader  # noqa: E402

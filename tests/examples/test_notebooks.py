@@ -2,14 +2,15 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
+import helpers
 import pytest
 
 nbformat = pytest.importorskip("nbformat", reason="notebooks need the test extra (nbformat)")
 nbclient = pytest.importorskip("nbclient", reason="notebooks need the test extra (nbclient)")
 
-NOTEBOOKS = sorted((Path(__file__).resolve().parents[1] / "notebooks").glob("*.ipynb"))
+NOTEBOOKS = sorted(helpers.NOTEBOOKS.glob("*.ipynb"))
+# A notebook renders, records or trains for a minute or more.
+pytestmark = pytest.mark.slow
 
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=[p.name for p in NOTEBOOKS])

@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers import EXAMPLES
 
 from ambfplus.dataset import (
     GenerateError,
@@ -176,7 +177,7 @@ def test_ray_gpu_ids_choose_the_engines_cuda_device():
 
 
 def test_the_example_spec_is_valid():
-    spec = load_spec(Path(__file__).resolve().parents[1] / "examples" / "dataset_spec.yaml")
+    spec = load_spec(EXAMPLES / "dataset_spec.yaml")
     assert spec.episodes == 6 and len(spec.data["anatomies"]) == 2
     kinds = {sample_episode(spec, i).scenario["kind"] for i in range(spec.episodes)}
     assert kinds <= {"camera", "drilling", "mixed"} and len(kinds) >= 2

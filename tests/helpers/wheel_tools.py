@@ -13,7 +13,7 @@ import venv
 import zipfile
 from pathlib import Path
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 BUILD_WHEEL = REPO / ".ci" / "build-wheel"
 
 

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from volume_files import nrrd_bytes, segment_keys, write_slices
+from helpers.volume_files import nrrd_bytes, segment_keys, write_slices
 
 import ambfplus
 

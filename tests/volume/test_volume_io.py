@@ -7,8 +7,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers.volume_files import nrrd_bytes, segment_keys, write_slices
 from PIL import Image
-from volume_files import nrrd_bytes, segment_keys, write_slices
 
 import ambfplus
 from ambfplus.cli import main as cli

@@ -18,12 +18,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from x11 import finish, launch, screenshot, window_origin
+from helpers import TESTS
+from helpers.x11 import finish, launch, screenshot, window_origin
 
 import ambfplus
 from ambfplus.devices.hmd import XrView, xr_eye_geometry
 
-SOURCE = Path(__file__).parent / "openxr" / "test_runtime.cpp"
+SOURCE = TESTS / "openxr" / "test_runtime.cpp"
 
 
 @pytest.fixture(scope="session")

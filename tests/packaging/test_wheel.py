@@ -22,7 +22,7 @@ import zipfile
 from pathlib import Path
 
 import pytest
-from wheel_tools import (
+from helpers.wheel_tools import (
     REPO,
     download_wheelhouse,
     glibc_version,
@@ -34,6 +34,9 @@ auditwheel = pytest.importorskip("auditwheel", reason="needs auditwheel (pip: am
 elftools = pytest.importorskip("elftools", reason="needs pyelftools (comes with auditwheel)")
 from elftools.elf.dynamic import DynamicSection  # noqa: E402
 from elftools.elf.elffile import ELFFile  # noqa: E402
+
+# Builds the wheel and checks it in fresh environments: minutes.
+pytestmark = pytest.mark.packaging
 
 # The GL vendor-neutral dispatch libraries: the system's (the driver sits behind them).
 GL_DISPATCH = {"libEGL.so.1", "libOpenGL.so.0", "libGL.so.1"}

@@ -9,7 +9,7 @@ import time
 
 import numpy as np
 import pytest
-from x11 import finish, launch, screenshot, window_origin, xdo
+from helpers.x11 import finish, launch, screenshot, window_origin, xdo
 
 import ambfplus
 

@@ -7,10 +7,12 @@ import importlib.metadata
 import re
 from pathlib import Path
 
+from helpers import REPO
+
 import ambfplus
 from ambfplus import _core
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = REPO
 
 
 def test_version_comes_from_pyproject():

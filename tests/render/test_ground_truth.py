@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import pixel_rays
+from helpers.rays import pixel_rays
 
 import ambfplus
 from ambfplus.labels import legend, segmentation

@@ -4,17 +4,14 @@ from __future__ import annotations
 
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
+from helpers import EXAMPLES
 
-# The paper's experiments need the torch extra and run at CI size in tests/test_learning.py.
+# The paper's experiments need the torch extra and run at CI size in
+# tests/learning/test_learning.py.
 TESTED_ELSEWHERE = {"stereo_depth_experiment.py", "tracking_experiment.py"}
-EXAMPLES = sorted(
-    p
-    for p in (Path(__file__).resolve().parents[1] / "examples").glob("*.py")
-    if p.name not in TESTED_ELSEWHERE
-)
+EXAMPLES = sorted(p for p in EXAMPLES.glob("*.py") if p.name not in TESTED_ELSEWHERE)
 
 
 @pytest.mark.parametrize("script", EXAMPLES, ids=[p.name for p in EXAMPLES])

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import backproject, pixel_rays
+from helpers.rays import backproject, pixel_rays
 
 import ambfplus
 

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-FUZZ = Path(__file__).resolve().parent / "fuzz"
+FUZZ = Path(__file__).resolve().parent
 TARGETS = ["nrrd", "slice_stack", "recording", "adf", "mesh"]
 
 
@@ -57,6 +57,7 @@ def keep_findings(target: str, work: Path) -> str:
 
 
 @pytest.mark.fuzz
+@pytest.mark.slow  # a minute each
 @pytest.mark.parametrize("target", FUZZED_IN_CI)
 def test_a_minute_of_fuzzing_finds_nothing(target, tmp_path):
     pytest.importorskip("atheris", reason='fuzzing needs atheris: pip install "ambfplus[fuzz]"')

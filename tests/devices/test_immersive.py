@@ -14,7 +14,7 @@ import time
 
 import numpy as np
 import pytest
-from x11 import finish, launch, screenshot, window_origin, xdo
+from helpers.x11 import finish, launch, screenshot, window_origin, xdo
 
 import ambfplus
 from ambfplus.devices.hmd import HmdError, HmdView, OpenHMD, quaternion_matrix

@@ -8,6 +8,7 @@ import sys
 import zlib
 
 import numpy as np
+import pytest
 
 from ambfplus.cli import main
 from ambfplus.cli.demo import DEPTH_PNG_SCALE
@@ -66,6 +67,7 @@ def read_png(path) -> np.ndarray:
     return out.reshape(height, width, channels).squeeze()
 
 
+@pytest.mark.slow
 def test_demo_records_a_checked_drilling_session(tmp_path):
     out = tmp_path / "demo"
     args = ["demo", "--out", str(out), "--width", "160", "--height", "120"]

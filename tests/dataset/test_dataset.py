@@ -145,6 +145,7 @@ def test_ray_without_the_extra_says_what_to_install(monkeypatch, tmp_path):
     assert not (tmp_path / "out").exists()
 
 
+@pytest.mark.slow
 def test_the_ray_tests_fail_rather_than_skip_under_ci_without_ray(tmp_path):
     ray_tests = Path(__file__).with_name("test_dataset_ray.py")
     without_ray = "import sys; sys.modules['ray'] = None; import pytest; sys.exit(pytest.main())"
@@ -219,6 +220,7 @@ def test_an_episode_is_a_pure_function_of_spec_seed_and_index(dataset_spec):
 # Generating --------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_one_and_two_workers_make_identical_shards(dataset_spec, reference_dataset, tmp_path):
     report = generate(dataset_spec, tmp_path / "two", workers=2, progress=False)
     assert report.generated == 12 and report.retries == 0
@@ -272,6 +274,7 @@ def _worker_pids(driver: int) -> list[int]:
     return found
 
 
+@pytest.mark.slow
 def test_killed_workers_are_replaced_and_their_episodes_redone(
     dataset_spec, reference_dataset, tmp_path
 ):
@@ -296,6 +299,7 @@ def test_killed_workers_are_replaced_and_their_episodes_redone(
     assert runs[-1]["retries"] >= 1  # at least one kill hit a worker at work
 
 
+@pytest.mark.slow
 def test_a_killed_driver_resumes_to_the_same_dataset(dataset_spec, reference_dataset, tmp_path):
     out = tmp_path / "data"
     driver = start_generate(dataset_spec, out)
@@ -673,6 +677,7 @@ def test_other_looks_leave_the_ground_truth_exact(dataset_spec, tmp_path):
 # Reading and checking ----------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_validate_finds_damage_gaps_and_duplicates(reference_dataset, tmp_path):
     out = tmp_path / "copy"
     shutil.copytree(reference_dataset, out)

@@ -349,6 +349,7 @@ def burr_sweep_labels(volume, before, path):
     return ijk, before[tuple(ijk.T)], distance
 
 
+@pytest.mark.slow
 def test_the_original_drilling_scene_runs_with_a_scripted_device(fixtures):
     """volumetric_drilling/launch.yaml with its drills and 256^3 volume: the launch file's
     plugin (libvolumetric_drilling.so) resolves to ours, which makes the drill of the burr

@@ -99,6 +99,7 @@ def test_a_scripted_head_rotation_turns_the_rendered_view_by_the_same_angle():
     hmd.close()
 
 
+@pytest.mark.slow
 def test_side_by_side_halves_have_the_disparity_of_the_stated_pair(fixtures, display, tmp_path):
     """The launcher's side-by-side window on the original drilling scene: block matching between
     the two halves of a screenshot gives the disparity the stated pair predicts from depth

@@ -216,6 +216,7 @@ def test_a_missing_runtime_or_one_without_egl_is_named(runtime_manifest, tmp_pat
         ambfplus.OpenXrSession()
 
 
+@pytest.mark.slow
 def test_the_launcher_shows_the_eyes_in_the_headset_and_mirrors_them(
     fixtures, display, xr_env, tmp_path, monkeypatch
 ):

@@ -5,13 +5,15 @@ from __future__ import annotations
 import subprocess
 import sys
 
+import helpers
 import pytest
-from helpers import EXAMPLES
 
 # The paper's experiments need the torch extra and run at CI size in
 # tests/learning/test_learning.py.
 TESTED_ELSEWHERE = {"stereo_depth_experiment.py", "tracking_experiment.py"}
-EXAMPLES = sorted(p for p in EXAMPLES.glob("*.py") if p.name not in TESTED_ELSEWHERE)
+EXAMPLES = sorted(p for p in helpers.EXAMPLES.glob("*.py") if p.name not in TESTED_ELSEWHERE)
+# Each example is a whole session (recording, dataset, bridge) in its own process.
+pytestmark = pytest.mark.slow
 
 
 @pytest.mark.parametrize("script", EXAMPLES, ids=[p.name for p in EXAMPLES])

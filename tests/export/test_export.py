@@ -733,6 +733,7 @@ def run_cli(cwd: Path, *args: str) -> subprocess.CompletedProcess:
                           capture_output=True, text=True, timeout=120)  # fmt: skip
 
 
+@pytest.mark.slow
 def test_bad_input_gives_a_clear_error_and_writes_nothing(session, tmp_path):
     # A truncated recording: its head cut in half.
     truncated = tmp_path / "truncated.h5"
@@ -1079,6 +1080,7 @@ def check_export_reads_back(to: str, output: Path, recording) -> None:
 
 
 @pytest.mark.parametrize("to", ["mcap", "rosbag2", "original-h5", "coco"])
+@pytest.mark.slow
 def test_a_generated_dataset_exports_whole_or_shard_by_shard(generated, tmp_path, to):
     """A dataset folder made by `ambfplus generate` (shards with parts) exports to every
     format, all shards at once or one shard at a time, and reads back equal to its shards."""

@@ -82,6 +82,7 @@ def drilling_world(resolution: int, width: int, height: int):
     return scene, hand
 
 
+@pytest.mark.slow
 def test_a_client_watches_a_drilling_session_live():
     """State channels at `rate`, images at `image_rate` where rendering keeps up (a small
     camera), everything decodable and consistent with the session."""
@@ -133,6 +134,7 @@ def test_a_client_watches_a_drilling_session_live():
           f"{loop_stats['max'] * 1e3:.3f} ms, {loop_stats['mean_rate']:.1f} Hz")  # fmt: skip
 
 
+@pytest.mark.slow
 def test_slow_images_do_not_slow_the_state_channels():
     """A 640x480 camera asked for 1000 images a second (more than any renderer and the
     WebSocket serialising 0.9 MB per image reach): images come as fast as rendering allows (the

@@ -16,6 +16,7 @@ import ambfplus
 WIDTH, HEIGHT = 1536, 540
 
 
+@pytest.mark.slow
 def test_keys_move_the_drill_and_the_window_shows_the_scene(fixtures, display, tmp_path):
     launch_file = fixtures / "volumetric_drilling" / "launch.yaml"
     process, status_file, window = launch(display, tmp_path, launch_file, 12)
@@ -60,6 +61,7 @@ def test_keys_move_the_drill_and_the_window_shows_the_scene(fixtures, display, t
     assert shot[bone].mean() > 60, "the anatomy is lit, not black"
 
 
+@pytest.mark.slow
 def test_a_recorded_interactive_session_replays_to_the_same_removal(fixtures, display, tmp_path):
     from ambfplus.scenes import replay
 

@@ -228,6 +228,7 @@ def test_a_crop_keeps_disparity_and_hides_matches_outside_it():
         crop_sample(sample, top=200, left=0, height=120, width=100)
 
 
+@pytest.mark.slow
 def test_two_workers_give_different_samples_and_each_is_reproducible():
     data = SimulatorStereoDataset(samples=4, scenario="mixed", episode_frames=2, seed=11, **SMALL)
     loader = make_loader(data, batch_size=1, num_workers=2)
@@ -248,6 +249,7 @@ def test_two_workers_give_different_samples_and_each_is_reproducible():
     assert not torch.equal(next(iter(data))["left"], here["left"]), "a new epoch, new samples"
 
 
+@pytest.mark.slow
 def test_a_forked_worker_of_a_parent_that_rendered_is_refused():
     """The rule make_loader enforces, shown: fork after rendering fails with a message that
     says what to do; spawn works."""
@@ -312,6 +314,7 @@ def test_a_recording_gives_back_the_samples_rendered_in_the_loop(recorded):
     data.close()
 
 
+@pytest.mark.slow
 def test_recordings_are_read_by_two_workers_that_open_their_own_files(recorded):
     path, live = recorded
     data = RecordingStereoDataset([path, path])
@@ -412,6 +415,7 @@ def load_example(name: str):
     return module
 
 
+@pytest.mark.slow
 def test_the_depth_experiment_runs_at_small_size(tmp_path):
     example = load_example("stereo_depth_experiment")
     assert example.main([str(tmp_path), "--small"]) == 0

@@ -211,6 +211,7 @@ def test_pass_selection_and_bad_names():
     assert np.all(out["voxel"] == -1) and np.all(out["instance"][24, 32] == world.get("cube").id)
 
 
+@pytest.mark.slow
 def test_fixture_stereo_pair_renders_the_ear_with_its_baseline(fixtures):
     # The original's stereoL/stereoR (children of main_camera, 25 mm apart) looking at the ear.
     launch = fixtures / "volumetric_drilling" / "launch.yaml"

@@ -52,6 +52,7 @@ def test_fixture_models_stay_finite_for_10_seconds(fixtures, model):
     assert_images_finite(camera)
 
 
+@pytest.mark.slow
 def test_drilling_fixture_stays_finite_while_drilling_for_10_seconds(fixtures):
     sim = ambfplus.Simulator.from_launch(
         fixtures / "volumetric_drilling" / "launch.yaml", models=[0, 2], strict=True

@@ -41,6 +41,7 @@ def independent_counts(folder: Path, table) -> np.ndarray:
 @pytest.mark.parametrize(
     ("name", "slices", "size"), [("ear3_171", 169, 171), ("ear3_256", 253, 256)]
 )
+@pytest.mark.slow
 def test_fixture_ears_load_with_exact_label_counts(fixtures, name, slices, size):
     root = fixtures / EAR
     table = read_labels_csv(root / "labels.csv")

@@ -91,7 +91,7 @@ from ._core import (
     write_label_table,
 )
 from .devices import input_device_options
-from .plugins import Plugin, cmake_dir, plugin_dir
+from .plugin import Plugin, cmake_dir, plugin_dir
 from .transforms import make_pose, rotation_between, rpy_matrix
 from .volumes import convert_volume, load_volume
 

@@ -1,4 +1,5 @@
-"""Stereo rigs, segmentation colours, the id legend and the conversions a dataset needs.
+"""Stereo rigs, stereo frames and the disparity/depth conversions a dataset needs (the id
+legend and segmentation colours are ``ambfplus.labels``).
 
 Conventions (see the package docstring): camera poses are world-from-camera in the OpenCV frame
 (x right, y down, z forward); pixel (row r, column c) is centred at (c + 0.5, r + 0.5).
@@ -244,49 +245,3 @@ def disparity_agreement(stereo: StereoFrame, step: int = 8, margin: int = 20) ->
         "p95_error": float(np.percentile(error, 95)),
         "baseline": float(np.median((measured[ok] + stereo.dcx) * z / stereo.focal)),
     }
-
-
-def legend(world: World) -> dict[int, dict]:
-    """Every object id a capture's instance image can hold: name, kind, model and flat colour
-    (RGB 0..255; bodies their material colour); volumes also list their labels (id -> name,
-    colour)."""
-    out = {}
-    for o in world.objects:
-        entry = {"name": o.name, "kind": o.kind, "model": o.model.name}
-        color = getattr(o, "color", None)
-        if color is not None:
-            entry["color"] = tuple(int(round(255 * c)) for c in list(color)[:3])
-        if o.kind == "volume":
-            entry["labels"] = {
-                label.id: {"name": label.name, "color": tuple(label.color)}
-                for label in o.data.label_table
-            }
-        out[o.id] = entry
-    return out
-
-
-def segmentation(frame: Frame, world: World, background=(0, 0, 0)) -> np.ndarray:
-    """Each object in its legend colour (its material colour, at full strength), volumes in their
-    labels' colours, from the frame's instance image (and label for volumes). For the colours
-    AMBF's preprocessing shaders draw, capture the "segmentation" pass instead."""
-    if frame.instance is None:
-        raise ValueError("segmentation needs a frame captured with the 'instance' pass")
-    ids = frame.instance
-    lut = np.zeros((int(ids.max()) + 1, 3), dtype=np.uint8)
-    lut[0] = background
-    entries = legend(world)
-    for i, entry in entries.items():
-        if i < len(lut) and "color" in entry:
-            lut[i] = entry["color"]
-    image = lut[ids]
-    if frame.label is not None:
-        labels = frame.label
-        on_volume = labels > 0
-        if on_volume.any():
-            table = np.zeros((int(labels.max()) + 1, 3), dtype=np.uint8)
-            for entry in entries.values():
-                for label_id, label in entry.get("labels", {}).items():
-                    if label_id < len(table):
-                        table[label_id] = label["color"]
-            image[on_volume] = table[labels[on_volume]]
-    return image

@@ -56,7 +56,7 @@ def read_trajectory(path: Path) -> np.ndarray:
 
 
 def bridge(out: Path, port: int, trajectory: np.ndarray) -> dict:
-    from ambfplus.network import Bridge
+    from ambfplus.devices.network import Bridge
 
     started = time.perf_counter()
     with Bridge(port) as link:

@@ -1,4 +1,5 @@
-"""Shared test helpers. Tests use the installed package only."""
+"""Shared fixtures (helper functions are in tests/helpers/). Tests use the installed package
+only."""
 
 from __future__ import annotations
 
@@ -8,7 +9,6 @@ import shutil
 import subprocess
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 # Real files from the original system live beside the repository (../shared/fixtures) on the
@@ -26,24 +26,6 @@ def fixtures() -> Path:
             "set AMBFPLUS_FIXTURES to their folder to run this test"
         )
     return FIXTURES
-
-
-def pixel_rays(intrinsics: np.ndarray, height: int, width: int) -> np.ndarray:
-    """Camera-frame ray directions (z = 1) through every pixel centre, (H, W, 3)."""
-    cols, rows = np.meshgrid(np.arange(width) + 0.5, np.arange(height) + 0.5)
-    k = intrinsics
-    x = (cols - k[0, 2]) / k[0, 0]
-    y = (rows - k[1, 2]) / k[1, 1]
-    return np.stack([x, y, np.ones_like(x)], axis=-1)
-
-
-def backproject(frame) -> np.ndarray:
-    """World-frame points of every pixel with a hit, (N, 3), from depth, intrinsics and pose."""
-    rays = pixel_rays(frame.intrinsics, frame.height, frame.width)
-    valid = frame.depth > 0
-    cam = rays[valid] * frame.depth[valid][:, None].astype(np.float64)
-    pose = frame.pose
-    return cam @ pose[:3, :3].T + pose[:3, 3]
 
 
 # What window tests need: a virtual X server, keys sent to it, the screen read back.
@@ -140,7 +122,12 @@ def reference_dataset(dataset_spec, tmp_path_factory) -> Path:
 OPT_IN_MARKS = ("benchmark",)
 
 
+@pytest.hookimpl(tryfirst=True)  # before -m deselects by marks
 def pytest_collection_modifyitems(config, items):
+    # A test that needs a virtual X display is a window test, whichever file it is in.
+    for item in items:
+        if "display" in getattr(item, "fixturenames", ()):
+            item.add_marker(pytest.mark.gui)
     asked = config.getoption("markexpr") or ""
     for mark in OPT_IN_MARKS:
         if re.search(rf"(?<!not )\b{mark}\b", asked):

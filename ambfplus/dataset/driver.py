@@ -31,7 +31,7 @@ from pathlib import Path
 from typing import TextIO
 
 from .. import __version__
-from ..recording_schema import replace_text
+from ..fileio import write_text
 from .episode import PARTIAL, RUN_FILE, SHARDS, new_run_id, take_over
 from .executor import Done, Executor, Failed, Retry
 from .manifest import MANIFEST, ManifestWriter, read_manifest, rewrite_manifest
@@ -277,7 +277,7 @@ def _now() -> str:
 
 
 def _write_json(path: Path, value) -> None:
-    replace_text(path, json.dumps(value, indent=2, sort_keys=True) + "\n")
+    write_text(path, json.dumps(value, indent=2, sort_keys=True) + "\n")
 
 
 class _FolderLock:

@@ -28,10 +28,8 @@ from pathlib import Path
 import numpy as np
 
 from .. import NullDevice, ScriptedDevice, __version__, gl_info
-from ..recording_schema import find_parts
-from ..scenarios import DrillScript
-from ..scenes import anatomy_data, drilling_scene
-from ..session import record_session
+from ..recording.schema import find_parts
+from ..scenes import DrillScript, anatomy_data, drilling_scene, record_session
 from ..stereo import StereoFrame
 from .manifest import shard_checksum
 from .sampling import EpisodePlan, jitter_label_colors, sample_episode

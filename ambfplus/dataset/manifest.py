@@ -20,7 +20,7 @@ import os
 from functools import partial
 from pathlib import Path
 
-from ..recording_schema import replace_text
+from ..fileio import write_text
 
 MANIFEST = "manifest.jsonl"
 # Fields that depend on the run (time, place, retries), not on the spec and the episode.
@@ -102,4 +102,4 @@ class ManifestWriter:
 def rewrite_manifest(folder, records: list[dict]) -> None:
     """Replaces the manifest with `records` sorted by episode (atomically)."""
     lines = [json.dumps(r, sort_keys=True) for r in sorted(records, key=lambda r: r["episode"])]
-    replace_text(Path(folder) / MANIFEST, "".join(line + "\n" for line in lines))
+    write_text(Path(folder) / MANIFEST, "".join(line + "\n" for line in lines))

@@ -13,7 +13,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from ..scenarios import CameraPath
+from ..scenes import CameraPath
 from .spec import DatasetSpec
 
 STREAMS = (

@@ -30,9 +30,9 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..recording_reader import open_recording
-from ..recording_schema import RecordingError
-from ._common import ExportError, MissingExtra, check_output, progress_bar, whole_output
+from ..fileio import written_whole
+from ..recording import RecordingError, open_recording
+from ._common import ExportError, MissingExtra, check_output, progress_bar
 
 FORMATS = ("mcap", "rosbag2", "original-h5", "coco")
 # What each format's output is called beside the shard or recording it comes from.
@@ -117,7 +117,7 @@ def export(source, out, to: str, *, force: bool = False, progress: bool | None =
                           f"{source.parent} (every shard) or one shard's head file")  # fmt: skip
     check_output(out, force)
     _writer(to)  # the extra's modules are imported before anything is opened
-    with open_recording(source) as recording, whole_output(out, force) as temporary:
+    with open_recording(source) as recording, written_whole(out) as temporary:
         return _export_one(recording, temporary, out, to, progress, options)
 
 
@@ -175,7 +175,7 @@ def read_manifest(folder: Path) -> list[dict]:
 def shard_digests(head: Path) -> set[str]:
     """SHA-256 of a shard as a manifest may state it: of its head file, and of the head
     followed by its parts in order (the same when it has no parts)."""
-    from ..recording_schema import find_parts
+    from ..recording.schema import find_parts
 
     whole, alone = hashlib.sha256(), hashlib.sha256()
     with open(head, "rb") as f:
@@ -214,7 +214,7 @@ def export_dataset(folder: Path, out: Path, to: str, *, force: bool = False,
     verify_shards(folder, entries)
     _writer(to)
     results = []
-    with whole_output(out, force) as temporary:
+    with written_whole(out) as temporary:
         temporary.mkdir()
         for extra in ("spec.yaml", "environment.json"):
             if (folder / extra).is_file():

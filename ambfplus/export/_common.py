@@ -1,13 +1,9 @@
-"""What every export shares: errors, the extras they need, writing outputs whole, poses as
+"""What every export shares: errors, the extras they need, output checks, poses as
 quaternions, the simulation clock of a recording and a progress bar."""
 
 from __future__ import annotations
 
-import contextlib
 import importlib
-import os
-import shutil
-from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -38,39 +34,12 @@ def require(extra: str, *modules: str):
     return loaded[0] if len(loaded) == 1 else loaded
 
 
-def _remove(path: Path) -> None:
-    if path.is_dir() and not path.is_symlink():
-        shutil.rmtree(path)
-    elif path.exists() or path.is_symlink():
-        path.unlink()
-
-
 def check_output(out: Path, force: bool) -> None:
     """Refuses an output path that exists unless force is given (checked before any work)."""
     if (out.exists() or out.is_symlink()) and not force:
         raise ExportError(f"{out} exists; pass --force (force=True) to replace it")
     if not out.parent.is_dir():
         raise ExportError(f"{out}: the folder {out.parent} does not exist")
-
-
-@contextlib.contextmanager
-def whole_output(out: Path, force: bool) -> Iterator[Path]:
-    """Yields a temporary path beside ``out`` to write into; it replaces ``out`` only once the
-    body finished, so a failed or interrupted export leaves nothing partial (the old output, if
-    any, stays until the new one is complete)."""
-    check_output(out, force)
-    temporary = out.with_name(f".{out.name}.tmp-{os.getpid()}")
-    _remove(temporary)
-    try:
-        yield temporary
-        if not temporary.exists():
-            raise ExportError(f"{out}: the export wrote nothing")
-        if out.exists() or out.is_symlink():
-            _remove(out)
-        os.replace(temporary, out)
-    except BaseException:
-        _remove(temporary)
-        raise
 
 
 def quaternion_xyzw(rotation: np.ndarray) -> np.ndarray:

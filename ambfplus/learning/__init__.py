@@ -40,10 +40,10 @@ except ImportError as _error:  # pragma: no cover - exercised in a subprocess by
         "https://download.pytorch.org/whl/cpu)"
     ) from _error
 
+from ..scenes import CameraPath, DrillScript
 from .datasets import RecordingStereoDataset, SimulatorStereoDataset, make_loader
 from .metrics import disparity_metrics, fill_invalid_along_rows
 from .samples import crop_sample, stereo_sample
-from .scenarios import CameraPath, DrillScript
 from .stereo_transformer import StereoTransformer, stereo_loss
 from .targets import depth_from_disparity, disparity_from_depth, occlusion_mask, stereo_targets
 

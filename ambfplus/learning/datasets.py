@@ -21,8 +21,7 @@ from torch.utils.data import DataLoader, Dataset, IterableDataset, get_worker_in
 
 from .. import RenderError, ScriptedDevice
 from ..recording import Recorder, open_recording
-from ..scenarios import CameraPath, DrillScript
-from ..scenes import Scene, drilling_phantom
+from ..scenes import CameraPath, DrillScript, Scene, drilling_phantom
 from .samples import OPTIONAL_PASSES, REQUIRED_PASSES, stereo_sample
 
 SCENARIOS = ("camera", "drilling", "mixed")

@@ -6,7 +6,7 @@ baseline, f = 1135 px at 640x480, off-axis with zero disparity at 250 mm):
 - moving drill: the rig holds the first view of that orbit while a scripted hand plunges the
   spinning burr into the bone at random sites and sweeps it (the paper's testing sequence).
 
-Both write ordinary recordings (``ambfplus.session.record_session``) with a ``sequence`` entry
+Both write ordinary recordings (``ambfplus.scenes.record_session``) with a ``sequence`` entry
 in their metadata that says how they were made, so that a later run can reuse them.
 """
 
@@ -18,9 +18,7 @@ import numpy as np
 
 from .. import NullDevice, ScriptedDevice
 from ..recording import open_recording
-from ..scenarios import DrillScript
-from ..scenes import drilling_phantom, orbit_view
-from ..session import record_session
+from ..scenes import DrillScript, drilling_phantom, orbit_view, record_session
 
 PASSES = ("rgb", "depth", "label", "instance", "segmentation")
 MOVING_CAMERA, MOVING_DRILL = "moving camera", "moving drill"

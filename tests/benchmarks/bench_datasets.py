@@ -319,7 +319,7 @@ def _start_cluster():
               file=sys.stderr)  # fmt: skip
         return None
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-    from ray_cluster import RayCluster
+    from helpers.ray_cluster import RayCluster
 
     return RayCluster(cpus_per_node=1).start()
 

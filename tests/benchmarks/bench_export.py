@@ -30,8 +30,7 @@ import ambfplus
 
 
 def _session(path: Path, seconds: float) -> dict:
-    from ambfplus.scenes import drilling_phantom, orbit_view
-    from ambfplus.session import record_session
+    from ambfplus.scenes import drilling_phantom, orbit_view, record_session
 
     scene = drilling_phantom(resolution=128, width=640, height=480)
     r = scene.drill.burr_radius

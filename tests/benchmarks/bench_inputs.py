@@ -25,7 +25,7 @@ import ambfplus
 SENDER = r"""
 import math, socket, struct, sys, time
 sys.path.insert(0, sys.argv[3])
-from ambfplus.network import pack_pose
+from ambfplus.devices.network import pack_pose
 port, seconds = int(sys.argv[1]), float(sys.argv[2])
 good = pack_pose(1, (0.0, 0.0, 0.0))
 bad = [b"short", good + bytes(64), b"XXXX" + good[4:], good[:4] + struct.pack("<H", 9) + good[6:],

@@ -16,7 +16,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from wheel_tools import (  # noqa: E402
+from helpers.wheel_tools import (  # noqa: E402
     download_wheelhouse,
     glibc_version,
     install_into_new_venv,

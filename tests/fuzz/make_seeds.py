@@ -15,7 +15,7 @@ from PIL import Image
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
-from volume_files import nrrd_bytes, segment_keys  # noqa: E402
+from helpers.volume_files import nrrd_bytes, segment_keys  # noqa: E402
 
 SEPARATOR = b"\n--8<--\n"
 

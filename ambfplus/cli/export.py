@@ -1,0 +1,74 @@
+"""``ambfplus export``: a recording or a dataset folder to MCAP, rosbag2, the original's HDF5
+layout or COCO."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+
+def add_parser(commands) -> None:
+    """Declares ``ambfplus export``, its options and the function that runs it."""
+    exporter = commands.add_parser(
+        "export",
+        help="export a recording or a dataset folder to MCAP or rosbag2 (ROS 2 messages), the "
+        "original system's HDF5 layout or COCO masks",
+    )
+    exporter.add_argument("source", type=Path, help="a recording (name.h5) or a dataset folder")
+    exporter.add_argument("--to", required=True, metavar="FORMAT",
+                          help="mcap, rosbag2, original-h5 or coco")  # fmt: skip
+    exporter.add_argument("out", type=Path, help="the output file (mcap) or folder")
+    exporter.add_argument("--force", action="store_true", help="replace an existing output")
+    exporter.add_argument("--quiet", action="store_true", help="no progress bar")
+    exporter.add_argument("--verbose", action="store_true", help="print message counts")
+    exporter.add_argument("--no-points", action="store_true",
+                          help="mcap/rosbag2: no point clouds")  # fmt: skip
+    exporter.add_argument("--compression", default="zstd", choices=("zstd", "lz4", "none"),
+                          help="mcap: chunk compression")  # fmt: skip
+    exporter.add_argument("--image-topics", default="raw", choices=("raw", "compressed", "both"),
+                          help="mcap/rosbag2: sensor_msgs/Image topics, CompressedImage topics "
+                          "(<topic>/compressed: PNG or TIFF, lossless) or both")  # fmt: skip
+    exporter.add_argument("--rgb-codec", default="png", choices=("png", "jpeg"),
+                          help="mcap/rosbag2: compressed rgb as png or jpeg (lossy)")  # fmt: skip
+    exporter.add_argument("--jpeg-quality", type=int, default=90,
+                          help="mcap/rosbag2: JPEG quality 1..100 (default 90)")  # fmt: skip
+    exporter.add_argument("--chunk-size", type=int, default=500,
+                          help="original-h5: samples per file (the original's 500)")  # fmt: skip
+    exporter.add_argument("--no-images", action="store_true",
+                          help="coco: annotations only, no PNG frames")  # fmt: skip
+    exporter.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Exports a recording or a dataset folder; errors are one line naming what is wrong."""
+    from ..export import ExportError, MissingExtra, export
+    from ..recording import RecordingError
+
+    options = {}
+    if args.to in ("mcap", "rosbag2"):
+        options["point_clouds"] = not args.no_points
+        options["image_topics"] = args.image_topics
+        options["rgb_codec"] = args.rgb_codec
+        options["jpeg_quality"] = args.jpeg_quality
+    if args.to == "mcap":
+        options["compression"] = None if args.compression == "none" else args.compression
+    if args.to == "original-h5":
+        options["chunk_size"] = args.chunk_size
+    if args.to == "coco":
+        options["images"] = not args.no_images
+    try:
+        results = export(args.source, args.out, args.to, force=args.force,
+                         progress=False if args.quiet else None, **options)  # fmt: skip
+    except (ExportError, RecordingError, MissingExtra) as error:
+        print(f"ambfplus export: {error}", file=sys.stderr)
+        return 1
+    results = results if isinstance(results, list) else [results]
+    for result in results:
+        line = result.to_dict()
+        if not args.verbose:
+            line.pop("topics", None)
+            line.pop("messages", None)
+        print(json.dumps(line))
+    return 0

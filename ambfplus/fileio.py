@@ -1,0 +1,62 @@
+"""Writing files whole: a reader sees the old file (or folder) or the new one, never a partial
+one. Every writer in the package that replaces an output in place goes through here: the
+recording's parts and head, a dataset's manifest and environment, exports, the launcher's status
+file.
+
+A file is written to its temporary name beside it (``<name>.tmp``, on the same file system) and
+renamed into place, which POSIX makes atomic. Readers and validators ignore ``.tmp`` files."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import shutil
+from collections.abc import Iterator
+from pathlib import Path
+
+
+def temporary_name(path: Path) -> Path:
+    """Where ``path`` is written before it is renamed into place."""
+    path = Path(path)
+    return path.with_name(path.name + ".tmp")
+
+
+def remove(path: Path) -> None:
+    """Removes a file, a link or a folder tree; nothing if there is none."""
+    path = Path(path)
+    if path.is_dir() and not path.is_symlink():
+        shutil.rmtree(path)
+    elif path.exists() or path.is_symlink():
+        path.unlink()
+
+
+@contextlib.contextmanager
+def written_whole(path: Path) -> Iterator[Path]:
+    """Yields the temporary path to write ``path``'s new content to (a file or a folder); once
+    the body ends it replaces ``path``, and if the body fails it is removed, leaving ``path``
+    as it was."""
+    path = Path(path)
+    temporary = temporary_name(path)
+    remove(temporary)
+    try:
+        yield temporary
+        if not temporary.exists():
+            raise FileNotFoundError(f"{path}: nothing was written to {temporary}")
+        if temporary.is_dir() or (path.is_dir() and not path.is_symlink()):
+            remove(path)  # a rename replaces a file by a file only
+        os.replace(temporary, path)
+    except BaseException:
+        remove(temporary)
+        raise
+
+
+def write_text(path: Path, text: str) -> None:
+    """Writes text to ``path`` whole (see the module)."""
+    with written_whole(path) as temporary:
+        temporary.write_text(text)
+
+
+def write_bytes(path: Path, data: bytes) -> None:
+    """Writes bytes to ``path`` whole (see the module)."""
+    with written_whole(path) as temporary:
+        temporary.write_bytes(data)

@@ -1,0 +1,175 @@
+"""A launched session: the launch file loaded, its drill bound to the chosen device, its
+real-time loop, and what it records or serves live."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from .._core import KeyboardDevice, RealTimeLoop, Simulator, __version__
+from .inputs import make_device
+from .status import WARN_DISTANCE, Status
+
+
+class LaunchSession:
+    """A loaded launch file, its drill bound to a keyboard device, and its real-time loop."""
+
+    def __init__(self, args: argparse.Namespace, plugin_args: list[str]) -> None:
+        launch = args.launch or args.launch_file
+        if launch is None:
+            raise SystemExit("ambfplus-launch: give a launch file (positional or --launch_file)")
+        extra = [Path(p) for p in args.load_multibody_files.split(",") if p] if (
+            args.load_multibody_files
+        ) else []  # fmt: skip
+        # The original keeps its anatomy's names beside its launch file; the drilling plugin
+        # reads them from --labels.
+        labels = Path(launch).parent / "labels.csv"
+        if "--labels" not in plugin_args and labels.is_file():
+            plugin_args = plugin_args + ["--labels", str(labels.resolve())]
+        self.sim = Simulator.from_launch(
+            launch,
+            models=args.load_multibodies,
+            extra=extra,
+            devices=args.load_devices or [],
+            namespace_prefix=args.ns,
+            time_step=1.0 / args.phx_frequency,
+            plugins=[p for p in args.plugins.split(",") if p],
+            arguments=plugin_args,
+        )
+        for file, message in self.sim.load_report.errors:
+            print(f"error: {file}: {message}", file=sys.stderr)
+        self.world = self.sim.world
+        cameras = self.world.cameras
+        if args.camera:
+            self.camera = self.world[args.camera]
+        elif cameras:
+            self.camera = cameras[0]
+        else:
+            raise SystemExit(f"ambfplus-launch: {launch} has no camera to show")
+        self.drill = self.world.drills[0] if self.world.drills else None
+        self.keyboard = KeyboardDevice()
+        self.device, self.device_name = make_device(args, self.keyboard)
+        self.binding = None
+        self.spec = {
+            "builder": "launch",
+            "params": {
+                "file": str(Path(launch).resolve()),
+                "models": args.load_multibodies,
+                "extra": [str(p.resolve()) for p in extra],
+                "namespace_prefix": args.ns,
+                "plugins": [p for p in args.plugins.split(",") if p],
+                "arguments": plugin_args,
+                "time_step": 1.0 / args.phx_frequency,
+            },
+        }
+        self.device_options = {
+            "reference": self.camera.name,
+            "drill_button": 0,
+            "clutch_button": 1,
+            "burr_button": 2,
+        }
+        if self.drill is not None:
+            options = dict(self.device_options, reference=self.camera)
+            # Named "keyboard" whatever drives it: the name replay looks for (scenes.launch_scene).
+            self.binding = self.world.add_input_device("keyboard", self.device, self.drill,
+                                                       **options)  # fmt: skip
+        self.initial_goal = self.drill.goal.copy() if self.drill is not None else None
+        self.loop = RealTimeLoop(self.world, rate=args.phx_frequency)
+        self.recorder = None
+        if args.record is not None:
+            self.start_recording(args.record)
+        self.live = None
+        self.live_options = None
+        if args.foxglove is not None:
+            self.live_options = {"port": args.foxglove, "host": args.foxglove_host,
+                                 "rate": args.foxglove_rate,
+                                 "image_rate": args.foxglove_image_rate}  # fmt: skip
+
+    def start_live(self) -> None:
+        """Starts the Foxglove live view (--foxglove), once the real-time loop runs."""
+        if self.live_options is None:
+            return
+        from ..export import MissingExtra
+        from ..export.live import FoxgloveServer
+
+        try:
+            self.live = FoxgloveServer(self.world, [self.camera], drill=self.drill,
+                                       **self.live_options).start()  # fmt: skip
+        except (MissingExtra, RuntimeError) as error:
+            raise SystemExit(f"ambfplus-launch: --foxglove: {error}") from None
+        print(f"ambfplus-launch: live view on {self.live.url}: TF, force and critical "
+              f"structures at {self.live.rate:g} Hz, images at up to {self.live.image_rate:g} "
+              "Hz as rendering allows (Foxglove: open a WebSocket connection)",
+              flush=True)  # fmt: skip
+
+    def stop_live(self) -> None:
+        if self.live is not None:
+            self.live.stop()
+            self.live = None
+
+    def start_recording(self, path: Path) -> None:
+        from ..recording import Recorder
+
+        logged = [self.camera] + ([self.drill, self.binding] if self.drill is not None else [])
+        self.world.start_step_log(logged)
+        meta = {
+            "scene": self.spec,
+            "device": {
+                "name": "keyboard",
+                "kind": type(self.device).__name__,
+                "source": self.device_name,
+                "options": self.device_options,
+            },  # fmt: skip
+            "camera": self.camera.name,
+            "launcher": {"version": __version__},
+        }
+        self.recorder = Recorder(path, metadata=meta)
+        self.recorder.set_legend(self.world)
+
+    def drain(self) -> None:
+        """Hands what the steps logged to the recorder."""
+        if self.recorder is None:
+            return
+        from ..scenes import drain
+
+        drain(self.world, self.drill, self.recorder)
+
+    def reset_volumes(self) -> None:
+        with self.world.lock():
+            for volume in self.world.volumes:
+                volume.data.reset()
+
+    def reset_world(self) -> None:
+        """Volumes back to their start, the drill to its first pose, plugins reset."""
+        with self.world.lock():
+            for volume in self.world.volumes:
+                volume.data.reset()
+            if self.drill is not None:
+                self.drill.goal = self.initial_goal
+            self.world.reset_plugins()
+
+    def status(self, status: Status, fps: float) -> Status:
+        s = self.loop.stats
+        status.fps = fps
+        status.physics_hz = s["mean_rate"]
+        status.physics_p99_ms = s["p99"] * 1e3
+        status.physics_max_ms = s["max"] * 1e3
+        if self.drill is None:
+            status.mode = "no drill"
+            return status
+        status.mode = "clutch" if self.binding.clutched else self.device_name
+        status.burr_mm = self.drill.burr_diameters[self.drill.burr] * 1000
+        status.spinning = self.drill.on
+        status.drill_position = self.drill.cursor_proxies[0].round(6).tolist()
+        distances = self.drill.critical_distances
+        if distances:
+            name, distance = min(distances.items(), key=lambda kv: kv[1])
+            status.critical, status.critical_mm = name, distance * 1000
+        events = self.drill.events
+        cut = [e for e in events if e["kind"] == "critical"]
+        if cut or status.critical_mm < WARN_DISTANCE * 1000:
+            status.warning = f"WARNING! {status.critical} {status.critical_mm:.1f} mm"
+        else:
+            status.warning = ""
+        return status

@@ -1,0 +1,594 @@
+"""Reading recordings (the format is described in ``ambfplus.recording``): ``open_recording``
+checks the head and every closed part, then gives lazy, h5py-backed access across parts."""
+
+from __future__ import annotations
+
+import bisect
+import json
+from collections import OrderedDict
+from collections.abc import Sequence
+from contextlib import contextmanager
+from dataclasses import dataclass
+from functools import cached_property
+from pathlib import Path
+
+import h5py
+import hdf5plugin  # noqa: F401 (registers the Blosc filter recordings use)
+import numpy as np
+
+from ..stereo import StereoFrame
+from .hdf5 import (
+    CheckedFile,
+    check_dataset_type,
+    open_checked,
+    read_attribute,
+    read_attributes,
+    text_value,
+)
+from .schema import (
+    EVENT_COLUMNS,
+    FORMAT,
+    FRAME_COLUMNS,
+    IMAGE_PASSES,
+    MINOR_VERSION_ATTR,
+    REMOVED_COLUMNS,
+    RIG_COLUMNS,
+    STEP_REQUIRED,
+    VERSION,
+    VERSION_ATTR,
+    GroupSummary,
+    PartSummary,
+    RecordingError,
+    find_parts,
+    legend_from_json,
+    part_name,
+)
+
+# Parts kept open at once while reading (a long session has many).
+MAX_OPEN_PARTS = 32
+
+
+def open_recording(path) -> Recording:
+    """Opens a recording by its head file (``name.h5``; its parts sit beside it)."""
+    return Recording(path)
+
+
+@dataclass
+class RecordedFrame:
+    """One recorded camera frame; image passes that were not recorded are None."""
+
+    stream: str
+    index: int
+    camera: str
+    time: float
+    step: int
+    intrinsics: np.ndarray
+    pose: np.ndarray
+    rgb: np.ndarray | None = None
+    depth: np.ndarray | None = None
+    instance: np.ndarray | None = None
+    label: np.ndarray | None = None
+    voxel: np.ndarray | None = None
+    points: np.ndarray | None = None
+    segmentation: np.ndarray | None = None
+
+    @property
+    def height(self) -> int:
+        return self._any_image().shape[0]
+
+    @property
+    def width(self) -> int:
+        return self._any_image().shape[1]
+
+    def _any_image(self) -> np.ndarray:
+        return next(getattr(self, n) for n in IMAGE_PASSES if getattr(self, n) is not None)
+
+    def __repr__(self) -> str:
+        passes = [n for n in IMAGE_PASSES if getattr(self, n) is not None]
+        return (
+            f"RecordedFrame({self.stream}[{self.index}], camera={self.camera}, "
+            f"time={self.time}, step={self.step}, {self.width}x{self.height}, passes={passes})"
+        )
+
+
+# What h5py raises where a file is damaged: HDF5's errors surface as any of these, depending on
+# where the damage is met (metadata, chunk index, attributes, data).
+DAMAGE = (OSError, RuntimeError, KeyError, ValueError, TypeError, AttributeError, IndexError)
+
+
+@contextmanager
+def _damage_is_an_error(path, what: str):
+    """Turns what h5py raises for a damaged file into a RecordingError naming the file."""
+    try:
+        yield
+    except RecordingError:
+        raise
+    except DAMAGE as error:
+        raise RecordingError(
+            f"{path}: damaged file: {what} failed ({type(error).__name__}: {error})"
+        ) from error
+
+
+class Recording:
+    """A recording opened for reading: ``cameras``, ``rigs``, ``steps``, ``removed``,
+    ``events``, ``metadata``, ``legend``, ``version`` (and ``minor_version``: 0 for format
+    1.0, 1 for 1.1). Arrays are read when indexed."""
+
+    def __init__(self, path) -> None:
+        self.path = Path(path)
+        with _damage_is_an_error(self.path, "reading the recording's structure"):
+            self._open()
+
+    def _open(self) -> None:
+        head = _read_head(self.path)
+        self.version: int = head["version"]
+        self.minor_version: int = head["minor_version"]
+        self.recording_id: str = head["recording_id"]
+        self.created: str = head["created"]
+        self.software_version: str = head["software_version"]
+        self.complete: bool = head["complete"]
+        self.metadata: dict = head["metadata"]
+        self.legend: dict = head["legend"]
+        self.conventions: dict = head["conventions"]
+        # The texts as stored, which repair() writes back unchanged.
+        self.metadata_text: str = head["metadata_text"]
+        self.legend_text: str = head["legend_text"]
+        self.part_summaries = scan_parts(self.path, self.recording_id)
+        if self.complete:
+            _check_index(self.path, head["parts"], self.part_summaries)
+        self._files = _PartFiles([p.path for p in self.part_summaries])
+        self._groups = _concatenate_groups(self.path, self.part_summaries)
+        _check_layout(self.part_summaries, self._groups)
+        self.cameras: dict[str, CameraStream] = {
+            name.split("/", 1)[1]: CameraStream(self._columns(name), attrs)
+            for name, (_, attrs) in self._groups.items()
+            if name.startswith("cameras/")
+        }
+        self.rigs: dict[str, RigStream] = {
+            name.split("/", 1)[1]: RigStream(
+                name.split("/", 1)[1], self._columns(name), attrs, self
+            )
+            for name, (_, attrs) in self._groups.items()
+            if name.startswith("rigs/")
+        }
+
+    @property
+    def parts(self) -> list[Path]:
+        return [p.path for p in self.part_summaries]
+
+    def _columns(self, group: str) -> dict[str, Column]:
+        pieces, _ = self._groups[group]
+        datasets = next(g for _, g in pieces).datasets
+        return {
+            name: Column(self._files, group, name, dtype, trailing, pieces)
+            for name, (dtype, trailing) in datasets.items()
+        }
+
+    @cached_property
+    def steps(self) -> dict[str, np.ndarray]:
+        """Columns at the physics rate (``step``, ``time`` and the producer's), read whole."""
+        if "steps" not in self._groups:
+            return {}
+        return {name: column[:] for name, column in self._columns("steps").items()}
+
+    @cached_property
+    def removed(self) -> dict:
+        """Removed voxels: ``step`` (M,), ``voxel`` (M, 3), ``label`` (M,) and ``volume``."""
+        if "removed" not in self._groups:
+            out = {n: np.empty((0,) + t, d) for n, (d, t) in REMOVED_COLUMNS.items()}
+            return {**out, "volume": None}
+        columns = {name: column[:] for name, column in self._columns("removed").items()}
+        return {**columns, "volume": self._groups["removed"][1].get("volume")}
+
+    @cached_property
+    def events(self) -> list[dict]:
+        """Events as dicts: ``step``, ``kind``, ``label``, ``voxel`` (i, j, k)."""
+        if "events" not in self._groups:
+            return []
+        c = {name: column[:] for name, column in self._columns("events").items()}
+        with _damage_is_an_error(self.path, "reading events"):
+            return [
+                {
+                    "step": int(c["step"][i]),
+                    "kind": str(c["kind"][i]),
+                    "label": int(c["label"][i]),
+                    "voxel": tuple(int(v) for v in c["voxel"][i]),
+                }
+                for i in range(len(c["step"]))
+            ]
+
+    def close(self) -> None:
+        self._files.close()
+
+    def __enter__(self) -> Recording:
+        return self
+
+    def __exit__(self, *exc_info) -> None:
+        self.close()
+
+    def rows(self, group: str) -> int:
+        """Rows of a group (``cameras/left``, ``steps``, ...) across parts, 0 if absent."""
+        pieces, _ = self._groups.get(group, ([], {}))
+        return sum(summary.rows for _, summary in pieces)
+
+    def __repr__(self) -> str:
+        cameras = ", ".join(f"{n}: {len(s)}" for n, s in self.cameras.items())
+        return (
+            f"<Recording {self.path} v{self.version}.{self.minor_version}, {len(self.parts)} "
+            f"parts, cameras "
+            f"{{{cameras}}}, rigs {list(self.rigs)}, {self.rows('steps')} steps, "
+            f"{self.rows('removed')} removed voxels, {self.rows('events')} events"
+            f"{'' if self.complete else ', not closed (interrupted)'}>"
+        )
+
+
+class Column(Sequence):
+    """One dataset read lazily across parts: ``len``, ``shape``, indexing by int, slice or a
+    list of ints, ``np.asarray``."""
+
+    def __init__(self, files, group, name, dtype, trailing, pieces) -> None:
+        self._files = files
+        self.path = f"{group}/{name}"
+        self.is_text = np.dtype(dtype).kind == "O"
+        self.dtype = np.dtype(object) if self.is_text else np.dtype(dtype)
+        self._trailing = tuple(trailing)
+        self._parts = [part_index for part_index, _ in pieces]
+        self._starts = [0]
+        for _, group_summary in pieces:
+            self._starts.append(self._starts[-1] + group_summary.rows)
+
+    def __len__(self) -> int:
+        return self._starts[-1]
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        return (len(self),) + self._trailing
+
+    def __getitem__(self, key):
+        if isinstance(key, tuple):
+            return self[key[0]][key[1:]]
+        if isinstance(key, slice):
+            start, stop, stride = key.indices(len(self))
+            if stride == 1:
+                return self._read_range(start, max(start, stop))
+            return self._read_rows(range(start, stop, stride))
+        if isinstance(key, (int, np.integer)):
+            return self._read_row(self._normalise(int(key)))
+        return self._read_rows([self._normalise(int(i)) for i in np.asarray(key).ravel()])
+
+    def __array__(self, dtype=None, copy=None):
+        array = self[:]
+        return array if dtype is None else array.astype(dtype)
+
+    def _normalise(self, index: int) -> int:
+        if not -len(self) <= index < len(self):
+            raise IndexError(f"{self.path}: index {index} out of range for {len(self)} rows")
+        return index % len(self)
+
+    def _dataset(self, piece: int):
+        dataset = self._files.get(self._parts[piece])[self.path]
+        return dataset.asstr() if self.is_text else dataset
+
+    def _read_row(self, index: int):
+        piece = bisect.bisect_right(self._starts, index) - 1
+        with _damage_is_an_error(self._files.path(self._parts[piece]), f"reading {self.path}"):
+            return self._dataset(piece)[index - self._starts[piece]]
+
+    def _read_rows(self, indices) -> np.ndarray:
+        rows = [self._read_row(i) for i in indices]
+        return np.array(rows, dtype=self.dtype) if rows else self._empty()
+
+    def _read_range(self, start: int, stop: int) -> np.ndarray:
+        chunks = []
+        for piece in range(len(self._parts)):
+            lo, hi = max(start, self._starts[piece]), min(stop, self._starts[piece + 1])
+            if lo < hi:
+                offset = self._starts[piece]
+                part = self._files.path(self._parts[piece])
+                with _damage_is_an_error(part, f"reading {self.path}"):
+                    chunks.append(np.asarray(self._dataset(piece)[lo - offset : hi - offset]))
+        return np.concatenate(chunks) if chunks else self._empty()
+
+    def _empty(self) -> np.ndarray:
+        return np.empty((0,) + self._trailing, dtype=self.dtype)
+
+
+class CameraStream(Sequence):
+    """One camera stream: ``len``, ``stream[i]`` -> RecordedFrame, and lazy columns ``rgb``,
+    ``depth``, ``instance``, ``label``, ``voxel``, ``points`` (None when not recorded),
+    ``time``, ``step``, ``intrinsics``, ``pose``."""
+
+    def __init__(self, columns: dict[str, Column], attrs: dict) -> None:
+        self.columns = columns
+        self.name = next(iter(columns.values())).path.split("/")[1]
+        self.camera = attrs.get("camera", self.name)
+        self.passes = [name for name in IMAGE_PASSES if name in columns]
+
+    def __len__(self) -> int:
+        return len(self.columns["time"])
+
+    def __getitem__(self, index):
+        if isinstance(index, slice):
+            return [self[i] for i in range(*index.indices(len(self)))]
+        index = self.columns["time"]._normalise(int(index))
+        images = {name: self.columns[name][index] for name in self.passes}
+        return RecordedFrame(
+            stream=self.name,
+            index=index,
+            camera=self.camera,
+            time=float(self.columns["time"][index]),
+            step=int(self.columns["step"][index]),
+            intrinsics=self.columns["intrinsics"][index],
+            pose=self.columns["pose"][index],
+            **images,
+        )
+
+    def __getattr__(self, name: str):
+        if name in IMAGE_PASSES:
+            return self.columns.get(name)
+        if name in ("time", "step", "intrinsics", "pose"):
+            return self.columns[name]
+        raise AttributeError(name)
+
+    def __repr__(self) -> str:
+        return f"<CameraStream {self.name} ({self.camera}): {len(self)} frames, {self.passes}>"
+
+
+class RigStream(Sequence):
+    """A stereo rig's pairs: ``rig[i]`` -> ``ambfplus.stereo.StereoFrame`` of RecordedFrames;
+    columns ``baseline``, ``dcx``, ``time``, ``step``, ``left_index``, ``right_index``."""
+
+    def __init__(self, name: str, columns: dict[str, Column], attrs: dict, recording) -> None:
+        self.name = name
+        self.columns = columns
+        self._path = recording.path
+        try:
+            self.left = recording.cameras[attrs["left"]]
+            self.right = recording.cameras[attrs["right"]]
+        except KeyError as missing:
+            raise RecordingError(
+                f"{recording.path}: rigs/{name} names stream {missing}, which is not recorded"
+            ) from None
+
+    def __len__(self) -> int:
+        return len(self.columns["baseline"])
+
+    def __getitem__(self, index):
+        index = self.columns["baseline"]._normalise(int(index))
+        return StereoFrame(
+            left=self._view(self.left, "left_index", index),
+            right=self._view(self.right, "right_index", index),
+            baseline=float(self.columns["baseline"][index]),
+            dcx=float(self.columns["dcx"][index]),
+        )
+
+    def _view(self, stream: CameraStream, column: str, index: int) -> RecordedFrame:
+        row = int(self.columns[column][index])
+        if not 0 <= row < len(stream):
+            raise RecordingError(
+                f"{self._path}: rigs/{self.name}/{column}[{index}] is {row}, but stream "
+                f"{stream.name} has {len(stream)} frames"
+            )
+        return stream[row]
+
+    def __getattr__(self, name: str):
+        if name in ("columns", "left", "right", "name"):
+            raise AttributeError(name)
+        try:
+            return self.columns[name]
+        except KeyError:
+            raise AttributeError(name) from None
+
+
+class _PartFiles:
+    """Part files opened on demand, the least recently used closed beyond MAX_OPEN_PARTS."""
+
+    def __init__(self, paths: list[Path]) -> None:
+        self._paths = paths
+        self._open: OrderedDict[int, CheckedFile] = OrderedDict()
+
+    def path(self, index: int) -> Path:
+        return self._paths[index]
+
+    def get(self, index: int) -> h5py.File:
+        f = self._open.get(index)
+        if f is None:
+            f = self._open[index] = open_checked(self._paths[index])
+            if len(self._open) > MAX_OPEN_PARTS:
+                self._open.popitem(last=False)[1].close()
+        self._open.move_to_end(index)
+        return f.file
+
+    def close(self) -> None:
+        while self._open:
+            self._open.popitem()[1].close()
+
+
+def _read_head(path: Path) -> dict:
+    """The head's attributes, checked: format, version, JSON metadata and legend."""
+    checked = open_checked(path, heaps="always")
+    with checked.file as f:
+        attrs = read_attributes(checked, f)
+        found = text_value(attrs.get("format"))
+        if found != FORMAT:
+            raise RecordingError(
+                f"{path}: not an ambfplus recording (root attribute 'format' is {found!r}, "
+                f"expected '{FORMAT}')"
+            )
+        if "part" in attrs:
+            raise RecordingError(
+                f"{path}: this is one part of a recording; open its head file instead"
+            )
+        version = read_attribute(checked, f, VERSION_ATTR, expect="integer")
+        if version is None or int(version) != VERSION:
+            version = version.item() if isinstance(version, np.generic) else version
+            raise RecordingError(
+                f"{path}: recording version {version!r} (attribute '{VERSION_ATTR}') is not "
+                f"supported; this ambfplus reads version {VERSION}"
+            )
+        try:
+            metadata = text_value(attrs.get("metadata")) or "{}"
+            legend = text_value(attrs.get("legend")) or "{}"
+            return {
+                "version": int(version),
+                "minor_version": int(attrs.get(MINOR_VERSION_ATTR, 0)),
+                "recording_id": text_value(attrs["recording_id"]),
+                "created": text_value(attrs.get("created")),
+                "software_version": text_value(attrs.get("software_version")),
+                "complete": bool(attrs.get("complete", False)),
+                "metadata": json.loads(metadata),
+                "metadata_text": metadata,
+                "legend": legend_from_json(legend),
+                "legend_text": legend,
+                "parts": json.loads(text_value(attrs.get("parts")) or "[]"),
+                "conventions": {
+                    k: text_value(v) for k, v in read_attributes(checked, f["conventions"]).items()
+                }
+                if "conventions" in f
+                else {},
+            }
+        except (KeyError, ValueError) as error:
+            raise RecordingError(
+                f"{path}: a root attribute is missing or invalid: {error}"
+            ) from None
+
+
+def scan_parts(head: Path, recording_id: str) -> list[PartSummary]:
+    """Every closed part on disk, checked: numbered 1..n without gaps, of this recording, each
+    group's datasets of equal length."""
+    summaries = []
+    for expected, (number, path) in enumerate(find_parts(head), start=1):
+        if number != expected:
+            raise RecordingError(
+                f"{part_name(head, expected)}: missing, but later parts exist: the recording "
+                "lost data"
+            )
+        summaries.append(_summarise_part(path, recording_id, number))
+    return summaries
+
+
+def _summarise_part(path: Path, recording_id: str, number: int) -> PartSummary:
+    checked = open_checked(path)
+    with checked.file as f:
+        found_id = text_value(read_attribute(checked, f, "recording_id"))
+        found_number = read_attribute(checked, f, "part", expect="integer")
+        if found_id != recording_id or found_number != number:
+            raise RecordingError(
+                f"{path}: not part {number} of recording {recording_id} (attributes "
+                f"'recording_id', 'part' say {found_id}, {found_number})"
+            )
+        summary = PartSummary(path)
+        f.visititems(lambda name, obj: _summarise_group(checked, summary, name, obj))
+        return summary
+
+
+def _summarise_group(checked: CheckedFile, summary: PartSummary, name: str, obj) -> None:
+    if not isinstance(obj, h5py.Dataset):
+        return
+    path = checked.path
+    check_dataset_type(checked, name, obj)
+    group, column = name.rsplit("/", 1) if "/" in name else ("", name)
+    entry = summary.groups.get(group)
+    if entry is None:
+        attrs = {k: text_value(v) for k, v in read_attributes(checked, obj.parent).items()}
+        entry = summary.groups[group] = GroupSummary(obj.shape[0] if obj.shape else 0, {}, attrs)
+    if not obj.shape or obj.shape[0] != entry.rows:
+        other = next(iter(entry.datasets), None)
+        raise RecordingError(
+            f"{path}: inconsistent lengths: dataset {name} has shape {obj.shape}, but "
+            f"{group}/{other} has {entry.rows} rows"
+        )
+    string = h5py.check_string_dtype(obj.dtype)
+    if string:
+        entry.strings[column] = (string.encoding, string.length)
+    entry.datasets[column] = (np.dtype(object) if string else obj.dtype, obj.shape[1:])
+
+
+def _concatenate_groups(head: Path, parts: list[PartSummary]) -> dict:
+    """group -> ([(part index, GroupSummary), ...], attrs), checking that a group has the same
+    datasets in every part."""
+    groups: dict[str, tuple[list, dict]] = {}
+    for index, part in enumerate(parts):
+        for name, group in part.groups.items():
+            pieces, attrs = groups.setdefault(name, ([], group.attrs))
+            if pieces and pieces[0][1].datasets != group.datasets:
+                first = parts[pieces[0][0]].path
+                raise RecordingError(
+                    f"{part.path}: group {name} holds {_describe(group.datasets)}, but in "
+                    f"{first} it holds {_describe(pieces[0][1].datasets)}"
+                )
+            pieces.append((index, group))
+    return groups
+
+
+# Columns every group of a kind must have: name -> (dtype, trailing shape); None = text.
+_REQUIRED = {
+    "cameras/": FRAME_COLUMNS,
+    "rigs/": RIG_COLUMNS,
+    "removed": REMOVED_COLUMNS,
+    "events": EVENT_COLUMNS,
+    "steps": {name: (dtype, ()) for name, dtype in STEP_REQUIRED.items()},
+}
+
+
+def _check_layout(parts: list[PartSummary], groups: dict) -> None:
+    """Every group has its kind's columns with their types and shapes, and a camera stream at
+    least one image pass of its type (else a damaged file fails later, outside the reader)."""
+    for name, (pieces, _) in groups.items():
+        kind = name.split("/", 1)[0] + "/" if "/" in name else name
+        if kind not in _REQUIRED:
+            continue
+        path, datasets = parts[pieces[0][0]].path, pieces[0][1].datasets
+        expected = dict(_REQUIRED[kind])
+        if kind == "cameras/":
+            if not any(p in datasets for p in IMAGE_PASSES):
+                raise RecordingError(f"{path}: {name} holds no image pass of {list(IMAGE_PASSES)}")
+            expected.update({p: (d, (None, None) + t) for p, (d, t) in IMAGE_PASSES.items()})
+        for column, (dtype, trailing) in expected.items():
+            found = datasets.get(column)
+            if found is None and (kind != "cameras/" or column not in IMAGE_PASSES):
+                raise RecordingError(f"{path}: {name} has no dataset '{column}'")
+            if found is not None and not _same_layout(found, dtype, trailing):
+                want = "text" if dtype is None else f"{dtype} {_shape_text(trailing)}"
+                raise RecordingError(
+                    f"{path}: {name}/{column} is {found[0]} {tuple(found[1])} per row, "
+                    f"expected {want}"
+                )
+
+
+def _same_layout(found: tuple, dtype, trailing: tuple) -> bool:
+    """A dataset's (dtype, shape of a row) against the layout's (None in a shape: any size,
+    None as dtype: text). Byte order does not matter."""
+    found_dtype, found_trailing = np.dtype(found[0]), tuple(found[1])
+    if dtype is None:
+        return found_dtype.kind == "O" and found_trailing == tuple(trailing)
+    dtype = np.dtype(dtype)
+    if (found_dtype.kind, found_dtype.itemsize) != (dtype.kind, dtype.itemsize):
+        return False
+    return len(found_trailing) == len(trailing) and all(
+        want is None or want == got for want, got in zip(trailing, found_trailing)
+    )
+
+
+def _shape_text(trailing: tuple) -> str:
+    names = iter("HW")
+    return "(" + ", ".join(next(names) if n is None else str(n) for n in trailing) + ")"
+
+
+def _describe(datasets: dict) -> str:
+    return ", ".join(f"{n} {d} {tuple(t)}" for n, (d, t) in sorted(datasets.items()))
+
+
+def _check_index(head: Path, listed: list[str], parts: list[PartSummary]) -> None:
+    """A closed recording lists its parts: every one must be there, and no other."""
+    found = [p.path.name for p in parts]
+    if found != listed:
+        missing = sorted(set(listed) - set(found))
+        extra = sorted(set(found) - set(listed))
+        raise RecordingError(
+            f"{head}: the head lists {len(listed)} parts but {len(found)} are on disk "
+            f"(missing: {missing or 'none'}; not listed: {extra or 'none'})"
+        )
+
+
+__all__ = ["CameraStream", "Column", "RecordedFrame", "Recording", "RigStream", "open_recording"]

@@ -1,0 +1,121 @@
+"""The interactive launcher under a virtual display (Xvfb): it opens the original drilling scene
+in a window, keys sent with xdotool move the drill by the documented steps, a screenshot of the
+X server shows what the camera renders, and a recorded session replays to the same removal."""
+
+from __future__ import annotations
+
+import json
+import time
+
+import numpy as np
+import pytest
+from helpers.x11 import finish, launch, screenshot, window_origin, xdo
+
+import ambfplus
+
+WIDTH, HEIGHT = 1536, 540
+
+
+@pytest.mark.slow
+def test_keys_move_the_drill_and_the_window_shows_the_scene(fixtures, display, tmp_path):
+    launch_file = fixtures / "volumetric_drilling" / "launch.yaml"
+    process, status_file, window = launch(display, tmp_path, launch_file, 12)
+    # Two steps into the view, one up; the burr spins; the next burr.
+    xdo(display, "key", "--delay", "250", "ctrl+i", "ctrl+i", "ctrl+w", "space", "c")
+    time.sleep(2.0)
+    status = json.loads(status_file.read_text())
+    screen = screenshot(display)
+    left, top = window_origin(display, window)
+    finish(process)
+
+    # The fixture's drill starts at (-0.2, 0, 0); main_camera at the origin looks along -x with
+    # z up: 2 mm into the view is -x, 1 mm up is +z.
+    np.testing.assert_allclose(status["drill_position"], [-0.202, 0.0, 0.001], atol=1e-6)
+    assert status["spinning"] and status["burr_mm"] == 1.0
+    assert status["mode"] == "keyboard" and status["physics_hz"] > 900
+    assert status["critical"] and np.isfinite(status["critical_mm"])  # named by labels.csv
+
+    # The screenshot is what the camera renders for that drill (the 1 mm burr's mesh, moved).
+    shot = screen[top : top + HEIGHT, left : left + WIDTH]
+    sim = ambfplus.Simulator.from_launch(
+        launch_file, models=[0, 2], arguments=["--labels", str(launch_file.parent / "labels.csv")]
+    )
+    drill, main = sim.get("drill"), sim.get("main_camera")
+    # The window shows main_camera's view at the window's size.
+    camera = sim.world.add_camera("view", WIDTH, HEIGHT, fov_y=main.fov_y, near=main.near,
+                                  far=main.far)  # fmt: skip
+    camera.pose = main.pose
+    goal = drill.goal.copy()
+    goal[:3, 3] = status["drill_position"]
+    drill.goal, drill.burr = goal, 0
+    sim.step(2)
+    frame = camera.capture(passes=["rgb", "instance"])
+    body = frame.instance == sim.get("1mm").id
+    bone = frame.instance == sim.world.volumes[0].id
+    assert body.sum() > 200 and bone.sum() > 10000
+    below_status = np.zeros(body.shape, bool)
+    below_status[60:] = True  # the status line covers the top rows
+    difference = np.abs(shot.astype(int) - frame.rgb.astype(int)).max(axis=2)
+    assert np.median(difference[bone & below_status]) <= 2
+    assert np.median(difference[body & below_status]) <= 2
+    assert shot[bone].mean() > 60, "the anatomy is lit, not black"
+
+
+@pytest.mark.slow
+def test_a_recorded_interactive_session_replays_to_the_same_removal(fixtures, display, tmp_path):
+    from ambfplus.scenes import replay
+
+    launch_file = fixtures / "volumetric_drilling" / "launch.yaml"
+    record = tmp_path / "session.h5"
+    process, status_file, _ = launch(display, tmp_path, launch_file, 14, "--record", str(record))
+    # The burr touches the ear about 76 mm in front of it: spin it and push 9 mm further.
+    xdo(display, "key", "space")
+    xdo(display, "key", "--delay", "20", "--repeat", "85", "ctrl+i")
+    time.sleep(3.0)
+    finish(process)
+    status = json.loads(status_file.read_text())
+    assert status["spinning"]
+
+    report = replay(record, compare_images=False)
+    assert report.voxels_removed > 100, "the session drilled"
+    assert report.removal_identical and report.forces_identical, report.differences
+
+
+def test_mouse_navigation_turns_about_the_target_pans_and_zooms():
+    from ambfplus.launcher.navigation import MOUSE_LEFT, MOUSE_RIGHT, Orbit
+
+    world = ambfplus.World()
+    camera = world.add_camera("cam", 64, 48, fov_y=0.8, near=0.01, far=5.0)
+    target = np.array([0.1, -0.2, 0.05])
+    camera.look_at(target + (0.3, -0.4, 0.2), target)
+    orbit = Orbit(target=target.copy())
+    distance = np.linalg.norm(camera.pose[:3, 3] - target)
+
+    def pixel_of(point):
+        p = np.linalg.inv(camera.pose) @ np.append(point, 1.0)
+        uv = camera.intrinsics @ (p[:3] / p[2])
+        return uv[:2]
+
+    # A turn: the eye stays at its distance and the target at the image's centre.
+    before = camera.pose.copy()
+    turn = orbit.drag(camera.pose, 40.0, -25.0, MOUSE_LEFT)["look_at"]
+    camera.look_at(*turn)
+    assert np.linalg.norm(camera.pose[:3, 3] - target) == pytest.approx(distance, rel=1e-12)
+    np.testing.assert_allclose(pixel_of(target), (32.0, 24.0), atol=1e-9)
+    assert np.linalg.norm(camera.pose[:3, 3] - before[:3, 3]) > 0.05
+    # A pan: the orientation stays, the eye and the target move by the same vector in the image
+    # plane.
+    before = camera.pose.copy()
+    pan = orbit.drag(camera.pose, 10.0, 5.0, MOUSE_RIGHT)["pose"]
+    np.testing.assert_array_equal(pan[:3, :3], before[:3, :3])
+    shift = pan[:3, 3] - before[:3, 3]
+    np.testing.assert_allclose(orbit.target - target, shift, atol=1e-15)
+    assert abs(shift @ before[:3, 2]) < 1e-12 and np.linalg.norm(shift) > 0
+    camera.pose = pan
+    np.testing.assert_allclose(pixel_of(orbit.target), (32.0, 24.0), atol=1e-9)
+    # Two wheel steps towards the target: (1 - zoom)^2 of the distance, same orientation.
+    zoomed = orbit.scroll(camera.pose, 2.0)
+    np.testing.assert_allclose(
+        np.linalg.norm(zoomed[:3, 3] - orbit.target), distance * (1 - orbit.zoom) ** 2, rtol=1e-12
+    )
+    np.testing.assert_array_equal(zoomed[:3, :3], camera.pose[:3, :3])

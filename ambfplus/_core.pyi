@@ -2482,7 +2482,7 @@ class PluginInfo:
         """
 def _register_plugin_support(arg0: typing.Any, arg1: typing.Any, arg2: typing.Any) -> None:
     """
-    Called once by ambfplus.plugins: the Plugin base class and the functions making Python plugins from a file and from an entry-point name.
+    Called once by ambfplus.plugin: the Plugin base class and the functions making Python plugins from a file and from an entry-point name.
     """
 def capture_passes() -> list:
     """

@@ -27,7 +27,7 @@ struct PythonSite {
   PluginInstance* plugin = nullptr;
 };
 
-// What the Python package gives the engine when it is imported (ambfplus.plugins): the
+// What the Python package gives the engine when it is imported (ambfplus.plugin): the
 // Plugin base class and the functions making plugins from files and entry-point names. The
 // extension never imports the package back.
 struct PythonSupport {
@@ -191,7 +191,7 @@ PluginInstance& live(const PythonSite& s, bool for_handles = true) {
   return *s.plugin;
 }
 
-// A plugin made by Python code (the ambfplus.plugins module's loaders), or null for None.
+// A plugin made by Python code (the ambfplus.plugin package's loaders), or null for None.
 std::shared_ptr<PluginInstance> from_python(bool entry_point, const std::string& argument) {
   if (!Py_IsInitialized()) throw PluginError("Python plugins need a running interpreter");
   py::gil_scoped_acquire gil;
@@ -345,7 +345,7 @@ void register_plugin(py::module_& m) {
       [](py::object base, py::object from_file, py::object from_entry_point) {
         support() = {std::move(base), std::move(from_file), std::move(from_entry_point)};
       },
-      "Called once by ambfplus.plugins: the Plugin base class and the functions making Python "
+      "Called once by ambfplus.plugin: the Plugin base class and the functions making Python "
       "plugins from a file and from an entry-point name.");
 
   py::class_<PythonSite>(m, "PluginSite",

@@ -15,31 +15,9 @@ import importlib
 import sys
 
 
-class _Captured(Exception):
-    def __init__(self, parser: argparse.ArgumentParser):
-        super().__init__(parser.prog)
-        self.parser = parser
-
-
-def parser_of(module_name: str, fallback: str, fallback_args: list[str]) -> argparse.ArgumentParser:
-    """The module's build_parser(); until a module has one, the first parser its `fallback`
-    function parses with (caught before it parses anything)."""
-    module = importlib.import_module(module_name)
-    if hasattr(module, "build_parser"):
-        return module.build_parser()
-    saved = argparse.ArgumentParser.parse_known_args
-
-    def capture(self, *args, **kwargs):
-        raise _Captured(self)
-
-    argparse.ArgumentParser.parse_known_args = capture
-    try:
-        getattr(module, fallback)(fallback_args)
-    except _Captured as captured:
-        return captured.parser
-    finally:
-        argparse.ArgumentParser.parse_known_args = saved
-    raise RuntimeError(f"{module_name}.{fallback} parsed no arguments")
+def parser_of(module_name: str) -> argparse.ArgumentParser:
+    """The command line of a module, from its build_parser()."""
+    return importlib.import_module(module_name).build_parser()
 
 
 def _cell(text: str) -> str:
@@ -101,8 +79,8 @@ def render_parser(parser: argparse.ArgumentParser, level: int, out: list[str]) -
 
 def render() -> str:
     out: list[str] = []
-    render_parser(parser_of("ambfplus.cli", "main", ["--help"]), 2, out)
-    render_parser(parser_of("ambfplus.launcher", "parse_args", []), 2, out)
+    render_parser(parser_of("ambfplus.cli"), 2, out)
+    render_parser(parser_of("ambfplus.launcher"), 2, out)
     return "\n".join(out) + "\n"
 
 

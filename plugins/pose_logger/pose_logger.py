@@ -36,7 +36,7 @@ class PoseLogger(ambfplus.Plugin):
 
     def bodies(self) -> list:
         # Handles are looked up each time, never kept: a kept handle would keep the simulator
-        # alive (see ambfplus.plugins).
+        # alive (see ambfplus.plugin).
         if self.object is not None:
             return [self.object] if self.object.kind == "body" else []
         objects = self.model.objects if self.model is not None else self.world.objects

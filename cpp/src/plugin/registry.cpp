@@ -231,8 +231,7 @@ void PluginRegistry::reset() {
 }
 
 void PluginRegistry::object_added(Object& object) {
-  each(
-      "on_object_added", [&](PluginInstance& p) { p.on_object_added(object); }, &object.model());
+  each("on_object_added", [&](PluginInstance& p) { p.on_object_added(object); }, &object.model());
 }
 
 void PluginRegistry::object_removed(Object& object) {

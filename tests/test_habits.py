@@ -18,7 +18,7 @@ def require_checkout():
 
 
 def lint_pins() -> dict[str, str]:
-    tomllib = pytest.importorskip("tomllib", reason="reads pyproject.toml with Python 3.11's tomllib")
+    tomllib = pytest.importorskip("tomllib", reason="Python 3.11 reads pyproject.toml")
     extra = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["optional-dependencies"]
     pins = dict(requirement.split("==") for requirement in extra["lint"])
     assert all(pins.values()), f"every lint tool is pinned with ==: {extra['lint']}"

@@ -14,21 +14,36 @@ that points at the working distance Z0 have zero disparity and the two views ove
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any, Protocol
 
 import numpy as np
 
-from ._core import Camera, Frame, World
+from ._core import Camera, World
 from .transforms import make_pose
 
 PASSES = ("rgb", "depth", "label", "instance")
+
+
+class _View(Protocol):
+    """What a stereo pair's view offers: a live ``Frame`` or a recording's ``RecordedFrame``
+    (for typing only; a pass that was not recorded is None)."""
+
+    @property
+    def intrinsics(self) -> np.ndarray: ...
+    @property
+    def pose(self) -> np.ndarray: ...
+    @property
+    def rgb(self) -> np.ndarray | None: ...
+    @property
+    def depth(self) -> np.ndarray | None: ...
 
 
 @dataclass
 class StereoFrame:
     """A left and a right frame taken at the same simulation time, with the rig's geometry."""
 
-    left: Frame
-    right: Frame
+    left: _View  #: a live Frame or a RecordedFrame
+    right: _View
     baseline: float  #: metres, from the two cameras' poses
     dcx: float  #: cx_right - cx_left, pixels
 
@@ -103,7 +118,12 @@ class StereoRig:
     ) -> None:
         if not baseline > 0:
             raise ValueError(f"baseline must be > 0 m, got {baseline}")
-        options = {"fov_y": fov_y, "near": near, "far": far, "background": list(background)}
+        options: dict[str, Any] = {
+            "fov_y": fov_y,
+            "near": near,
+            "far": far,
+            "background": list(background),
+        }
         left = world.add_camera(f"{name}_left", width, height, **options)
         right = world.add_camera(f"{name}_right", width, height, **options)
         offset = np.eye(4)
@@ -217,6 +237,8 @@ def disparity_agreement(stereo: StereoFrame, step: int = 8, margin: int = 20) ->
     non-occluded points used, the median and 95th percentile of |measured - predicted| (px), and
     the baseline recovered from the measured disparities, B = (d + dcx) Z / f (m)."""
     left, right = stereo.left, stereo.right
+    if left.depth is None:
+        raise ValueError("disparity_agreement needs the left view's depth pass")
     height, width = left.depth.shape
     predicted = stereo.disparity()
     rows, cols = (

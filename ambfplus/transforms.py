@@ -9,7 +9,7 @@ import numpy as np
 from ._core import ArgumentError
 
 
-def rpy_matrix(rpy: Sequence[float]) -> np.ndarray:
+def rpy_matrix(rpy: Sequence[float] | np.ndarray) -> np.ndarray:
     """Rotation from fixed-axis roll, pitch, yaw (radians), as AMBF files give them.
 
     R = Rz(yaw) @ Ry(pitch) @ Rx(roll).

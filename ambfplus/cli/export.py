@@ -7,6 +7,7 @@ import argparse
 import json
 import sys
 from pathlib import Path
+from typing import Any
 
 
 def add_parser(commands) -> None:
@@ -46,7 +47,7 @@ def run(args: argparse.Namespace) -> int:
     from ..export import ExportError, MissingExtra, export
     from ..recording import RecordingError
 
-    options = {}
+    options: dict[str, Any] = {}
     if args.to in ("mcap", "rosbag2"):
         options["point_clouds"] = not args.no_points
         options["image_topics"] = args.image_topics

@@ -5,6 +5,11 @@ from __future__ import annotations
 import argparse
 import json
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from ..dataset.check import DatasetReport
+    from ..recording.validation import ValidationReport
 
 
 def add_parser(commands) -> None:
@@ -29,6 +34,7 @@ def add_parser(commands) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Checks a recording or a dataset folder; exit code 0 only when every check passes."""
+    report: DatasetReport | ValidationReport
     if args.recording.is_dir():
         from ..dataset import validate_dataset
 

@@ -348,6 +348,7 @@ class _Progress:
             self._postfix()
 
     def _postfix(self) -> None:
+        assert self.bar is not None, "called only with a bar"
         rate = self.frames / max(time.perf_counter() - self.started, 1e-9)
         self.bar.set_postfix_str(f"{rate:.1f} pairs/s, {self.retries} retries")
 

@@ -217,7 +217,9 @@ class _RgbNoise:
             noisy = rgb + rng.normal(0.0, self.sigma, rgb.shape).astype(np.float32)
             views.append(_replace_rgb(frame, np.clip(np.rint(noisy), 0, 255).astype(np.uint8)))
         self.pairs += 1
-        return StereoFrame(views[0], views[1], pair.baseline, pair.dcx)
+        # The noisy views are mappings of a frame's fields, which only the recorder reads
+        # (Recorder.add_stereo takes them), not the frames StereoFrame's fields are typed as.
+        return StereoFrame(views[0], views[1], pair.baseline, pair.dcx)  # type: ignore[arg-type]
 
 
 def _replace_rgb(frame, rgb: np.ndarray) -> dict:

@@ -6,7 +6,7 @@ an episode is tried at most ``retries + 1`` times."""
 from __future__ import annotations
 
 import shutil
-from collections.abc import Iterator
+from collections.abc import Generator
 from dataclasses import dataclass
 
 
@@ -66,7 +66,7 @@ class Executor:
         """What environment.json records of this executor."""
         return {"executor": self.name}
 
-    def run(self, spec_data: dict, out, todo: list[int], run_id: str | None = None) -> Iterator:
+    def run(self, spec_data: dict, out, todo: list[int], run_id: str | None = None) -> Generator:
         """Runs the episodes of `todo` into dataset folder `out` as run `run_id` (see
         ``episode.run_episode``), yielding events."""
         raise NotImplementedError

@@ -24,9 +24,10 @@ import threading
 import time
 import traceback
 from collections import deque
-from collections.abc import Iterator
+from collections.abc import Generator, Iterator
 from dataclasses import dataclass, field
 from multiprocessing.connection import Connection, wait
+from pathlib import Path
 
 from .executor import Done, Executor, Failed, Retry, WorkerStartError
 
@@ -121,7 +122,8 @@ class LocalExecutor(Executor):
         self._context = _worker_context()
         self._started = 0
         self._start_failures = 0  # workers in a row that died before they were ready
-        self._out, self._run_id = None, None
+        self._out: str | Path | None = None
+        self._run_id: str | None = None
 
     def describe(self) -> dict:
         return {"executor": self.name, "workers": self.workers}
@@ -140,7 +142,7 @@ class LocalExecutor(Executor):
         theirs.close()
         return _Slot(number, process, ours)
 
-    def run(self, spec_data: dict, out, todo: list[int], run_id: str | None = None) -> Iterator:
+    def run(self, spec_data: dict, out, todo: list[int], run_id: str | None = None) -> Generator:
         queue = deque((index, 0) for index in todo)
         self._out, self._run_id = out, run_id
         slots: list[_Slot] = []

@@ -16,7 +16,7 @@ import os
 import socket
 import time
 from collections import deque
-from collections.abc import Iterator
+from collections.abc import Generator
 from pathlib import Path
 from typing import Any
 
@@ -140,7 +140,7 @@ class RayExecutor(Executor):
             "task_gpus": self.gpus,
         }
 
-    def run(self, spec_data: dict, out, todo: list[int], run_id: str | None = None) -> Iterator:
+    def run(self, spec_data: dict, out, todo: list[int], run_id: str | None = None) -> Generator:
         ray = self._ray
         # A worker runs any number of these tasks in one process (one EGL context for all its
         # episodes) however the GPUs are asked for: Ray's default for a function declared with

@@ -429,7 +429,7 @@ def _appearance(value, where: _Where) -> dict:
     if "background" in value:
         out["background"] = _varying(value["background"], where.at("background"), _unit, size=3)
     shininess = (None, lambda v, w: _number(v, w, 1, 1024))
-    sections = {
+    sections: dict[str, tuple[str, dict]] = {
         "labels": ("label colours", {"color_jitter": (0.0, lambda v, w: _number(v, w, 0, 255))}),
         "material": ("the anatomy's material", {"specular": (None, _unit),
                                                 "shininess": shininess}),

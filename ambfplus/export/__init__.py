@@ -73,12 +73,13 @@ def _writer(to: str) -> Callable:
     from .original_h5 import write_original
     from .ros import write_ros
 
-    return {
+    writers: dict[str, Callable] = {
         "mcap": lambda rec, out, bar, **o: write_ros(rec, out, "mcap", bar, **o),
         "rosbag2": lambda rec, out, bar, **o: write_ros(rec, out, "rosbag2", bar, **o),
         "original-h5": write_original,
         "coco": write_coco,
-    }[to]
+    }
+    return writers[to]
 
 
 def check_format(to: str, options: dict | None = None) -> str:

@@ -355,6 +355,7 @@ class FoxgloveServer:
         return state
 
     def _critical(self, t: int, state: dict) -> dict:
+        assert self.drill is not None, "publish_state asks only with a drill"
         statuses = []
         for name, distance in sorted(state["distances"].items(), key=lambda kv: kv[1]):
             level = DIAGNOSTIC_OK

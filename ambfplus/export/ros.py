@@ -172,7 +172,7 @@ def point_cloud(time_ns: int, frame: str, columns: dict, height: int, width: int
              "rgb": ("<f4", FLOAT32), "i": ("<i4", INT32), "j": ("<i4", INT32),
              "k": ("<i4", INT32), "instance": ("<i4", INT32), "label": ("<u2", UINT16)}  # fmt: skip
     names = [n for n in kinds if n in columns]
-    dtype = np.dtype([(n, kinds[n][0]) for n in names])
+    dtype: np.dtype = np.dtype([(n, kinds[n][0]) for n in names])
     offsets = {n: dtype.fields[n][1] for n in names} if dtype.fields else {}
     packed = np.empty(height * width, dtype=dtype)
     fields = []

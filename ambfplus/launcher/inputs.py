@@ -38,7 +38,7 @@ def make_device(args: argparse.Namespace, keyboard: KeyboardDevice) -> tuple[Dev
             f"ambfplus-launch: --device is keyboard, network[:PORT] or joystick[:PATH], got "
             f"'{args.device}'"
         )
-    buttons = [] if pose is keyboard else [keyboard]
+    buttons: list[Device] = [] if pose is keyboard else [keyboard]
     if args.pedal:
         buttons.append(_joystick(args.pedal, pedal_mapping(args.pedal_map)))
         kind += " + pedal"

@@ -6,10 +6,15 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from .._core import KeyboardDevice, RealTimeLoop, Simulator, __version__
 from .inputs import make_device
 from .status import WARN_DISTANCE, Status
+
+if TYPE_CHECKING:
+    from ..export.live import FoxgloveServer
+    from ..recording import Recorder
 
 
 class LaunchSession:
@@ -76,11 +81,11 @@ class LaunchSession:
                                                        **options)  # fmt: skip
         self.initial_goal = self.drill.goal.copy() if self.drill is not None else None
         self.loop = RealTimeLoop(self.world, rate=args.phx_frequency)
-        self.recorder = None
+        self.recorder: Recorder | None = None
         if args.record is not None:
             self.start_recording(args.record)
-        self.live = None
-        self.live_options = None
+        self.live: FoxgloveServer | None = None
+        self.live_options: dict[str, Any] | None = None
         if args.foxglove is not None:
             self.live_options = {"port": args.foxglove, "host": args.foxglove_host,
                                  "rate": args.foxglove_rate,
@@ -158,6 +163,7 @@ class LaunchSession:
         if self.drill is None:
             status.mode = "no drill"
             return status
+        assert self.binding is not None, "bound whenever there is a drill"
         status.mode = "clutch" if self.binding.clutched else self.device_name
         status.burr_mm = self.drill.burr_diameters[self.drill.burr] * 1000
         status.spinning = self.drill.on

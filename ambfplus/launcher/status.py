@@ -47,7 +47,7 @@ def draw_overlay(status: Status, width: int, height: int) -> np.ndarray:
     image = Image.new("RGBA", (width, height), (0, 0, 0, 0))
     draw = ImageDraw.Draw(image)
     font = _font(16)
-    y = 8
+    y: float = 8
     for line in status.lines():
         box = draw.textbbox((10, y), line, font=font)
         draw.rectangle((box[0] - 4, box[1] - 3, box[2] + 4, box[3] + 3), fill=(0, 0, 0, 140))

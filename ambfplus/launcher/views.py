@@ -98,7 +98,11 @@ class Views:
             xr.poll_events()
             if xr.running:
                 eyes = xr.wait_frame()
-                cameras = self.xr_view.update(eyes) if eyes else []
+                cameras = []
+                if eyes:
+                    if self.xr_view is None:
+                        raise RenderError("OpenXR: the session runs without its view")
+                    cameras = self.xr_view.update(eyes)
                 frames = xr.end_frame(cameras)
                 if frames:
                     window.present(cameras, width, height, overlay, rendered=True)
@@ -125,9 +129,11 @@ class Views:
         if self.mode in ("off", "openxr"):
             return [_view_of(world, camera, width, height, name)]
         if self.mode == "hmd":
+            hmd = self.hmd
+            assert hmd is not None, "the mode stays 'hmd' only once the HMD opened"
             with world.lock():
-                view = HmdView(world, self.hmd, camera, name=name,
-                               scale=(width // 2) / self.hmd.eye_resolution[0])  # fmt: skip
+                view = HmdView(world, hmd, camera, name=name,
+                               scale=(width // 2) / hmd.eye_resolution[0])  # fmt: skip
             self._hmd_views[(width, height)] = view
             return view.cameras
         # Side by side: each eye half the window, half the IPD either side of the camera.

@@ -22,7 +22,10 @@ PRESS, RELEASE = 1, 0
 
 
 def run_window(glfw, args: argparse.Namespace, plugin_args: list[str]) -> int:
-    use_x11_display(ctypes.cast(glfw.get_x11_display(), ctypes.c_void_p).value)
+    display = ctypes.cast(glfw.get_x11_display(), ctypes.c_void_p).value
+    if display is None:
+        raise SystemExit("ambfplus-launch: GLFW has no X11 display to render on")
+    use_x11_display(display)
     session = LaunchSession(args, plugin_args)
     world, camera = session.world, session.camera
     views = Views(session, args)

@@ -20,7 +20,7 @@ import torch
 from torch.utils.data import DataLoader, Dataset, IterableDataset, get_worker_info
 
 from .. import RenderError, ScriptedDevice
-from ..recording import Recorder, open_recording
+from ..recording import Recorder, Recording, open_recording
 from ..scenes import CameraPath, DrillScript, Scene, drilling_phantom
 from .samples import OPTIONAL_PASSES, REQUIRED_PASSES, stereo_sample
 
@@ -148,6 +148,8 @@ class SimulatorStereoDataset(IterableDataset):
                     if quota is not None and produced >= quota:
                         break
                     world.step(self.capture_every)
+                    if rig is None:
+                        raise ValueError("SimulatorStereoDataset: the scene has no stereo rig")
                     rig.aim(*path(world.time))
                     pair = rig.capture(self.passes)
                     if recorder is not None:
@@ -240,8 +242,8 @@ class RecordingStereoDataset(Dataset):
         self.transform = transform
         self.lengths = [self._count(path) for path in self.paths]
         self._starts = np.cumsum([0] + self.lengths)
-        self._open: dict[int, object] = {}
-        self._pid = None
+        self._open: dict[int, Recording] = {}
+        self._pid: int | None = None
 
     def _count(self, path: Path) -> int:
         with open_recording(path) as rec:

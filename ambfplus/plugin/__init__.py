@@ -35,8 +35,9 @@ from .. import _core
 from .loader import ENTRY_POINT_GROUP, Plugin, cmake_dir, plugin_dir
 from .probe import ProbeResult, check_plugin, probe_plugin, resolve, with_probe
 
-_core.World.load_plugin = with_probe(_core.World.load_plugin)
-_core.Simulator.load_plugin = with_probe(_core.Simulator.load_plugin)
+# Deliberately replaces the bound methods with their probing wrappers.
+_core.World.load_plugin = with_probe(_core.World.load_plugin)  # type: ignore[method-assign]
+_core.Simulator.load_plugin = with_probe(_core.Simulator.load_plugin)  # type: ignore[method-assign]
 
 __all__ = [
     "ENTRY_POINT_GROUP",

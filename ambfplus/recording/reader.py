@@ -6,11 +6,12 @@ from __future__ import annotations
 import bisect
 import json
 from collections import OrderedDict
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
+from typing import Any
 
 import h5py
 import hdf5plugin  # noqa: F401 (registers the Blosc filter recordings use)
@@ -490,7 +491,9 @@ def _summarise_group(checked: CheckedFile, summary: PartSummary, name: str, obj)
     group, column = name.rsplit("/", 1) if "/" in name else ("", name)
     entry = summary.groups.get(group)
     if entry is None:
-        attrs = {k: text_value(v) for k, v in read_attributes(checked, obj.parent).items()}
+        attrs: dict[str, object] = {
+            k: text_value(v) for k, v in read_attributes(checked, obj.parent).items()
+        }
         entry = summary.groups[group] = GroupSummary(obj.shape[0] if obj.shape else 0, {}, attrs)
     if not obj.shape or obj.shape[0] != entry.rows:
         other = next(iter(entry.datasets), None)
@@ -522,7 +525,7 @@ def _concatenate_groups(head: Path, parts: list[PartSummary]) -> dict:
 
 
 # Columns every group of a kind must have: name -> (dtype, trailing shape); None = text.
-_REQUIRED = {
+_REQUIRED: dict[str, Mapping[str, tuple[Any, tuple[Any, ...]]]] = {
     "cameras/": FRAME_COLUMNS,
     "rigs/": RIG_COLUMNS,
     "removed": REMOVED_COLUMNS,

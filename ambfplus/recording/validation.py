@@ -388,7 +388,7 @@ def _removed_checks(recording: Recording) -> list[Check]:
     return checks
 
 
-def volume_shape(recording: Recording, entry: dict) -> tuple[int, int, int] | None:
+def volume_shape(recording: Recording, entry: dict) -> tuple[int, ...] | None:
     """(nx, ny, nz) from the legend's volume entry, or from metadata["volumes"][name]."""
     shape = entry.get("shape")
     if shape is None:
@@ -402,8 +402,12 @@ def _removed_visibility_check(name: str, stream: CameraStream, recording: Record
     why_not = _visibility_skip_reason(stream, recording)
     if why_not:
         return Check(title, "skip", why_not)
-    volume_id, entry = removed_volume(recording)
-    nx, ny, _ = volume_shape(recording, entry)
+    found = removed_volume(recording)
+    assert found is not None, "_visibility_skip_reason found the volume in the legend"
+    volume_id, entry = found
+    shape = volume_shape(recording, entry)
+    assert shape is not None, "_visibility_skip_reason found the volume's shape"
+    nx, ny, _ = shape
     removed = recording.removed
     order = np.argsort(removed["step"], kind="stable")
     steps = removed["step"][order]

@@ -799,6 +799,7 @@ class _PartFile:
         group = self.summary.groups.get(rows.group)
         if group is None:
             group = self.summary.groups[rows.group] = _new_group_summary(rows)
+            assert self.file is not None, "open from __init__ on"
             _set_attributes(self.file.require_group(rows.group), rows.attrs)
         is_camera = rows.group.startswith("cameras/")
         for name, data in rows.columns.items():
@@ -831,6 +832,7 @@ class _PartFile:
             data = text_column(data)
         dataset = self._datasets.get((group, name))
         if dataset is None:
+            assert self.file is not None, "open from __init__ on"
             dataset = _create(self.file[group], name, data, chunk_rows, self.compression)
         else:
             if data.dtype.kind == "S" and data.dtype.itemsize > dataset.dtype.itemsize:
@@ -847,6 +849,7 @@ class _PartFile:
         """The text dataset rewritten with wider fixed-length strings (text columns are small, and
         HDF5 reuses the space it frees while the part is open)."""
         rows, chunk_rows = dataset[()], dataset.chunks[0]
+        assert self.file is not None, "open from __init__ on"
         del self.file[group][name]
         return _create(self.file[group], name, rows.astype(dtype), chunk_rows, self.compression)
 
@@ -856,6 +859,7 @@ class _PartFile:
         for group, name in list(self._buffers):
             self._write_buffer(group, name)
         self._datasets.clear()
+        assert self.file is not None, "open from __init__ on"
         self.file.close()
         self.disk.close()
         if self.disk.error is not None:
@@ -965,7 +969,7 @@ def write_head(path: Path, head: _HeadInfo, parts: list[PartSummary], complete: 
 
 
 def _write_virtual_datasets(f: h5py.File, parts: list[PartSummary]) -> None:
-    groups: dict[str, list[tuple[PartSummary, object]]] = {}
+    groups: dict[str, list[tuple[PartSummary, GroupSummary]]] = {}
     for part in parts:
         for name, group in part.groups.items():
             groups.setdefault(name, []).append((part, group))
@@ -1006,8 +1010,8 @@ def _text_union(stored: list) -> np.dtype:
     """The string type a virtual dataset over text parts needs: as wide as the widest part,
     variable-length only over format 1.0 parts that were (repair of an old recording)."""
     encoding = stored[0][0] if stored[0] else "utf-8"
-    lengths = [entry[1] if entry else None for entry in stored]
-    if any(length is None for length in lengths):
+    lengths = [entry[1] for entry in stored if entry and entry[1] is not None]
+    if len(lengths) < len(stored):  # a part without an entry, or variable-length
         return h5py.string_dtype(encoding)
     return h5py.string_dtype(encoding, max(lengths))
 

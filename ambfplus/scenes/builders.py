@@ -5,7 +5,9 @@ from __future__ import annotations
 import json
 import math
 from collections import OrderedDict
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -83,7 +85,7 @@ def demo_scene(width: int = 640, height: int = 480, resolution: int = 192):
 
 
 # The built-in scenes' lights: a key light from above the surgeon's side and a weak fill.
-DEFAULT_LIGHTS = (
+DEFAULT_LIGHTS: tuple[dict[str, Any], ...] = (
     {"name": "key", "type": "directional", "direction": (-0.3, 0.4, -1.0), "intensity": 0.8},
     {"name": "fill", "type": "point", "position": (0.15, -0.2, 0.3), "intensity": 0.3},
 )
@@ -329,7 +331,7 @@ def launch_scene(
     return Scene(world, drill, rig, "keyboard", {}, [drill], spec)
 
 
-SCENES = {
+SCENES: dict[str, Callable[..., Scene]] = {
     "drilling_phantom": drilling_phantom,
     "drilling_scene": drilling_scene,
     "launch": launch_scene,

@@ -115,6 +115,8 @@ def record_session(
         recorder.set_legend(world)
         while world.step_index < total:
             world.step(min(capture_every, total - world.step_index))
+            if rig is None:
+                raise ValueError("record_session: the scene has no stereo rig to capture with")
             if camera_motion is not None:
                 rig.aim(*camera_motion(world.time))
             pair = rig.capture(passes)
@@ -180,10 +182,18 @@ def replay(
         steps = rec.steps
         removed = rec.removed
         rig_frames = rec.rigs.get(meta.get("rig", RIG))
-        plan = [
-            (int(rig_frames.step[i]), np.asarray(rig_frames[i].left.pose), rig_frames.baseline[i])
-            for i in range(len(rig_frames) if rig_frames is not None else 0)
-        ]
+        plan = (
+            [
+                (
+                    int(rig_frames.step[i]),
+                    np.asarray(rig_frames[i].left.pose),
+                    rig_frames.baseline[i],
+                )
+                for i in range(len(rig_frames))
+            ]
+            if rig_frames is not None
+            else []
+        )
         recorded = rig_frames if compare_images else None
         spec = {"builder": meta["scene"]["builder"], "params": dict(meta["scene"]["params"])}
         params = spec["params"]
@@ -221,6 +231,8 @@ def replay(
         try:
             for i, (step, left_pose, recorded_baseline) in enumerate(plan):
                 step_to(step)
+                if rig is None:
+                    raise ValueError("replay: the rebuilt scene has no stereo rig to capture with")
                 # Keep the recorded rig's centre; the new baseline spreads the cameras about it.
                 centre = left_pose @ make_pose((recorded_baseline / 2, 0.0, 0.0))
                 rig.pose = centre @ make_pose((-rig.baseline / 2, 0.0, 0.0))
@@ -288,14 +300,14 @@ def _stepper(world, steps: dict, reference: str | None) -> Callable[[int], None]
     camera = world[reference]
     poses = dict(zip(steps["step"].tolist(), steps[column]))
 
-    def step_to(target: int) -> None:
+    def step_with_camera(target: int) -> None:
         while world.step_index < target:
             pose = poses.get(world.step_index + 1)
             if pose is not None:
                 camera.pose = pose
             world.step(1)
 
-    return step_to
+    return step_with_camera
 
 
 def _same_images(pair, recorded, passes) -> bool:

@@ -11,8 +11,10 @@ from .trainees import (
     NOVICE,
     ProtectedField,
     ScriptedTrainee,
+    TraineeSession,
     TraineeStyle,
     TrainingRegion,
+    drill_phantom,
     expert_like,
     novice_like,
 )
@@ -26,7 +28,9 @@ __all__ = [
     "ProtectedField",
     "ScriptedTrainee",
     "TraineeStyle",
+    "TraineeSession",
     "TrainingRegion",
+    "drill_phantom",
     "expert_like",
     "novice_like",
 ]

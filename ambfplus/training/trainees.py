@@ -24,7 +24,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._core import DistanceField
+from .._core import DistanceField, ScriptedDevice
+from ..scenes import drilling_phantom
 
 
 @dataclass(frozen=True)
@@ -316,3 +317,56 @@ def expert_like(volume, drill_start, burr_radius, rng, **options) -> ScriptedTra
 def novice_like(volume, drill_start, burr_radius, rng, **options) -> ScriptedTrainee:
     """A novice-like trainee (see the module's docstring)."""
     return ScriptedTrainee(volume, drill_start, burr_radius, NOVICE, rng, **options)
+
+
+@dataclass
+class TraineeSession:
+    """What ``drill_phantom`` gives: the drill, and the session's step log and removed voxels
+    (as ``World.take_step_log`` and ``Drill.take_removed`` give them)."""
+
+    drill: object
+    steps: dict
+    removed: dict
+
+
+def drill_phantom(
+    make,
+    seed: int,
+    seconds: float,
+    protect: list[tuple[str, str, float]],
+    resolution: int = 128,
+    region: TrainingRegion | None = None,
+    field_band: float = 0.03,
+) -> TraineeSession:
+    """A scripted trainee (``make``: expert_like or novice_like) drilling the built-in phantom
+    (``scenes.drilling_phantom``) for `seconds`; `protect` lists (name, label, margin in metres),
+    whose distance fields, `field_band` deep, the trainee plans with. The step log is taken
+    every 10,000 steps, so long sessions keep little in the engine."""
+    scene = drilling_phantom(resolution=resolution)
+    world, drill = scene.world, scene.drill
+    fields = [
+        ProtectedField(name, DistanceField(drill.volume.data, label, field_band), margin)
+        for name, label, margin in protect
+    ]
+    trainee = make(
+        drill.volume,
+        drill.pose[:3, 3],
+        drill.burr_radius,
+        np.random.default_rng(seed),
+        protect=fields,
+        region=region or TrainingRegion(),
+    )
+    trainee.plan(seconds)
+    device = ScriptedDevice()
+    device.set_callback(trainee, every=10)
+    world.add_input_device(scene.device_name, device, drill, **scene.device_options)
+    world.start_step_log([drill])
+    total = int(round(seconds / world.time_step))
+    chunks = []
+    while world.step_index < total:
+        world.step(min(10000, total - world.step_index))
+        chunks.append((world.take_step_log(), drill.take_removed()))
+    world.stop_step_log()
+    steps = {k: np.concatenate([c[0][k] for c in chunks]) for k in chunks[0][0]}
+    removed = {k: np.concatenate([c[1][k] for c in chunks]) for k in chunks[0][1]}
+    return TraineeSession(drill, steps, removed)

@@ -21,15 +21,7 @@ import time
 import numpy as np
 
 import ambfplus
-from ambfplus.scenes import drilling_phantom
-from ambfplus.training import (
-    Protect,
-    ProtectedField,
-    TrainingRegion,
-    expert_like,
-    novice_like,
-    session_metrics,
-)
+from ambfplus.training import Protect, drill_phantom, expert_like, novice_like, session_metrics
 
 RESOLUTION = 128
 PROTECT = (
@@ -37,39 +29,12 @@ PROTECT = (
     Protect("sinus and dura", ("Sinus_Dura",), 0.0008),
     Protect("chorda tympani", ("Chorda_Tympani",), 0.0005),
 )
+PROTECT_LABELS = [(p.name, p.labels[0], p.margin) for p in PROTECT]
 
 
 def run_session(make, seed: int, seconds: float):
-    scene = drilling_phantom(resolution=RESOLUTION)
-    world, drill = scene.world, scene.drill
-    fields = [
-        ProtectedField(
-            p.name, ambfplus.DistanceField(drill.volume.data, p.labels[0], 0.03), p.margin
-        )
-        for p in PROTECT
-    ]
-    trainee = make(
-        drill.volume,
-        drill.pose[:3, 3],
-        drill.burr_radius,
-        np.random.default_rng(seed),
-        protect=fields,
-        region=TrainingRegion(),
-    )
-    trainee.plan(seconds)
-    device = ambfplus.ScriptedDevice()
-    device.set_callback(trainee, every=10)
-    world.add_input_device(scene.device_name, device, drill, **scene.device_options)
-    world.start_step_log([drill])
-    steps, removed = {}, []
-    total = int(round(seconds / world.time_step))
-    chunks = []
-    while world.step_index < total:
-        world.step(min(10000, total - world.step_index))
-        chunks.append((world.take_step_log(), drill.take_removed()))
-    steps = {k: np.concatenate([c[0][k] for c in chunks]) for k in chunks[0][0]}
-    removed = {k: np.concatenate([c[1][k] for c in chunks]) for k in chunks[0][1]}
-    return drill, steps, removed
+    session = drill_phantom(make, seed, seconds, PROTECT_LABELS, resolution=RESOLUTION)
+    return session.drill, session.steps, session.removed
 
 
 def measure(drill, steps, removed) -> dict:

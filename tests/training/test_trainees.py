@@ -7,15 +7,7 @@ import numpy as np
 import pytest
 
 import ambfplus
-from ambfplus.scenes import drilling_phantom
-from ambfplus.training import (
-    Protect,
-    ProtectedField,
-    TrainingRegion,
-    expert_like,
-    novice_like,
-    session_metrics,
-)
+from ambfplus.training import Protect, drill_phantom, expert_like, novice_like, session_metrics
 
 RESOLUTION = 96
 PROTECT = (
@@ -26,33 +18,13 @@ PROTECT = (
 
 
 def drill_session(make, seed: int, seconds: float = 12.0) -> dict:
-    scene = drilling_phantom(resolution=RESOLUTION)
-    world, drill = scene.world, scene.drill
-    fields = [
-        ProtectedField(
-            p.name, ambfplus.DistanceField(drill.volume.data, p.labels[0], 0.03), p.margin
-        )
-        for p in PROTECT
-    ]
-    trainee = make(
-        drill.volume,
-        drill.pose[:3, 3],
-        drill.burr_radius,
-        np.random.default_rng(seed),
-        protect=fields,
-        region=TrainingRegion(),
-    )
-    trainee.plan(seconds)
-    device = ambfplus.ScriptedDevice()
-    device.set_callback(trainee, every=10)
-    world.add_input_device(scene.device_name, device, drill, **scene.device_options)
-    world.start_step_log([drill])
-    world.step(int(round(seconds / world.time_step)))
-    steps, removed = world.take_step_log(), drill.take_removed()
+    protect = [(p.name, p.labels[0], p.margin) for p in PROTECT]
+    session = drill_phantom(make, seed, seconds, protect, resolution=RESOLUTION)
+    drill = session.drill
     return session_metrics(
         ambfplus.phantom(RESOLUTION),
-        steps,
-        removed,
+        session.steps,
+        session.removed,
         drill=drill.name,
         burr_diameters=drill.burr_diameters,
         volume_pose=drill.volume.pose,

@@ -279,16 +279,16 @@ class FoxgloveServer:
             frame = camera.capture(passes=passes, poses=True)
             t = nanoseconds(frame.time)
             frame_id = frame_name(camera.name, "camera")
+            if self._wanted("/tf"):  # first, so a client has the pose when the image comes
+                poses = frame.poses
+                transforms = [transform(t, WORLD, n, poses[n]) for n in self._posed if n in poses]
+                transforms.append(transform(t, WORLD, frame_id, frame.pose))
+                self._send("/tf", t, {"transforms": transforms})
             for pass_name, encoding in (("rgb", "rgb8"), ("depth", "32FC1")):
                 image = getattr(frame, pass_name, None)
                 if image is not None:
                     self._send(topics[pass_name], t, image_message(t, frame_id, image, encoding))
                     self.stats.images += 1
-            if self._wanted("/tf"):
-                poses = frame.poses
-                transforms = [transform(t, WORLD, n, poses[n]) for n in self._posed if n in poses]
-                transforms.append(transform(t, WORLD, frame_id, frame.pose))
-                self._send("/tf", t, {"transforms": transforms})
             sent = True
         if sent:
             self.stats.image_rounds += 1

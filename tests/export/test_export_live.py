@@ -37,8 +37,9 @@ def receive_json(connection, op: str) -> dict:
                 return message
 
 
-WANTED = ["/rig_left/image_rect_color", "/rig_left/camera_info", "/drill/wrench",
-          "/drill/critical", "/tf"]  # fmt: skip
+# /tf first: subscribed before the images, so every image's pose reaches the client before it.
+WANTED = ["/tf", "/rig_left/image_rect_color", "/rig_left/camera_info", "/drill/wrench",
+          "/drill/critical"]  # fmt: skip
 
 
 def watch(server, seconds: float) -> dict[str, list]:

@@ -22,6 +22,7 @@ ENGINE = f"{PACKAGE}._core"
 TOP_LEVEL_MODULES = {
     "__init__",
     "__main__",
+    "config",  # checked YAML configuration: the rules every YAML file is checked by
     "ambf_client",  # AMBF's Python client, for scripts written against it
     "doctor",  # what the engine finds on this machine
     "fileio",  # writing files whole

@@ -18,12 +18,25 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .._core import ConfigError
+from ..config import (
+    Where,
+    anatomy,
+    describe,
+    fixed,
+    integer,
+    keys,
+    load_yaml,
+    mapping,
+    non_negative,
+    number,
+    positive,
+    unit,
+)
 
 SCHEMA_VERSION = 1
 SCENARIO_KINDS = ("camera", "drilling", "mixed")
 LIGHT_TYPES = ("directional", "point", "spot")
 PASS_NAMES = ("rgb", "depth", "label", "instance", "voxel", "segmentation", "points")
-ANATOMY_SOURCES = ("phantom", "file")
 # The paper's camera: f = 1135 px at 480 rows.
 PAPER_FOV_Y = 2.0 * math.atan(240.0 / 1135.0)
 
@@ -100,28 +113,20 @@ def spec_hash(data: dict) -> str:
 def load_spec(source) -> DatasetSpec:
     """Reads and checks a spec: a YAML file's path, or a dict (relative paths are then taken
     from the current folder)."""
-    import yaml
-
     if isinstance(source, dict):
+        import yaml
+
         return parse_spec(source, Path.cwd(), "<spec>", yaml.safe_dump(source, sort_keys=False))
     path = Path(source)
-    if not path.is_file():
-        raise SpecError(f"{path}: no such spec file")
-    text = path.read_text()
-    try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as error:
-        mark = getattr(error, "problem_mark", None)
-        where = f" (line {mark.line + 1}, column {mark.column + 1})" if mark else ""
-        raise SpecError(f"{path}: not valid YAML{where}: {error}") from None
+    data, text = load_yaml(path, SpecError, "spec")
     return parse_spec(data, path.resolve().parent, str(path), text)
 
 
 def parse_spec(data, base: Path, source: str, text: str) -> DatasetSpec:
     """Checks a spec's parsed YAML and normalises it (see the module)."""
-    where = _Where(source)
-    _mapping(data, where, "the spec")
-    _keys(
+    where = Where(source, error=SpecError)
+    mapping(data, where, "the spec")
+    keys(
         data,
         where,
         required=("version", "episodes", "anatomies"),
@@ -135,11 +140,11 @@ def parse_spec(data, base: Path, source: str, text: str) -> DatasetSpec:
             f"version {SCHEMA_VERSION}",
         )
     out = {"version": SCHEMA_VERSION, "name": str(data.get("name", ""))}
-    out["episodes"] = _integer(data["episodes"], where.at("episodes"), minimum=1)
-    out["seed"] = _integer(data.get("seed", 0), where.at("seed"), minimum=0)
+    out["episodes"] = integer(data["episodes"], where.at("episodes"), minimum=1)
+    out["seed"] = integer(data.get("seed", 0), where.at("seed"), minimum=0)
     out["capture"] = _capture(data.get("capture", {}), where.at("capture"))
     out["anatomies"] = _weighted_list(
-        data["anatomies"], where.at("anatomies"), lambda e, w: _anatomy(e, w, base)
+        data["anatomies"], where.at("anatomies"), lambda e, w: anatomy(e, w, base, _varying)
     )
     out["scenarios"] = _weighted_list(
         data.get("scenarios", [{"kind": "camera"}]), where.at("scenarios"), _scenario
@@ -149,70 +154,14 @@ def parse_spec(data, base: Path, source: str, text: str) -> DatasetSpec:
     return DatasetSpec(out, text, source)
 
 
-class _Where:
-    """A position in the spec (file and key path) for error messages."""
-
-    def __init__(self, source: str, path: str = "") -> None:
-        self.source, self.path = source, path
-
-    def at(self, key) -> _Where:
-        if isinstance(key, int):
-            return _Where(self.source, f"{self.path}[{key}]")
-        return _Where(self.source, f"{self.path}.{key}" if self.path else str(key))
-
-    def error(self, key, message: str) -> SpecError:
-        path = self.at(key).path if key is not None else self.path
-        return SpecError(f"{self.source}: {path or 'the spec'}: {message}")
-
-
-def _mapping(value, where: _Where, what: str) -> dict:
-    if not isinstance(value, dict):
-        raise where.error(None, f"expected a mapping ({what}), got {_kind(value)}")
-    return value
-
-
-def _kind(value) -> str:
-    return "nothing" if value is None else f"{type(value).__name__} {value!r}"
-
-
-def _keys(value: dict, where: _Where, required=(), optional=()) -> None:
-    allowed = set(required) | set(optional)
-    unknown = sorted(str(k) for k in value if k not in allowed)
-    if unknown:
-        raise where.error(unknown[0], f"unknown key; expected one of {', '.join(sorted(allowed))}")
-    missing = [k for k in required if k not in value]
-    if missing:
-        raise where.error(missing[0], "missing (required)")
-
-
-def _number(value, where: _Where, minimum=None, maximum=None, integer=False, strict=False):
-    """A fixed number (bool refused) within bounds."""
-    ok = isinstance(value, int) if integer else isinstance(value, (int, float))
-    if isinstance(value, bool) or not ok or (not integer and not math.isfinite(value)):
-        raise where.error(
-            None, f"expected {'an integer' if integer else 'a number'}, got {_kind(value)}"
-        )
-    if minimum is not None and (value <= minimum if strict else value < minimum):
-        raise where.error(
-            None, f"expected a value {'>' if strict else '>='} {minimum}, got {value}"
-        )
-    if maximum is not None and value > maximum:
-        raise where.error(None, f"expected a value <= {maximum}, got {value}")
-    return value if integer else float(value)
-
-
-def _integer(value, where: _Where, minimum=None, maximum=None) -> int:
-    return _number(value, where, minimum, maximum, integer=True)
-
-
-def _varying(value, where: _Where, check: Callable, size: int | None = None, integer=False):
+def _varying(value, where: Where, check: Callable, size: int | None = None, integer=False):
     """A fixed value, {uniform: [low, high]} or {choice: [...], weights: [...]}, each value
     passed through check(value, where). `size` > 0: values are vectors of that many numbers."""
     if isinstance(value, dict) and "uniform" in value:
-        _keys(value, where, required=("uniform",), optional=("integer",))
+        keys(value, where, required=("uniform",), optional=("integer",))
         bounds = value["uniform"]
         if not isinstance(bounds, list) or len(bounds) != 2:
-            raise where.error("uniform", f"expected [low, high], got {_kind(bounds)}")
+            raise where.error("uniform", f"expected [low, high], got {describe(bounds)}")
         low, high = (
             _component_bounds(b, where.at("uniform").at(i), size, check)
             for i, b in enumerate(bounds)
@@ -223,55 +172,47 @@ def _varying(value, where: _Where, check: Callable, size: int | None = None, int
         pack = (lambda v: v[0]) if size is None else (lambda v: v)
         return {"uniform": [pack(low), pack(high)], **({"integer": True} if integer else {})}
     if isinstance(value, dict) and "choice" in value:
-        _keys(value, where, required=("choice",), optional=("weights",))
+        keys(value, where, required=("choice",), optional=("weights",))
         options = value["choice"]
         if not isinstance(options, list) or not options:
-            raise where.error("choice", f"expected a non-empty list, got {_kind(options)}")
-        checked = [_fixed(o, where.at("choice").at(i), check, size) for i, o in enumerate(options)]
+            raise where.error("choice", f"expected a non-empty list, got {describe(options)}")
+        checked = [fixed(o, where.at("choice").at(i), check, size) for i, o in enumerate(options)]
         weights = _weights(value.get("weights"), len(options), where.at("weights"))
         return {"choice": checked, "weights": weights}
     if isinstance(value, dict) or (size is None and isinstance(value, list)):
         raise where.error(
             None,
             f"expected a {'vector' if size else 'value'}, {{uniform: [low, "
-            f"high]}} or {{choice: [...]}}, got {_kind(value)}",
+            f"high]}} or {{choice: [...]}}, got {describe(value)}",
         )
-    return _fixed(value, where, check, size)
+    return fixed(value, where, check, size)
 
 
-def _fixed(value, where: _Where, check: Callable, size: int | None):
-    if size is None:
-        return check(value, where)
-    if not isinstance(value, list) or len(value) != size:
-        raise where.error(None, f"expected a list of {size} numbers, got {_kind(value)}")
-    return [check(v, where.at(i)) for i, v in enumerate(value)]
-
-
-def _component_bounds(bound, where: _Where, size: int | None, check: Callable) -> list:
+def _component_bounds(bound, where: Where, size: int | None, check: Callable) -> list:
     if size is not None and isinstance(bound, list):
-        return _fixed(bound, where, check, size)
+        return fixed(bound, where, check, size)
     value = check(bound, where)
     return [value] * (size or 1)
 
 
-def _weights(weights, count: int, where: _Where) -> list[float]:
+def _weights(weights, count: int, where: Where) -> list[float]:
     if weights is None:
         return [1.0] * count
     if not isinstance(weights, list) or len(weights) != count:
-        raise where.error(None, f"expected a list of {count} weights, got {_kind(weights)}")
-    checked = [_number(w, where.at(i), minimum=0) for i, w in enumerate(weights)]
+        raise where.error(None, f"expected a list of {count} weights, got {describe(weights)}")
+    checked = [number(w, where.at(i), minimum=0) for i, w in enumerate(weights)]
     if sum(checked) <= 0:
         raise where.error(None, "the weights add up to 0")
     return checked
 
 
-def _weighted_list(value, where: _Where, entry: Callable) -> list[dict]:
+def _weighted_list(value, where: Where, entry: Callable) -> list[dict]:
     if not isinstance(value, list) or not value:
-        raise where.error(None, f"expected a non-empty list, got {_kind(value)}")
+        raise where.error(None, f"expected a non-empty list, got {describe(value)}")
     out = []
     for i, item in enumerate(value):
-        _mapping(item, where.at(i), "an entry")
-        weight = _number(item.get("weight", 1.0), where.at(i).at("weight"), minimum=0)
+        mapping(item, where.at(i), "an entry")
+        weight = number(item.get("weight", 1.0), where.at(i).at("weight"), minimum=0)
         body = {k: v for k, v in item.items() if k != "weight"}
         out.append({**entry(body, where.at(i)), "weight": weight})
     if sum(e["weight"] for e in out) <= 0:
@@ -279,12 +220,12 @@ def _weighted_list(value, where: _Where, entry: Callable) -> list[dict]:
     return out
 
 
-def _capture(value, where: _Where) -> dict:
-    _mapping(value, where, "capture")
-    _keys(value, where, optional=("every", "frames", "passes"))
+def _capture(value, where: Where) -> dict:
+    mapping(value, where, "capture")
+    keys(value, where, optional=("every", "frames", "passes"))
     passes = value.get("passes", ["rgb", "depth", "label", "instance", "voxel"])
     if not isinstance(passes, list) or not passes:
-        raise where.error("passes", f"expected a non-empty list of passes, got {_kind(passes)}")
+        raise where.error("passes", f"expected a non-empty list of passes, got {describe(passes)}")
     for i, name in enumerate(passes):
         if name not in PASS_NAMES:
             raise where.error(
@@ -293,80 +234,18 @@ def _capture(value, where: _Where) -> dict:
     if len(set(passes)) != len(passes):
         raise where.error("passes", f"a pass is listed twice: {passes}")
     return {
-        "every": _integer(value.get("every", 40), where.at("every"), minimum=1),
+        "every": integer(value.get("every", 40), where.at("every"), minimum=1),
         "frames": _varying(value.get("frames", 25), where.at("frames"), _frames, integer=True),
         "passes": list(passes),
     }
 
 
-def _frames(value, where: _Where) -> int:
-    return _integer(value, where, minimum=1, maximum=100000)
+def _frames(value, where: Where) -> int:
+    return integer(value, where, minimum=1, maximum=100000)
 
 
-def _anatomy(entry: dict, where: _Where, base: Path) -> dict:
-    sources = [k for k in ANATOMY_SOURCES if k in entry]
-    if len(sources) != 1:
-        raise where.error(
-            None,
-            f"expected exactly one of {', '.join(ANATOMY_SOURCES)}, got {sorted(entry) or 'none'}",
-        )
-    if sources[0] == "phantom":
-        _keys(entry, where, optional=("phantom", "name"))
-        params = entry["phantom"] if entry["phantom"] is not None else {}
-        _mapping(params, where.at("phantom"), "phantom options")
-        _keys(params, where.at("phantom"), optional=("resolution", "seed"))
-        return {
-            "name": str(entry.get("name", "phantom")),
-            "phantom": {
-                "resolution": _varying(
-                    params.get("resolution", 128),
-                    where.at("phantom").at("resolution"),
-                    lambda v, w: _integer(v, w, minimum=8, maximum=1024),
-                    integer=True,
-                ),
-                "seed": _varying(
-                    params.get("seed", 0),
-                    where.at("phantom").at("seed"),
-                    lambda v, w: _integer(v, w, minimum=0),
-                    integer=True,
-                ),
-            },
-        }
-    _keys(
-        entry,
-        where,
-        optional=("file", "name", "prefix", "labels", "dimensions", "voxel_size", "threshold"),
-    )
-    path = _existing(entry["file"], base, where.at("file"))
-    out = {"name": str(entry.get("name", path.name.split(".")[0])), "file": str(path)}
-    if "labels" in entry:
-        out["labels"] = str(_existing(entry["labels"], base, where.at("labels")))
-    if "prefix" in entry:
-        out["prefix"] = str(entry["prefix"])
-    for key in ("dimensions", "voxel_size"):
-        if key in entry:
-            out[key] = _fixed(
-                entry[key], where.at(key), lambda v, w: _number(v, w, minimum=0, strict=True), 3
-            )
-    if "threshold" in entry:
-        out["threshold"] = _number(entry["threshold"], where.at("threshold"))
-    if path.is_dir() and "dimensions" not in out and "voxel_size" not in out:
-        raise where.error(None, f"the slice folder {path} needs dimensions or voxel_size")
-    return out
-
-
-def _existing(value, base: Path, where: _Where) -> Path:
-    if not isinstance(value, str) or not value:
-        raise where.error(None, f"expected a path, got {_kind(value)}")
-    path = Path(value).expanduser()
-    path = path if path.is_absolute() else base / path
-    if not path.exists():
-        raise where.error(None, f"no such file or folder: {path}")
-    return path.resolve()
-
-
-def _scenario(entry: dict, where: _Where) -> dict:
-    _keys(entry, where, required=("kind",), optional=("frames", "distance"))
+def _scenario(entry: dict, where: Where) -> dict:
+    keys(entry, where, required=("kind",), optional=("frames", "distance"))
     if entry["kind"] not in SCENARIO_KINDS:
         raise where.error(
             "kind",
@@ -376,49 +255,37 @@ def _scenario(entry: dict, where: _Where) -> dict:
     if "frames" in entry:
         out["frames"] = _varying(entry["frames"], where.at("frames"), _frames, integer=True)
     out["distance"] = _varying(
-        entry.get("distance", {"uniform": [0.23, 0.27]}), where.at("distance"), _positive
+        entry.get("distance", {"uniform": [0.23, 0.27]}), where.at("distance"), positive
     )
     return out
 
 
-def _positive(value, where: _Where) -> float:
-    return _number(value, where, minimum=0, strict=True)
-
-
-def _non_negative(value, where: _Where) -> float:
-    return _number(value, where, minimum=0)
-
-
-def _unit(value, where: _Where) -> float:
-    return _number(value, where, minimum=0, maximum=1)
-
-
-def _rig(entry: dict, where: _Where) -> dict:
-    _keys(entry, where, optional=("baseline", "working_distance", "resolution", "fov_y"))
+def _rig(entry: dict, where: Where) -> dict:
+    keys(entry, where, optional=("baseline", "working_distance", "resolution", "fov_y"))
     working = entry.get("working_distance", 0.25)
     return {
-        "baseline": _varying(entry.get("baseline", 0.065), where.at("baseline"), _positive),
+        "baseline": _varying(entry.get("baseline", 0.065), where.at("baseline"), positive),
         "working_distance": None
         if working is None
-        else _varying(working, where.at("working_distance"), _positive),
+        else _varying(working, where.at("working_distance"), positive),
         "resolution": _varying(
             entry.get("resolution", [640, 480]),
             where.at("resolution"),
-            lambda v, w: _integer(v, w, minimum=8, maximum=16384),
+            lambda v, w: integer(v, w, minimum=8, maximum=16384),
             size=2,
             integer=True,
         ),
         "fov_y": _varying(
             entry.get("fov_y", PAPER_FOV_Y),
             where.at("fov_y"),
-            lambda v, w: _number(v, w, minimum=0.01, maximum=3.0),
+            lambda v, w: number(v, w, minimum=0.01, maximum=3.0),
         ),
     }
 
 
-def _appearance(value, where: _Where) -> dict:
-    _mapping(value, where, "appearance")
-    _keys(
+def _appearance(value, where: Where) -> dict:
+    mapping(value, where, "appearance")
+    keys(
         value,
         where,
         optional=("lights", "labels", "material", "drill", "background", "intrinsics", "noise"),
@@ -427,18 +294,18 @@ def _appearance(value, where: _Where) -> dict:
     if "lights" in value:
         out["lights"] = _lights(value["lights"], where.at("lights"))
     if "background" in value:
-        out["background"] = _varying(value["background"], where.at("background"), _unit, size=3)
-    shininess = (None, lambda v, w: _number(v, w, 1, 1024))
+        out["background"] = _varying(value["background"], where.at("background"), unit, size=3)
+    shininess = (None, lambda v, w: number(v, w, 1, 1024))
     sections: dict[str, tuple[str, dict]] = {
-        "labels": ("label colours", {"color_jitter": (0.0, lambda v, w: _number(v, w, 0, 255))}),
-        "material": ("the anatomy's material", {"specular": (None, _unit),
+        "labels": ("label colours", {"color_jitter": (0.0, lambda v, w: number(v, w, 0, 255))}),
+        "material": ("the anatomy's material", {"specular": (None, unit),
                                                 "shininess": shininess}),
-        "drill": ("the drill's material", {"color_jitter": (0.0, _unit), "specular": (None, _unit),
+        "drill": ("the drill's material", {"color_jitter": (0.0, unit), "specular": (None, unit),
                                            "shininess": shininess}),
         "intrinsics": ("intrinsics jitter", {
-            "fov_y_jitter": (0.0, lambda v, w: _number(v, w, 0, 0.5)),
-            "principal_point_jitter": (0.0, _non_negative)}),
-        "noise": ("sensor noise", {"rgb_sigma": (0.0, lambda v, w: _number(v, w, 0, 128))}),
+            "fov_y_jitter": (0.0, lambda v, w: number(v, w, 0, 0.5)),
+            "principal_point_jitter": (0.0, non_negative)}),
+        "noise": ("sensor noise", {"rgb_sigma": (0.0, lambda v, w: number(v, w, 0, 128))}),
     }  # fmt: skip
     for key, (what, fields) in sections.items():
         if key in value:
@@ -446,11 +313,11 @@ def _appearance(value, where: _Where) -> dict:
     return out
 
 
-def _section(value, where: _Where, what: str, fields: dict) -> dict:
+def _section(value, where: Where, what: str, fields: dict) -> dict:
     """A mapping of varying numbers: `fields` maps each key to (default, check); a key whose
     default is None is left out unless given."""
-    _mapping(value, where, what)
-    _keys(value, where, optional=tuple(fields))
+    mapping(value, where, what)
+    keys(value, where, optional=tuple(fields))
     return {
         key: _varying(value.get(key, default), where.at(key), check)
         for key, (default, check) in fields.items()
@@ -458,16 +325,18 @@ def _section(value, where: _Where, what: str, fields: dict) -> dict:
     }
 
 
-def _lights(value, where: _Where) -> dict:
-    _mapping(value, where, "lights")
-    _keys(
+def _lights(value, where: Where) -> dict:
+    mapping(value, where, "lights")
+    keys(
         value,
         where,
         optional=("count", "types", "intensity", "color", "azimuth", "elevation", "distance"),
     )
     types = value.get("types", ["directional", "point"])
     if not isinstance(types, list) or not types:
-        raise where.error("types", f"expected a non-empty list of light types, got {_kind(types)}")
+        raise where.error(
+            "types", f"expected a non-empty list of light types, got {describe(types)}"
+        )
     for i, kind in enumerate(types):
         if kind not in LIGHT_TYPES:
             raise where.error(
@@ -478,25 +347,25 @@ def _lights(value, where: _Where) -> dict:
         "count": _varying(
             value.get("count", 2),
             where.at("count"),
-            lambda v, w: _integer(v, w, minimum=1, maximum=8),
+            lambda v, w: integer(v, w, minimum=1, maximum=8),
             integer=True,
         ),
         "types": list(types),
         "intensity": _varying(
-            value.get("intensity", 0.8), where.at("intensity"), lambda v, w: _number(v, w, 0, 10)
+            value.get("intensity", 0.8), where.at("intensity"), lambda v, w: number(v, w, 0, 10)
         ),
-        "color": _varying(value.get("color", [1.0, 1.0, 1.0]), where.at("color"), _unit, size=3),
+        "color": _varying(value.get("color", [1.0, 1.0, 1.0]), where.at("color"), unit, size=3),
         "azimuth": _varying(
             value.get("azimuth", {"uniform": [-math.pi, math.pi]}),
             where.at("azimuth"),
-            lambda v, w: _number(v, w, -10, 10),
+            lambda v, w: number(v, w, -10, 10),
         ),
         "elevation": _varying(
             value.get("elevation", {"uniform": [0.6, 1.4]}),
             where.at("elevation"),
-            lambda v, w: _number(v, w, -math.pi / 2, math.pi / 2),
+            lambda v, w: number(v, w, -math.pi / 2, math.pi / 2),
         ),
         "distance": _varying(
-            value.get("distance", {"uniform": [0.15, 0.4]}), where.at("distance"), _positive
+            value.get("distance", {"uniform": [0.15, 0.4]}), where.at("distance"), positive
         ),
     }

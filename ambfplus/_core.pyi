@@ -228,6 +228,10 @@ class VolumeData:
         """
         voxels per label id (index = id; index 0 counts the empty voxels)
         """
+    def label_ids(self, labels: typing.Any, what: str = 'labels') -> list[int]:
+        """
+        The ids of labels given by name or id (one, or a list), by the rule every caller uses (a name first, then a number); an unknown one raises NotFound starting with `what` and listing the table's labels.
+        """
     def mark_dirty(self, lo: typing.Annotated[collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], "FixedSize(3)"] | None = None, hi: typing.Annotated[collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], "FixedSize(3)"] | None = None) -> None:
         """
         declares voxels [lo, hi) (default: all) changed through the labels view
@@ -2386,9 +2390,9 @@ class SkillMetrics:
     """
     Skill metrics of a drilling session, fed tick by tick (live) or from a recording (offline) through the same code.
     """
-    def __init__(self, volume: VolumeData, *, protect: list = [], target_labels: typing.Any = None, excess_force: typing.SupportsFloat | typing.SupportsIndex = 3.0, stroke_gap: typing.SupportsFloat | typing.SupportsIndex = 0.05, turn_step: typing.SupportsFloat | typing.SupportsIndex = 0.0005, turn_angle: typing.SupportsFloat | typing.SupportsIndex = 0.7853981633974483, field_band: typing.SupportsFloat | typing.SupportsIndex = 0.005, apply_removals: bool = False) -> None:
+    def __init__(self, volume: VolumeData, *, protect: list = [], target_labels: typing.Any = None, target_mask: typing.Any = None, excess_force: typing.SupportsFloat | typing.SupportsIndex = 3.0, stroke_gap: typing.SupportsFloat | typing.SupportsIndex = 0.05, turn_step: typing.SupportsFloat | typing.SupportsIndex = 0.0005, turn_angle: typing.SupportsFloat | typing.SupportsIndex = 0.7853981633974483, field_band: typing.SupportsFloat | typing.SupportsIndex = 0.005, apply_removals: bool = False) -> None:
         """
-        Metrics of drilling `volume` (the volume being drilled, which the structures' distance fields follow). protect: [{'name', 'labels': names or ids, 'margin': metres}]; target_labels: the labels of the target region; excess_force: N; stroke_gap: s; turn_step: m; turn_angle: rad; field_band: m beyond the margins; apply_removals: remove each tick's voxels from `volume` (offline, on a fresh copy of the anatomy).
+        Metrics of drilling `volume` (the volume being drilled, which the structures' distance fields follow). protect: [{'name', 'labels': names or ids, 'margin': metres}]; target_labels: the labels of the target region, or target_mask: the region voxel by voxel (an array of the volume's shape, non-zero inside); excess_force: N; stroke_gap: s; turn_step: m; turn_angle: rad; field_band: m beyond the margins; apply_removals: remove each tick's voxels from `volume` (offline, on a fresh copy of the anatomy).
         """
     def add(self, step: typing.SupportsInt | typing.SupportsIndex, time: typing.SupportsFloat | typing.SupportsIndex, dt: typing.SupportsFloat | typing.SupportsIndex, tip: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], force: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], burr_radius: typing.SupportsFloat | typing.SupportsIndex, burr_on: bool, removed: typing.Annotated[numpy.typing.ArrayLike, numpy.int32] | None = None, removed_labels: typing.Annotated[numpy.typing.ArrayLike, numpy.uint16] | None = None) -> None:
         """

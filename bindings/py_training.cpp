@@ -79,9 +79,9 @@ py::dict summary_dict(const MetricsSummary& m) {
 }
 
 MetricsConfig config_from(const VolumeData& data, const py::list& protect,
-                          const py::handle& target_labels, double excess_force, double stroke_gap,
-                          double turn_step, double turn_angle, double field_band,
-                          bool apply_removals) {
+                          const py::handle& target_labels, const py::handle& target_mask,
+                          double excess_force, double stroke_gap, double turn_step,
+                          double turn_angle, double field_band, bool apply_removals) {
   MetricsConfig c;
   for (const py::handle item : protect) {
     if (!py::isinstance<py::dict>(item)) {
@@ -109,6 +109,22 @@ MetricsConfig config_from(const VolumeData& data, const py::list& protect,
   }
   if (!target_labels.is_none()) {
     c.target_labels = structure_labels(data, target_labels, "SkillMetrics target_labels");
+  }
+  if (!target_mask.is_none()) {
+    // (I, J, K) like the label grid (VolumeData.labels), stored i fastest.
+    const auto mask = py::array_t<std::uint8_t, py::array::forcecast>::ensure(target_mask);
+    const auto& n = data.shape();
+    if (!mask || mask.ndim() != 3 || mask.shape(0) != n[0] || mask.shape(1) != n[1] ||
+        mask.shape(2) != n[2]) {
+      throw ArgumentError("SkillMetrics: target_mask must be an array of the volume's shape (" +
+                          std::to_string(n[0]) + ", " + std::to_string(n[1]) + ", " +
+                          std::to_string(n[2]) + ")");
+    }
+    c.target_mask.resize(static_cast<std::size_t>(n[0]) * n[1] * n[2]);
+    const auto m = mask.unchecked<3>();
+    for (int k = 0; k < n[2]; ++k)
+      for (int j = 0; j < n[1]; ++j)
+        for (int i = 0; i < n[0]; ++i) c.target_mask[data.linear_index(i, j, k)] = m(i, j, k) != 0;
   }
   c.excess_force = excess_force;
   c.stroke_gap = stroke_gap;
@@ -145,26 +161,29 @@ void declare_training(py::module_& m) {
 
 void define_training(py::module_& m) {
   bound<SkillMetrics, std::shared_ptr<SkillMetrics>>(m, "SkillMetrics")
-      .def(
-          py::init([](const std::shared_ptr<VolumeData>& data, const py::list& protect,
-                      const py::handle& target_labels, double excess_force, double stroke_gap,
-                      double turn_step, double turn_angle, double field_band, bool apply_removals) {
-            MetricsConfig c = config_from(*data, protect, target_labels, excess_force, stroke_gap,
-                                          turn_step, turn_angle, field_band, apply_removals);
-            py::gil_scoped_release release;
-            return std::make_shared<SkillMetrics>(*data, std::move(c));
-          }),
-          py::arg("volume"), py::kw_only(), py::arg("protect") = py::list(),
-          py::arg("target_labels") = py::none(), py::arg("excess_force") = 3.0,
-          py::arg("stroke_gap") = 0.05, py::arg("turn_step") = 0.0005,
-          py::arg("turn_angle") = 0.7853981633974483, py::arg("field_band") = 0.005,
-          py::arg("apply_removals") = false, py::keep_alive<1, 2>(),
-          "Metrics of drilling `volume` (the volume being drilled, which the structures' "
-          "distance fields follow). protect: [{'name', 'labels': names or ids, 'margin': "
-          "metres}]; target_labels: the labels of the target region; excess_force: N; "
-          "stroke_gap: s; turn_step: m; turn_angle: rad; field_band: m beyond the margins; "
-          "apply_removals: remove each tick's voxels from `volume` (offline, on a fresh copy "
-          "of the anatomy).")
+      .def(py::init([](const std::shared_ptr<VolumeData>& data, const py::list& protect,
+                       const py::handle& target_labels, const py::handle& target_mask,
+                       double excess_force, double stroke_gap, double turn_step, double turn_angle,
+                       double field_band, bool apply_removals) {
+             MetricsConfig c =
+                 config_from(*data, protect, target_labels, target_mask, excess_force, stroke_gap,
+                             turn_step, turn_angle, field_band, apply_removals);
+             py::gil_scoped_release release;
+             return std::make_shared<SkillMetrics>(*data, std::move(c));
+           }),
+           py::arg("volume"), py::kw_only(), py::arg("protect") = py::list(),
+           py::arg("target_labels") = py::none(), py::arg("target_mask") = py::none(),
+           py::arg("excess_force") = 3.0, py::arg("stroke_gap") = 0.05,
+           py::arg("turn_step") = 0.0005, py::arg("turn_angle") = 0.7853981633974483,
+           py::arg("field_band") = 0.005, py::arg("apply_removals") = false, py::keep_alive<1, 2>(),
+           "Metrics of drilling `volume` (the volume being drilled, which the structures' "
+           "distance fields follow). protect: [{'name', 'labels': names or ids, 'margin': "
+           "metres}]; target_labels: the labels of the target region, or target_mask: the region "
+           "voxel by voxel "
+           "(an array of the volume's shape, non-zero inside); excess_force: N; "
+           "stroke_gap: s; turn_step: m; turn_angle: rad; field_band: m beyond the margins; "
+           "apply_removals: remove each tick's voxels from `volume` (offline, on a fresh copy "
+           "of the anatomy).")
       .def(
           "add",
           [](SkillMetrics& s, std::int64_t step, double time, double dt, const Eigen::Vector3d& tip,

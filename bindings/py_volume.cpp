@@ -270,6 +270,15 @@ void define_volume(py::module_& m) {
           },
           py::arg("id_or_name"))
       .def(
+          "label_ids",
+          [](const VolumeData& v, const py::handle& labels, const std::string& what) {
+            return structure_labels(v, labels, what);
+          },
+          py::arg("labels"), py::arg("what") = "labels",
+          "The ids of labels given by name or id (one, or a list), by the rule every caller uses "
+          "(a name first, then a number); an unknown one raises NotFound starting with `what` "
+          "and listing the table's labels.")
+      .def(
           "label_counts",
           [](const VolumeData& v) {
             const auto counts = v.label_counts();

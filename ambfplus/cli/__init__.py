@@ -1,4 +1,4 @@
-"""The ``ambfplus`` command line: ``demo``, ``replay``, ``convert``, ``launch``,
+"""The ``ambfplus`` command line: ``demo``, ``replay``, ``assess``, ``convert``, ``launch``,
 ``check-plugins``, ``validate``, ``export``, ``generate``, ``dataset info``, ``info``, ``doctor``
 (and ``--cmake-dir``, the folder of the CMake package C++ plugins build against).
 
@@ -13,6 +13,7 @@ import argparse
 from .._core import __version__
 from ..plugin import cmake_dir
 from . import (
+    assess,
     check_plugins,
     convert,
     dataset,
@@ -27,8 +28,8 @@ from . import (
 )
 
 # In the order ``ambfplus --help`` lists them.
-COMMANDS = (demo, replay, convert, launch, check_plugins, validate, export, generate, dataset,
-            info, doctor)  # fmt: skip
+COMMANDS = (demo, replay, assess, convert, launch, check_plugins, validate, export, generate,
+            dataset, info, doctor)  # fmt: skip
 
 
 class _PrintCmakeDir(argparse.Action):

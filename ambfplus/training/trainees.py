@@ -220,7 +220,7 @@ class ScriptedTrainee:
         self._plan.go(distance / speed, target, buttons)
 
     def _plan_strokes(self, end: float) -> None:
-        r, region, p = self.burr_radius, self.region, self.params
+        region, p = self.region, self.params
         layer = 0
         while self._plan.end < end:
             layer += 1
@@ -229,7 +229,7 @@ class ScriptedTrainee:
                 break
             shrink = max(0.0, 1.0 - region.taper * depth / max(region.depth, 1e-9))
             hx, hy = (h * shrink for h in region.half_extent)
-            if hx < r or hy < r:
+            if min(hx, hy) < 0.0005:  # the region has narrowed to nothing
                 break
             rows = max(1, int(2 * hy / p["spacing"]))
             for row in range(rows + 1):
@@ -309,6 +309,11 @@ class ScriptedTrainee:
             self._move_to(self._device(above), 1, 0.04)
 
 
+# The phantom's lateral surface (volume z, metres) and the drill's burrs (scenes.drilling_phantom).
+PHANTOM_SURFACE = 0.0126
+DRILL_BURRS = (0.001, 0.002, 0.004, 0.006)
+
+
 def expert_like(volume, drill_start, burr_radius, rng, **options) -> ScriptedTrainee:
     """A careful expert-like trainee (see the module's docstring)."""
     return ScriptedTrainee(volume, drill_start, burr_radius, EXPERT, rng, **options)
@@ -329,24 +334,17 @@ class TraineeSession:
     removed: dict
 
 
-def drill_phantom(
-    make,
-    seed: int,
-    seconds: float,
-    protect: list[tuple[str, str, float]],
-    resolution: int = 128,
-    region: TrainingRegion | None = None,
-    field_band: float = 0.03,
-) -> TraineeSession:
-    """A scripted trainee (``make``: expert_like or novice_like) drilling the built-in phantom
-    (``scenes.drilling_phantom``) for `seconds`; `protect` lists (name, label, margin in metres),
-    whose distance fields, `field_band` deep, the trainee plans with. The step log is taken
-    every 10,000 steps, so long sessions keep little in the engine."""
-    scene = drilling_phantom(resolution=resolution)
-    world, drill = scene.world, scene.drill
+def _trainee_on_phantom(
+    make, seed, seconds, protect, resolution, region, field_band, burr, width=640, height=480
+):
+    """The phantom scene with a planned trainee on a ScriptedDevice: (scene, device)."""
+    scene = drilling_phantom(resolution=resolution, width=width, height=height)
+    drill = scene.drill
+    if burr is not None:
+        drill.burr = burr
     fields = [
-        ProtectedField(name, DistanceField(drill.volume.data, label, field_band), margin)
-        for name, label, margin in protect
+        ProtectedField(name, DistanceField(drill.volume.data, labels, field_band), margin)
+        for name, labels, margin in protect
     ]
     trainee = make(
         drill.volume,
@@ -359,6 +357,28 @@ def drill_phantom(
     trainee.plan(seconds)
     device = ScriptedDevice()
     device.set_callback(trainee, every=10)
+    return scene, device
+
+
+def drill_phantom(
+    make,
+    seed: int,
+    seconds: float,
+    protect: list[tuple[str, object, float]],
+    resolution: int = 128,
+    region: TrainingRegion | None = None,
+    field_band: float = 0.03,
+    burr: int | None = None,
+) -> TraineeSession:
+    """A scripted trainee (``make``: expert_like or novice_like) drilling the built-in phantom
+    (``scenes.drilling_phantom``) for `seconds`; `protect` lists (name, labels, margin in
+    metres), whose distance fields, `field_band` deep, the trainee plans with; `burr` selects
+    the drill's burr. The step log is taken every 10,000 steps, so long sessions keep little in
+    the engine."""
+    scene, device = _trainee_on_phantom(
+        make, seed, seconds, protect, resolution, region, field_band, burr
+    )
+    world, drill = scene.world, scene.drill
     world.add_input_device(scene.device_name, device, drill, **scene.device_options)
     world.start_step_log([drill])
     total = int(round(seconds / world.time_step))
@@ -370,3 +390,91 @@ def drill_phantom(
     steps = {k: np.concatenate([c[0][k] for c in chunks]) for k in chunks[0][0]}
     removed = {k: np.concatenate([c[1][k] for c in chunks]) for k in chunks[0][1]}
     return TraineeSession(drill, steps, removed)
+
+
+def task_setup(task, style: TraineeStyle) -> dict:
+    """How a scripted trainee of `style` works on a training task of the built-in phantom:
+    ``resolution``, ``protect`` (the task's structures), ``region`` (the target's box) and
+    ``burr`` (an expert takes the largest burr the task allows, a novice the drill's largest).
+    Raises ValueError for a task that is not on the phantom or has no target box."""
+    if "phantom" not in task.anatomy:
+        raise ValueError(f"{task.source}: scripted trainees drill the built-in phantom only")
+    if "box" not in task.target:
+        raise ValueError(f"{task.source}: scripted trainees need a target box")
+    # The first box's width; the union's depth.
+    (x0, y0, _), (x1, y1, z1) = task.target["box"][0]
+    z0 = min(low[2] for low, _ in task.target["box"])
+    surface = min(z1, PHANTOM_SURFACE)
+    burr = len(DRILL_BURRS) - 1
+    if style.strokes and task.burrs:
+        largest = max(task.burrs)
+        burr = min(range(len(DRILL_BURRS)), key=lambda i: abs(DRILL_BURRS[i] - largest))
+    # An expert keeps the whole burr inside the box; a novice aims its centre anywhere in it.
+    inset = DRILL_BURRS[burr] / 2 if style.strokes else 0.0
+    region = TrainingRegion(
+        center=((x0 + x1) / 2, (y0 + y1) / 2),
+        half_extent=(max((x1 - x0) / 2 - inset, 0.0005), max((y1 - y0) / 2 - inset, 0.0005)),
+        depth=max(surface - z0, 0.0),
+        taper=0.8 if style.strokes else 0.0,
+    )
+    return {
+        "resolution": int(task.anatomy["phantom"]["resolution"]),
+        "protect": [(p.name, p.labels, p.length) for p in task.protect],
+        "region": region,
+        "burr": burr,
+    }
+
+
+def record_trainee(
+    make,
+    seed: int,
+    seconds: float,
+    path,
+    task=None,
+    *,
+    capture_every: int = 50,
+    passes=("rgb", "depth"),
+    width: int = 320,
+    height: int = 240,
+    **setup,
+) -> dict:
+    """Records a scripted trainee on the built-in phantom to `path` (a recording like any
+    other, with stereo frames every `capture_every` steps), set up for `task` (``task_setup``)
+    or by `setup` (resolution, protect, region, burr, as ``drill_phantom``). Returns
+    record_session's summary."""
+    from ..scenes import record_session
+
+    options = {"resolution": 128, "protect": [], "region": None, "burr": None}
+    if task is not None:
+        options.update(task_setup(task, _STYLES[make]))
+    options.update(setup)
+    scene, device = _trainee_on_phantom(
+        make,
+        seed,
+        seconds,
+        options["protect"],
+        options["resolution"],
+        options["region"],
+        0.03,
+        options["burr"],
+        width=width,
+        height=height,
+    )
+    return record_session(
+        scene,
+        path,
+        device,
+        seconds,
+        capture_every=capture_every,
+        passes=passes,
+        metadata={
+            "trainee": {
+                "style": _STYLES[make].name,
+                "seed": seed,
+                "task": None if task is None else task.name,
+            }
+        },
+    )
+
+
+_STYLES = {expert_like: EXPERT, novice_like: NOVICE}

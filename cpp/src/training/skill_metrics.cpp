@@ -32,6 +32,13 @@ SkillMetrics::SkillMetrics(VolumeData& volume, MetricsConfig config)
     throw ArgumentError("SkillMetrics: turn_step must be a positive number of metres");
   }
   for (std::uint16_t id : config_.target_labels) in_target_[id] = true;
+  const auto& shape = volume_.shape();
+  if (!config_.target_mask.empty() &&
+      config_.target_mask.size() != static_cast<std::size_t>(shape[0]) * shape[1] * shape[2]) {
+    throw ArgumentError("SkillMetrics: target_mask has " +
+                        std::to_string(config_.target_mask.size()) + " voxels, the volume " +
+                        std::to_string(static_cast<std::size_t>(shape[0]) * shape[1] * shape[2]));
+  }
   std::set<std::string> names;
   for (const ProtectedStructure& s : config_.protect) {
     if (!names.insert(s.name).second) {
@@ -89,11 +96,25 @@ void SkillMetrics::add(const ToolTick& tick) {
   const double force = tick.force.norm();
 
   // Removed voxels by label and by region.
-  for (std::uint16_t label : tick.removed_labels) {
+  const auto& shape = volume_.shape();
+  for (std::size_t r = 0; r < tick.removed_labels.size(); ++r) {
+    const std::uint16_t label = tick.removed_labels[r];
     if (label == 0) continue;
     if (sum_.removed_by_label.size() <= label) sum_.removed_by_label.resize(label + 1, 0);
     ++sum_.removed_by_label[label];
-    ++(in_target_[label] ? sum_.removed_in_target : sum_.removed_outside_target);
+    bool inside = in_target_[label];
+    if (!config_.target_mask.empty()) {
+      const auto& v = tick.removed[r];
+      for (int a = 0; a < 3; ++a) {
+        if (v[a] < 0 || v[a] >= shape[a]) {
+          throw OutOfRange("SkillMetrics: removed voxel (" + std::to_string(v[0]) + ", " +
+                           std::to_string(v[1]) + ", " + std::to_string(v[2]) +
+                           ") is outside the volume");
+        }
+      }
+      inside = config_.target_mask[volume_.linear_index(v[0], v[1], v[2])] != 0;
+    }
+    ++(inside ? sum_.removed_in_target : sum_.removed_outside_target);
   }
 
   for (std::size_t s = 0; s < watches_.size(); ++s) {

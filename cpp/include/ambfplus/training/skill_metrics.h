@@ -28,6 +28,9 @@ struct AMBFPLUS_API MetricsConfig {
   std::vector<ProtectedStructure> protect;
   /// Labels whose voxels make the target region (empty: no target by label).
   std::vector<std::uint16_t> target_labels;
+  /// Or the target region voxel by voxel: one byte per voxel of the volume, i fastest (non-zero:
+  /// in the target). When given, it alone says what is in the target.
+  std::vector<std::uint8_t> target_mask;
   /// A force magnitude (N) above which cutting counts as excessive.
   double excess_force = 3.0;
   /// A stroke ends after the burr has not cut for this long (seconds).

@@ -29,7 +29,7 @@ class OutOfRange(Error, IndexError):
     """An index outside what it indexes."""
 class ArgumentTypeError(ArgumentError, TypeError):
     """A value of the wrong type, or a keyword option that does not exist."""
-__all__: list[str] = ['ActuatorHold', 'ArgumentError', 'ArgumentTypeError', 'AssetNotFound', 'Axis', 'Camera', 'ConfigError', 'ConstraintActuator', 'ControlOutput', 'Device', 'DistanceField', 'Drill', 'Error', 'Frame', 'InputDevice', 'Joint', 'JointType', 'JoystickDevice', 'JoystickMapping', 'KeyboardDevice', 'Label', 'Light', 'LightType', 'LoadReport', 'MergedDevice', 'MeshCollision', 'Model', 'NetworkDevice', 'NotFound', 'NullDevice', 'Object', 'OpenXrSession', 'OutOfRange', 'PLUGIN_ABI_VERSION', 'PluginError', 'PluginInfo', 'PluginSite', 'ProximitySensor', 'RealTimeLoop', 'RemovalMode', 'RenderError', 'ReplayDevice', 'ResourceError', 'RigidBody', 'ScriptedDevice', 'ShapeKind', 'SimulatedDevice', 'Simulator', 'SkillMetrics', 'SoftBody', 'StateError', 'Volume', 'VolumeData', 'Window', 'World', 'capture_passes', 'gl_info', 'load_nrrd', 'load_slice_stack', 'openxr_built', 'phantom', 'plugin_search_path', 'read_colors', 'read_input_devices', 'read_label_table', 'read_launch', 'use_x11_display', 'write_image', 'write_label_table']
+__all__: list[str] = ['ActuatorHold', 'ArgumentError', 'ArgumentTypeError', 'AssetNotFound', 'Axis', 'Camera', 'ConfigError', 'ConstraintActuator', 'ControlOutput', 'Device', 'DistanceField', 'Drill', 'Error', 'Frame', 'InputDevice', 'Joint', 'JointType', 'JoystickDevice', 'JoystickMapping', 'KeyboardDevice', 'Label', 'Light', 'LightType', 'LiveMetrics', 'LoadReport', 'MergedDevice', 'MeshCollision', 'Model', 'NetworkDevice', 'NotFound', 'NullDevice', 'Object', 'OpenXrSession', 'OutOfRange', 'PLUGIN_ABI_VERSION', 'PluginError', 'PluginInfo', 'PluginSite', 'ProximitySensor', 'RealTimeLoop', 'RemovalMode', 'RenderError', 'ReplayDevice', 'ResourceError', 'RigidBody', 'ScriptedDevice', 'ShapeKind', 'SimulatedDevice', 'Simulator', 'SkillMetrics', 'SoftBody', 'StateError', 'Volume', 'VolumeData', 'Window', 'World', 'capture_passes', 'gl_info', 'live_metrics', 'load_nrrd', 'load_slice_stack', 'openxr_built', 'phantom', 'plugin_search_path', 'read_colors', 'read_input_devices', 'read_label_table', 'read_launch', 'use_x11_display', 'write_image', 'write_label_table']
 class Window:
     """
     An X11 window (GLFW's, made without a client API) showing cameras.
@@ -2410,6 +2410,24 @@ class SkillMetrics:
         """
         Everything measured so far, as a dict (distances in metres, times in seconds, forces in newtons, volumes as voxel counts with voxel_volume in cubic metres).
         """
+class LiveMetrics:
+    """
+    Skill metrics of a drill measured live: its world feeds them at every step, through the code the offline assessment runs (ambfplus.live_metrics starts them).
+    """
+    def summary(self) -> dict:
+        """
+        The metrics so far, as SkillMetrics.summary() gives them.
+        """
+    @property
+    def active(self) -> bool:
+        """
+        Whether the metrics are still fed (their drill is in the world).
+        """
+    @property
+    def tick_cpu_seconds(self) -> numpy.typing.NDArray[numpy.float64]:
+        """
+        CPU seconds the metrics added to each of the last ticks (up to 16384).
+        """
 class PluginSite:
     """
     Where a Python plugin is attached (its `_site`); handles are made on each access, so keep names on a plugin rather than handles.
@@ -2495,6 +2513,10 @@ def capture_passes() -> list:
 def gl_info() -> dict:
     """
     Describes the OpenGL context (created on first use): vendor, renderer, version, ...
+    """
+def live_metrics(drill: Drill, *, protect: list = [], target_labels: typing.Any = None, target_mask: typing.Any = None, excess_force: typing.SupportsFloat | typing.SupportsIndex = 3.0, stroke_gap: typing.SupportsFloat | typing.SupportsIndex = 0.05, turn_step: typing.SupportsFloat | typing.SupportsIndex = 0.0005, turn_angle: typing.SupportsFloat | typing.SupportsIndex = 0.7853981633974483, field_band: typing.SupportsFloat | typing.SupportsIndex = 0.005) -> LiveMetrics:
+    """
+    Starts skill metrics of `drill`, fed by its world after every step (SkillMetrics' options); its world keeps them until it goes.
     """
 def load_nrrd(path: os.PathLike | str | bytes, kind: str = 'auto', threshold: typing.SupportsFloat | typing.SupportsIndex | None = None) -> VolumeData:
     """

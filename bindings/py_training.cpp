@@ -8,6 +8,9 @@
 #include <string>
 
 #include "ambfplus/errors.h"
+#include "ambfplus/haptics/drill.h"
+#include "ambfplus/scene/world.h"
+#include "ambfplus/training/live_metrics.h"
 #include "ambfplus/training/skill_metrics.h"
 #include "bindings.h"
 
@@ -157,6 +160,10 @@ void declare_training(py::module_& m) {
       m, "SkillMetrics",
       "Skill metrics of a drilling session, fed tick by tick (live) or from a recording "
       "(offline) through the same code.");
+  py::class_<LiveMetrics, std::shared_ptr<LiveMetrics>>(
+      m, "LiveMetrics",
+      "Skill metrics of a drill measured live: its world feeds them at every step, through the "
+      "code the offline assessment runs (ambfplus.live_metrics starts them).");
 }
 
 void define_training(py::module_& m) {
@@ -282,6 +289,55 @@ void define_training(py::module_& m) {
            py::arg("radius"),
            "Distance (metres) from a sphere at `point` (volume frame) to the protected "
            "structure with this index, from its field as of the last tick.");
+
+  bound<LiveMetrics, std::shared_ptr<LiveMetrics>>(m, "LiveMetrics")
+      .def(
+          "summary",
+          [](const LiveMetrics& l) {
+            const MetricsSummary summary = [&] {
+              py::gil_scoped_release release;
+              auto lock = l.drill().world().lock_state_for_copy();
+              return l.summary();
+            }();
+            return summary_dict(summary);
+          },
+          "The metrics so far, as SkillMetrics.summary() gives them.")
+      .def_property_readonly(
+          "tick_cpu_seconds",
+          [](const LiveMetrics& l) {
+            const std::deque<double> t = [&] {
+              py::gil_scoped_release release;
+              auto lock = l.drill().world().lock_state_for_copy();
+              return l.tick_cpu_seconds();
+            }();
+            return py::array_t<double>(py::ssize_t(t.size()),
+                                       std::vector<double>(t.begin(), t.end()).data());
+          },
+          "CPU seconds the metrics added to each of the last ticks (up to 16384).")
+      .def_property_readonly("active", &LiveMetrics::active,
+                             "Whether the metrics are still fed (their drill is in the world).");
+
+  m.def(
+      "live_metrics",
+      [](Drill& drill, const py::list& protect, const py::handle& target_labels,
+         const py::handle& target_mask, double excess_force, double stroke_gap, double turn_step,
+         double turn_angle, double field_band) {
+        MetricsConfig c =
+            config_from(*drill.volume().data(), protect, target_labels, target_mask, excess_force,
+                        stroke_gap, turn_step, turn_angle, field_band, false);
+        World& world = drill.world();
+        LiveMetrics* live = [&] {
+          py::gil_scoped_release release;
+          return &add_live_metrics(world, drill, std::move(c));
+        }();
+        return handle(live, world);
+      },
+      py::arg("drill"), py::kw_only(), py::arg("protect") = py::list(),
+      py::arg("target_labels") = py::none(), py::arg("target_mask") = py::none(),
+      py::arg("excess_force") = 3.0, py::arg("stroke_gap") = 0.05, py::arg("turn_step") = 0.0005,
+      py::arg("turn_angle") = 0.7853981633974483, py::arg("field_band") = 0.005,
+      "Starts skill metrics of `drill`, fed by its world after every step (SkillMetrics' "
+      "options); its world keeps them until it goes.");
 }
 
 }  // namespace ambfplus::bindings

@@ -3,6 +3,8 @@ long session costs.
 
     python tests/benchmarks/run.py --only training_discrimination
     python tests/benchmarks/run.py --only training_offline_metrics
+    python tests/benchmarks/run.py --only assessment_discrimination
+    python tests/benchmarks/run.py --only assessment_speed
 
 training_discrimination: 20 expert-like and 20 novice-like sessions (seeds 100.. and 200..,
 none of the tests' seeds) of 20 s on the 128^3 phantom; for each metric, the ROC AUC of telling
@@ -12,16 +14,40 @@ training_offline_metrics: a 10-minute session at 1 kHz (a novice-like trainee pl
 on the 128^3 phantom), then its skill metrics computed offline from its step log and removed
 voxels, replayed onto a fresh phantom: CPU seconds of that computation (target for the whole
 assessment: 20 s), and per tick.
+
+assessment_discrimination: on each shipped task (cortical mastoidectomy, facial recess), 20
+expert-like and 20 novice-like recorded sessions of 20 s (seeds 100.. and 200..; stereo depth at
+10 Hz, 160x120), assessed against the task with target completion not judged (a 20 s excerpt
+completes no target): the ROC AUC of the composite score, and of each rubric item's score (the
+direction every item is expected to move in: an expert scores higher).
+
+assessment_speed: a 10-minute novice-like session at 1 kHz with stereo at 20 Hz (320x240 rgb
+and depth) recorded on the 128^3 phantom, then assessed against the cortical mastoidectomy task
+(metrics, target, exposure, burr visibility from every frame with cutting, rubric, timeline):
+CPU seconds (median and worst of 3), target 20 s; and the report on top.
 """
 
 from __future__ import annotations
 
+import shutil
+import tempfile
 import time
+from pathlib import Path
 
 import numpy as np
 
 import ambfplus
-from ambfplus.training import Protect, drill_phantom, expert_like, novice_like, session_metrics
+from ambfplus.training import (
+    BUILTIN_TASKS,
+    Protect,
+    assess,
+    builtin_task,
+    drill_phantom,
+    expert_like,
+    novice_like,
+    record_trainee,
+    session_metrics,
+)
 
 RESOLUTION = 128
 PROTECT = (
@@ -119,7 +145,96 @@ def offline_metrics(args):
     }
 
 
+def assessment_discrimination(args):
+    n = 6 if args.quick else 20
+    folder = Path(tempfile.mkdtemp(prefix="ambfplus-assess-"))
+    try:
+        for name in BUILTIN_TASKS:
+            task = builtin_task(name).with_thresholds(min_target_fraction=0.0)
+            started = time.process_time()
+            results = {"expert": [], "novice": []}
+            for group, make, base in (("expert", expert_like, 100), ("novice", novice_like, 200)):
+                for k in range(n):
+                    path = folder / f"{name}_{group}_{k}.h5"
+                    record_trainee(make, base + k, 20.0, path, task, capture_every=100,
+                                   passes=("depth",), width=160, height=120)  # fmt: skip
+                    results[group].append(assess(path, task).data)
+            items = {}
+            for key in [i["key"] for i in results["expert"][0]["rubric"]]:
+
+                def score(d, key=key):
+                    item = next(i for i in d["rubric"] if i["key"] == key)
+                    return item["score"] if item["score"] is not None else 0.5
+
+                items[key] = round(auc([score(d) for d in results["expert"]],
+                                       [score(d) for d in results["novice"]]), 4)  # fmt: skip
+            composite = auc([d["score"] for d in results["expert"]],
+                            [d["score"] for d in results["novice"]])  # fmt: skip
+            scores = {g: [round(d["score"], 1) for d in results[g]] for g in results}
+            yield {
+                "benchmark": "assessment_discrimination",
+                "task": name,
+                "composite_auc": round(composite, 4),
+                "target": 0.95,
+                "item_auc": items,
+                "items_against_direction": sorted(k for k, v in items.items() if v < 0.5),
+                "expert_score_median": float(np.median(scores["expert"])),
+                "expert_score_min": min(scores["expert"]),
+                "novice_score_median": float(np.median(scores["novice"])),
+                "novice_score_max": max(scores["novice"]),
+                "sessions_per_group": n,
+                "cpu_s": round(time.process_time() - started, 2),
+                "what": "ROC AUC of the composite score (and of each rubric item's score) telling "
+                "20 s expert-like from novice-like recorded sessions on a shipped task; 0.5 is "
+                "chance, items at 0.5 do not vary between the groups",
+                "quick": args.quick,
+            }
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
+
+
+def assessment_speed(args):
+    seconds = 120.0 if args.quick else 600.0
+    folder = Path(tempfile.mkdtemp(prefix="ambfplus-assess-"))
+    try:
+        task = builtin_task("cortical_mastoidectomy")
+        path = folder / "long.h5"
+        started = time.process_time()
+        summary = record_trainee(novice_like, 7, seconds, path, task, capture_every=50,
+                                 passes=("rgb", "depth"), width=320, height=240)  # fmt: skip
+        record_cpu = time.process_time() - started
+        rounds, report = [], []
+        for _ in range(3):
+            started = time.process_time()
+            result = assess(path, task)
+            rounds.append(time.process_time() - started)
+            started = time.process_time()
+            result.write_report(folder / "report.html")
+            report.append(time.process_time() - started)
+        yield {
+            "benchmark": "assessment_speed",
+            "session_s": seconds,
+            "frames": summary["frames"],
+            "voxels_removed": summary["voxels_removed"],
+            "cpu_s": round(float(np.median(rounds)), 3),
+            "worst_cpu_s": round(max(rounds), 3),
+            "target_cpu_s": 20.0,
+            "report_cpu_s": round(float(np.median(report)), 3),
+            "report_worst_cpu_s": round(max(report), 3),
+            "visibility_frames": result.data["visibility"]["frames"],
+            "record_cpu_s": round(record_cpu, 1),
+            "what": "assessing a 1 kHz session with 20 Hz stereo (320x240 rgb+depth) recorded on "
+            "the 128^3 phantom against the cortical mastoidectomy task; median and worst of 3, "
+            "process CPU time; the report (renders of the cavity) on top",
+            "quick": args.quick,
+        }
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
+
+
 BENCHMARKS = {
     "training_discrimination": discrimination,
     "training_offline_metrics": offline_metrics,
+    "assessment_discrimination": assessment_discrimination,
+    "assessment_speed": assessment_speed,
 }

@@ -6,6 +6,7 @@
 #include "ambfplus/plugin/registry.h"
 #include "ambfplus/render/renderer.h"
 #include "ambfplus/scene/world.h"
+#include "ambfplus/training/live_metrics.h"
 
 namespace ambfplus::engine {
 
@@ -17,6 +18,7 @@ void install_systems(World& world) {
   world.add_system(physics::make_physics(world));
   world.add_system(haptics::make_device_system());
   world.add_system(haptics::make_drill_system());
+  world.add_system(training::make_training_system());
   world.add_system(render::make_renderer(world));
   world.add_system(std::make_unique<PluginRegistry>(world));
 }

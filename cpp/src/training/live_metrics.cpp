@@ -1,0 +1,115 @@
+#include "ambfplus/training/live_metrics.h"
+
+#include <time.h>
+
+#include <algorithm>
+
+#include "ambfplus/errors.h"
+#include "ambfplus/haptics/drill.h"
+#include "ambfplus/scene/volume.h"
+#include "ambfplus/scene/world.h"
+
+namespace ambfplus {
+namespace {
+
+double thread_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+}  // namespace
+
+LiveMetrics::LiveMetrics(Drill& drill, MetricsConfig config)
+    : drill_(&drill), metrics_(*drill.volume().data(), [&] {
+        // The drill removes the voxels itself.
+        config.apply_removals = false;
+        return std::move(config);
+      }()) {}
+
+void LiveMetrics::tick(const StepContext& context) {
+  if (drill_ == nullptr) return;
+  const double started = thread_cpu_seconds();
+  const Drill& d = *drill_;
+  tick_.step = context.step;
+  tick_.time = context.time;
+  tick_.dt = context.dt;
+  const Eigen::Isometry3d volume_from_world = d.volume().pose().inverse();
+  tick_.tip = volume_from_world * d.pose().translation();
+  tick_.force = d.force();
+  tick_.burr_radius = d.burr_radius();
+  tick_.burr_on = d.on();
+  tick_.removed.clear();
+  tick_.removed_labels.clear();
+  // This step's voxels are the newest of the drill's log.
+  const auto& removed = d.removed();
+  auto first = removed.end();
+  while (first != removed.begin() && std::prev(first)->step == context.step) --first;
+  for (auto it = first; it != removed.end(); ++it) {
+    tick_.removed.push_back(it->voxel);
+    tick_.removed_labels.push_back(it->label);
+  }
+  metrics_.add(tick_);
+  tick_cpu_seconds_.push_back(thread_cpu_seconds() - started);
+  if (tick_cpu_seconds_.size() > kTickHistory) tick_cpu_seconds_.pop_front();
+}
+
+namespace training {
+namespace {
+
+class TrainingSystem : public System {
+ public:
+  const char* name() const override { return "training"; }
+  unsigned stages() const override { return stage_bit(StepStage::kHaptics); }
+  void object_removed(Object& object) override {
+    for (auto& m : metrics_) {
+      if (m->active() && &m->drill() == &object) m->detach();
+    }
+  }
+  void detach_all() override {
+    for (auto& m : metrics_) m->detach();
+  }
+  void run(StepStage, const StepContext& context) override {
+    for (auto& m : metrics_) m->tick(context);
+  }
+  LiveMetrics& add(Drill& drill, MetricsConfig config) {
+    metrics_.push_back(std::make_unique<LiveMetrics>(drill, std::move(config)));
+    return *metrics_.back();
+  }
+  void remove(const LiveMetrics& metrics) {
+    metrics_.erase(std::remove_if(metrics_.begin(), metrics_.end(),
+                                  [&](const auto& m) { return m.get() == &metrics; }),
+                   metrics_.end());
+  }
+
+ private:
+  std::vector<std::unique_ptr<LiveMetrics>> metrics_;
+};
+
+}  // namespace
+
+std::unique_ptr<System> make_training_system() { return std::make_unique<TrainingSystem>(); }
+
+}  // namespace training
+
+LiveMetrics& add_live_metrics(World& world, Drill& drill, MetricsConfig config) {
+  auto* system = world.find_system<training::TrainingSystem>();
+  if (system == nullptr) {
+    throw StateError("world '" + world.name() + "' has no training system (not an engine world)");
+  }
+  if (&drill.world() != &world) {
+    throw ArgumentError("add_live_metrics: drill '" + drill.name() + "' is not in world '" +
+                        world.name() + "'");
+  }
+  auto lock = world.lock_state_for_copy();
+  return system->add(drill, std::move(config));
+}
+
+void remove_live_metrics(World& world, const LiveMetrics& metrics) {
+  auto* system = world.find_system<training::TrainingSystem>();
+  if (system == nullptr) return;
+  auto lock = world.lock_state_for_copy();
+  system->remove(metrics);
+}
+
+}  // namespace ambfplus

@@ -1,0 +1,74 @@
+"""Live skill metrics: the engine feeds them at every step, and they equal the offline
+assessment of the session's recording (the same code, fed from the recording)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import ambfplus
+from ambfplus.scenes import record_session
+from ambfplus.training import NOVICE, assess, load_task, novice_like, task_setup
+from ambfplus.training.trainees import _trainee_on_phantom
+
+TASK = {
+    "version": 1,
+    "name": "Live",
+    "anatomy": {"phantom": {"resolution": 128, "seed": 0}},
+    "target": {"labels": ["Bone"], "box": {"min": [-10, -8, 7.5], "max": [1, 8, 13]}},
+    "protect": [
+        {"structure": "Facial_Nerve", "margin": 1.0},
+        {"structure": "EAC", "margin": 2.0},
+    ],
+}
+
+
+def same(live, offline, path="summary"):
+    """Equal, floats to 1e-9 relative (sums of the same terms may round differently)."""
+    if isinstance(live, dict):
+        assert live.keys() == offline.keys(), path
+        for key in live:
+            same(live[key], offline[key], f"{path}.{key}")
+    elif isinstance(live, list):
+        assert len(live) == len(offline), path
+        for i, (a, b) in enumerate(zip(live, offline)):
+            same(a, b, f"{path}[{i}]")
+    elif isinstance(live, float) and not (math.isinf(live) or offline is None):
+        assert live == pytest.approx(offline, rel=1e-9, abs=1e-12), path
+    else:
+        assert live == offline, path
+
+
+def test_live_metrics_equal_the_offline_assessment(tmp_path):
+    task = load_task(TASK)
+    setup = task_setup(task, NOVICE)
+    scene, device = _trainee_on_phantom(novice_like, 4, 6.0, setup["protect"], 128,
+                                        setup["region"], 0.03, setup["burr"], 160, 120)  # fmt: skip
+    data = scene.drill.volume.data
+    live = ambfplus.live_metrics(scene.drill, protect=task.protect_config(data),
+                                 target_mask=task.target_mask(data),
+                                 excess_force=task.excess_force)  # fmt: skip
+    path = tmp_path / "live.h5"
+    record_session(scene, path, device, 6.0, capture_every=200, passes=("depth",))
+    summary = live.summary()
+    assert summary["ticks"] == 6000 and sum(summary["removed_by_label"].values()) > 100
+    assert any(s["contacts"] for s in summary["structures"])  # the novice came near the canal
+    offline = assess(path, task).data["metrics"]
+    offline.pop("removed_by_name")
+    same(summary, offline)
+    costs = live.tick_cpu_seconds
+    assert len(costs) == 6000 and np.all(costs >= 0)
+
+
+def test_live_metrics_check_their_config_and_count_every_step():
+    scene = ambfplus.scenes.drilling_phantom(resolution=32, width=64, height=48)
+    with pytest.raises(ambfplus.NotFound, match="Facial nerve"):
+        ambfplus.live_metrics(scene.drill, protect=[{"labels": "Facial nerve", "margin": 0.001}])
+    live = ambfplus.live_metrics(scene.drill, protect=[{"labels": "Facial_Nerve"}])
+    scene.world.step(5)
+    later = ambfplus.live_metrics(scene.drill, excess_force=1.0)
+    scene.world.step(7)
+    assert live.active and live.summary()["ticks"] == 12 and later.summary()["ticks"] == 7
+    assert live.summary()["total_time"] == pytest.approx(0.012)

@@ -5,6 +5,7 @@ long session costs.
     python tests/benchmarks/run.py --only training_offline_metrics
     python tests/benchmarks/run.py --only assessment_discrimination
     python tests/benchmarks/run.py --only assessment_speed
+    python tests/benchmarks/run.py --only live_metrics_tick
 
 training_discrimination: 20 expert-like and 20 novice-like sessions (seeds 100.. and 200..,
 none of the tests' seeds) of 20 s on the 128^3 phantom; for each metric, the ROC AUC of telling
@@ -25,6 +26,11 @@ assessment_speed: a 10-minute novice-like session at 1 kHz with stereo at 20 Hz 
 and depth) recorded on the 128^3 phantom, then assessed against the cortical mastoidectomy task
 (metrics, target, exposure, burr visibility from every frame with cutting, rubric, timeline):
 CPU seconds (median and worst of 3), target 20 s; and the report on top.
+
+live_metrics_tick: what live skill metrics add to a haptic tick, measured in C++ (the thread's
+CPU time around each tick's metrics, LiveMetrics.tick_cpu_seconds) over the last 16384 ticks of
+a 20 s novice-like session on the cortical mastoidectomy task (three protected structures, the
+target mask): median, p99 and max; target p99 <= 5 us.
 """
 
 from __future__ import annotations
@@ -232,7 +238,44 @@ def assessment_speed(args):
         shutil.rmtree(folder, ignore_errors=True)
 
 
+def live_metrics_tick(args):
+    from ambfplus.training import NOVICE, task_setup
+    from ambfplus.training.trainees import _trainee_on_phantom
+
+    seconds = 8.0 if args.quick else 20.0
+    task = builtin_task("cortical_mastoidectomy")
+    setup = task_setup(task, NOVICE)
+    scene, device = _trainee_on_phantom(novice_like, 11, seconds, setup["protect"],
+                                        setup["resolution"], setup["region"], 0.03,
+                                        setup["burr"], 160, 120)  # fmt: skip
+    world, drill = scene.world, scene.drill
+    data = drill.volume.data
+    live = ambfplus.live_metrics(drill, protect=task.protect_config(data),
+                                 target_mask=task.target_mask(data),
+                                 excess_force=task.excess_force)  # fmt: skip
+    world.add_input_device(scene.device_name, device, drill, **scene.device_options)
+    world.step(int(round(seconds / world.time_step)))
+    costs = np.asarray(live.tick_cpu_seconds) * 1e6
+    drill_costs = np.asarray(drill.tick_cpu_seconds)[-len(costs) :] * 1e6
+    yield {
+        "benchmark": "live_metrics_tick",
+        "ticks": int(len(costs)),
+        "us_median": round(float(np.median(costs)), 3),
+        "us_p99": round(float(np.percentile(costs, 99)), 3),
+        "us_max": round(float(costs.max()), 3),
+        "target_us_p99": 5.0,
+        "drill_tick_us_median": round(float(np.median(drill_costs)), 3),
+        "drill_tick_us_p99": round(float(np.percentile(drill_costs, 99)), 3),
+        "voxels_removed": int(sum(live.summary()["removed_by_label"].values())),
+        "what": "CPU time live skill metrics add to each haptic tick (C++, thread CPU clock), "
+        "last 16384 ticks of a novice-like session on the cortical mastoidectomy task; the "
+        "drill's own tick beside it",
+        "quick": args.quick,
+    }
+
+
 BENCHMARKS = {
+    "live_metrics_tick": live_metrics_tick,
     "training_discrimination": discrimination,
     "training_offline_metrics": offline_metrics,
     "assessment_discrimination": assessment_discrimination,

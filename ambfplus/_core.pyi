@@ -2414,6 +2414,10 @@ class LiveMetrics:
     """
     Skill metrics of a drill measured live: its world feeds them at every step, through the code the offline assessment runs (ambfplus.live_metrics starts them).
     """
+    def clearances(self) -> list:
+        """
+        Each protected structure's distance (metres; None once it is gone) from the burr where it is now, with its margin: [{'name', 'margin', 'distance'}].
+        """
     def summary(self) -> dict:
         """
         The metrics so far, as SkillMetrics.summary() gives them.

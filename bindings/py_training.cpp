@@ -314,6 +314,26 @@ void define_training(py::module_& m) {
                                        std::vector<double>(t.begin(), t.end()).data());
           },
           "CPU seconds the metrics added to each of the last ticks (up to 16384).")
+      .def(
+          "clearances",
+          [](const LiveMetrics& l) {
+            const auto all = [&] {
+              py::gil_scoped_release release;
+              auto lock = l.drill().world().lock_state_for_copy();
+              return l.clearances();
+            }();
+            py::list out;
+            for (const auto& c : all) {
+              py::dict d;
+              d["name"] = c.name;
+              d["margin"] = c.margin;
+              d["distance"] = finite_or_none(c.distance);
+              out.append(d);
+            }
+            return out;
+          },
+          "Each protected structure's distance (metres; None once it is gone) from the burr "
+          "where it is now, with its margin: [{'name', 'margin', 'distance'}].")
       .def_property_readonly("active", &LiveMetrics::active,
                              "Whether the metrics are still fed (their drill is in the world).");
 

@@ -49,6 +49,5 @@ def run_headless(args: argparse.Namespace, plugin_args: list[str]) -> int:
     finally:
         session.stop_live()
         session.drain()
-        if session.recorder is not None:
-            session.recorder.close()
+        session.finish()
     return 0

@@ -84,6 +84,14 @@ def build_parser() -> argparse.ArgumentParser:
         help="live view: the most images per second (default: --foxglove-rate); rendering may "
         "make fewer",
     )
+    p.add_argument("--task", help="a training task (YAML file, or cortical_mastoidectomy / "
+                   "facial_recess on the built-in phantom): its metrics live on screen (time, "
+                   "burr, force, the nearest protected structure, violations)")  # fmt: skip
+    p.add_argument("--report", type=Path, help="with --task: write the debrief report (HTML) "
+                   "here when the session ends (the session is recorded beside it unless "
+                   "--record names a file)")  # fmt: skip
+    p.add_argument("--metrics", type=Path, help="with --task: write the live metrics (JSON) "
+                   "here when the session ends")  # fmt: skip
     p.add_argument("--seconds", type=float, help="quit after this many seconds")
     p.add_argument("--status", type=Path, help="write the status (JSON) here as it changes")
     p.add_argument("--latency-log", type=Path, help="log key-to-screen latencies (JSON lines)")

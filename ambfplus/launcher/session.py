@@ -80,16 +80,77 @@ class LaunchSession:
             self.binding = self.world.add_input_device("keyboard", self.device, self.drill,
                                                        **options)  # fmt: skip
         self.initial_goal = self.drill.goal.copy() if self.drill is not None else None
+        self.task, self.metrics = self._task(args)
+        self.report, self.metrics_path = args.report, args.metrics
+        self.record_path = args.record
+        if self.report is not None and self.record_path is None:
+            self.record_path = self.report.with_suffix(".h5")
+        self.started_time = self.world.time
         self.loop = RealTimeLoop(self.world, rate=args.phx_frequency)
         self.recorder: Recorder | None = None
-        if args.record is not None:
-            self.start_recording(args.record)
+        if self.record_path is not None:
+            self.start_recording(self.record_path)
         self.live: FoxgloveServer | None = None
         self.live_options: dict[str, Any] | None = None
         if args.foxglove is not None:
             self.live_options = {"port": args.foxglove, "host": args.foxglove_host,
                                  "rate": args.foxglove_rate,
                                  "image_rate": args.foxglove_image_rate}  # fmt: skip
+
+    def _task(self, args: argparse.Namespace):
+        """--task: the task, checked against the launched anatomy, and its live metrics."""
+        if args.task is None:
+            if args.report is not None or args.metrics is not None:
+                raise SystemExit("ambfplus-launch: --report and --metrics need --task")
+            return None, None
+        from .._core import ConfigError, live_metrics
+        from ..training import load_task
+
+        if self.drill is None:
+            raise SystemExit(f"ambfplus-launch: --task: {args.launch or args.launch_file} has "
+                             "no drill to measure")  # fmt: skip
+        try:
+            task = load_task(args.task)
+            data = self.drill.volume.data
+            if task.anatomy:
+                import numpy as np
+
+                expected = task.anatomy_data()
+                if tuple(expected.shape) != tuple(data.shape) or not np.array_equal(
+                    np.asarray(expected.labels), np.asarray(data.labels)
+                ):
+                    raise SystemExit(f"ambfplus-launch: --task: {task.source}: the task's "
+                                     f"anatomy is not the launched volume "
+                                     f"'{self.drill.volume.name}'")  # fmt: skip
+            metrics = live_metrics(self.drill, protect=task.protect_config(data),
+                                   target_mask=task.target_mask(data) if task.target else None,
+                                   excess_force=task.excess_force)  # fmt: skip
+        except (ConfigError, OSError) as error:
+            raise SystemExit(f"ambfplus-launch: --task: {error}") from None
+        return task, metrics
+
+    def finish(self) -> None:
+        """The session's end: the recording closed, then --metrics and --report written."""
+        if self.recorder is not None:
+            self.recorder.close()
+            self.recorder = None
+        if self.metrics is None:
+            return
+        import json
+
+        from ..fileio import write_text
+
+        summary = self.metrics.summary()
+        if self.metrics_path is not None:
+            write_text(self.metrics_path, json.dumps(summary, indent=1) + "\n")
+            print(f"ambfplus-launch: live metrics: {self.metrics_path}", flush=True)
+        if self.report is not None:
+            from ..training import assess
+
+            result = assess(self.record_path, self.task)
+            result.write_report(self.report)
+            print(f"ambfplus-launch: debrief report: {self.report} (score "
+                  f"{result.score:.0f} / 100)", flush=True)  # fmt: skip
 
     def start_live(self) -> None:
         """Starts the Foxglove live view (--foxglove), once the real-time loop runs."""
@@ -140,6 +201,27 @@ class LaunchSession:
 
         drain(self.world, self.drill, self.recorder)
 
+    def _task_status(self, status: Status) -> None:
+        import math
+
+        import numpy as np
+
+        assert self.task is not None and self.metrics is not None and self.drill is not None
+        summary = self.metrics.summary()
+        status.task = self.task.name
+        status.elapsed_s = summary["total_time"]
+        status.force_n = float(np.linalg.norm(self.drill.force))
+        near = [c for c in self.metrics.clearances() if c["distance"] is not None]
+        if near:
+            c = min(near, key=lambda c: c["distance"] - c["margin"])
+            status.nearest, status.nearest_mm = c["name"], c["distance"] * 1000
+            status.nearest_margin_mm = c["margin"] * 1000
+        else:
+            status.nearest, status.nearest_mm = "", math.inf
+        status.violations = sum(
+            s["contacts"] + (s["voxels_removed"] > 0) for s in summary["structures"]
+        )
+
     def reset_volumes(self) -> None:
         with self.world.lock():
             for volume in self.world.volumes:
@@ -172,6 +254,8 @@ class LaunchSession:
         if distances:
             name, distance = min(distances.items(), key=lambda kv: kv[1])
             status.critical, status.critical_mm = name, distance * 1000
+        if self.metrics is not None:
+            self._task_status(status)
         events = self.drill.events
         cut = [e for e in events if e["kind"] == "critical"]
         if cut or status.critical_mm < WARN_DISTANCE * 1000:

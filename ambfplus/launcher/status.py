@@ -28,6 +28,30 @@ class Status:
     cpu_s_per_frame: float = 0.0
     frames: int = 0
     drill_position: list = field(default_factory=list)
+    # With --task: the task's live metrics.
+    task: str = ""
+    elapsed_s: float = 0.0
+    force_n: float = 0.0
+    nearest: str = ""
+    nearest_mm: float = math.inf
+    nearest_margin_mm: float = 0.0
+    violations: int = 0
+
+    @property
+    def level(self) -> str:
+        """The nearest protected structure: "clear", "near" (within twice its margin) or
+        "inside" its margin."""
+        if not math.isfinite(self.nearest_mm) or self.nearest_mm > 2 * self.nearest_margin_mm:
+            return "clear"
+        return "inside" if self.nearest_mm <= self.nearest_margin_mm else "near"
+
+    def task_line(self) -> str:
+        if not self.task:
+            return ""
+        near = (f"{self.nearest} {self.nearest_mm:.1f} mm (margin {self.nearest_margin_mm:g})"
+                if math.isfinite(self.nearest_mm) else "no structure near")  # fmt: skip
+        return (f"{self.task} | {self.elapsed_s:.0f} s | force {self.force_n:.1f} N | {near} | "
+                f"violations {self.violations}")  # fmt: skip
 
     def lines(self) -> list[str]:
         burr = f"burr {self.burr_mm:g} mm {'ON' if self.spinning else 'off'}"
@@ -37,7 +61,9 @@ class Status:
             else "no critical structure"
         )
         rates = f"graphics {self.fps:.1f} fps | physics {self.physics_hz:.0f} Hz"
-        return [f"{burr} | {self.mode} | {critical} | {rates}"]
+        return [f"{burr} | {self.mode} | {critical} | {rates}"] + (
+            [self.task_line()] if self.task else []
+        )
 
 
 def draw_overlay(status: Status, width: int, height: int) -> np.ndarray:
@@ -48,11 +74,21 @@ def draw_overlay(status: Status, width: int, height: int) -> np.ndarray:
     draw = ImageDraw.Draw(image)
     font = _font(16)
     y: float = 8
+    colours = {"clear": (120, 230, 120, 255), "near": (255, 200, 60, 255),
+               "inside": (255, 90, 90, 255)}  # fmt: skip
     for line in status.lines():
         box = draw.textbbox((10, y), line, font=font)
         draw.rectangle((box[0] - 4, box[1] - 3, box[2] + 4, box[3] + 3), fill=(0, 0, 0, 140))
-        draw.text((10, y), line, font=font, fill=(255, 255, 255, 255))
+        task = bool(status.task) and line == status.task_line()
+        colour = colours[status.level] if task else (255, 255, 255, 255)
+        draw.text((10, y), line, font=font, fill=colour)
         y = box[3] + 8
+        if task:  # the force bar: 0..10 N, red past the task's excess force
+            width_n = 24
+            draw.rectangle((10, y, 10 + 10 * width_n, y + 8), outline=(255, 255, 255, 200))
+            filled = min(status.force_n, 10.0) * width_n
+            draw.rectangle((10, y, 10 + filled, y + 8), fill=colour)
+            y += 16
     if status.warning:
         big = _font(28)
         box = draw.textbbox((0, 0), status.warning, font=big)

@@ -144,8 +144,7 @@ def run_window(glfw, args: argparse.Namespace, plugin_args: list[str]) -> int:
                     last_status = current
     session.stop_live()
     session.drain()
-    if session.recorder is not None:
-        session.recorder.close()
+    session.finish()
     if latency_log is not None:
         latency_log.close()
     return 0

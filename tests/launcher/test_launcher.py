@@ -119,3 +119,58 @@ def test_mouse_navigation_turns_about_the_target_pans_and_zooms():
         np.linalg.norm(zoomed[:3, 3] - orbit.target), distance * (1 - orbit.zoom) ** 2, rtol=1e-12
     )
     np.testing.assert_array_equal(zoomed[:3, :3], camera.pose[:3, :3])
+
+
+@pytest.mark.slow
+def test_a_task_session_shows_its_metrics_and_they_equal_the_offline_assessment(
+    fixtures, display, tmp_path
+):
+    """--task on the original drilling scene: the overlay's task line, the live metrics written
+    at the end equal the offline assessment of the session's recording, and the debrief."""
+    from ambfplus.training import assess, load_task
+
+    launch_file = fixtures / "volumetric_drilling" / "launch.yaml"
+    ear = fixtures / "volumetric_drilling"
+    task_file = tmp_path / "task.yaml"
+    task_file.write_text(
+        "version: 1\nname: Ear drilling\n"
+        f"anatomy: {{file: {ear / 'ADF' / 'volume_256.yaml'}, labels: {ear / 'labels.csv'}}}\n"
+        "target: {labels: [Bone]}\n"
+        "protect:\n  - {structure: Facial_Nerve, margin: 1.0}\n"
+        "  - {structure: Sinus_+_Dura, margin: 1.0}\n"
+    )
+    record, metrics, report = tmp_path / "s.h5", tmp_path / "live.json", tmp_path / "d.html"
+    process, status_file, _ = launch(display, tmp_path, launch_file, 14, "--record", str(record),
+                                     "--task", str(task_file), "--metrics", str(metrics),
+                                     "--report", str(report))  # fmt: skip
+    xdo(display, "key", "space")
+    xdo(display, "key", "--delay", "20", "--repeat", "85", "ctrl+i")
+    time.sleep(2.0)
+    shot = screenshot(display)
+    output = finish(process)
+    status = json.loads(status_file.read_text())
+    assert status["task"] == "Ear drilling" and status["elapsed_s"] > 1, output
+    assert status["nearest"] in ("Facial_Nerve", "Sinus_+_Dura")
+    assert shot[:80].std() > 5  # the status lines over the view
+    live = json.loads(metrics.read_text())
+    offline = assess(record, load_task(task_file)).data["metrics"]
+    offline = json.loads(json.dumps({k: v for k, v in offline.items() if k != "removed_by_name"}))
+    assert sum(live["removed_by_label"].values()) > 100, "the session drilled"
+    assert_same(live, offline)
+    assert report.is_file() and "Debrief: Ear drilling" in report.read_text()
+
+
+def assert_same(live, offline, path="metrics"):
+    """Equal, floats to 1e-9 relative (sums of the same terms may round differently)."""
+    if isinstance(live, dict):
+        assert live.keys() == offline.keys(), path
+        for key in live:
+            assert_same(live[key], offline[key], f"{path}.{key}")
+    elif isinstance(live, list):
+        assert len(live) == len(offline), path
+        for i, (a, b) in enumerate(zip(live, offline)):
+            assert_same(a, b, f"{path}[{i}]")
+    elif isinstance(live, float) and isinstance(offline, float):
+        assert live == pytest.approx(offline, rel=1e-9, abs=1e-12), path
+    else:
+        assert live == offline, path

@@ -3,6 +3,7 @@
 #include <time.h>
 
 #include <algorithm>
+#include <limits>
 
 #include "ambfplus/errors.h"
 #include "ambfplus/haptics/drill.h"
@@ -34,8 +35,7 @@ void LiveMetrics::tick(const StepContext& context) {
   tick_.step = context.step;
   tick_.time = context.time;
   tick_.dt = context.dt;
-  const Eigen::Isometry3d volume_from_world = d.volume().pose().inverse();
-  tick_.tip = volume_from_world * d.pose().translation();
+  tick_.tip = tip();
   tick_.force = d.force();
   tick_.burr_radius = d.burr_radius();
   tick_.burr_on = d.on();
@@ -52,6 +52,21 @@ void LiveMetrics::tick(const StepContext& context) {
   metrics_.add(tick_);
   tick_cpu_seconds_.push_back(thread_cpu_seconds() - started);
   if (tick_cpu_seconds_.size() > kTickHistory) tick_cpu_seconds_.pop_front();
+}
+
+Eigen::Vector3d LiveMetrics::tip() const {
+  return drill_->volume().pose().inverse() * drill_->pose().translation();
+}
+
+std::vector<LiveMetrics::Clearance> LiveMetrics::clearances() const {
+  std::vector<Clearance> out;
+  const auto& protect = metrics_.config().protect;
+  for (std::size_t s = 0; s < protect.size(); ++s) {
+    const double d = drill_ == nullptr ? std::numeric_limits<double>::infinity()
+                                       : metrics_.clearance(s, tip(), drill_->burr_radius());
+    out.push_back({protect[s].name, protect[s].margin, d});
+  }
+  return out;
 }
 
 namespace training {

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <deque>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "ambfplus/export.h"
@@ -30,6 +31,14 @@ class AMBFPLUS_API LiveMetrics {
   void tick(const StepContext& context);
   MetricsSummary summary() const { return metrics_.summary(); }
   const SkillMetrics& metrics() const { return metrics_; }
+  /// Each protected structure's distance (metres) from the burr where it is now, with its
+  /// margin, in the config's order (infinite once the structure is gone).
+  struct Clearance {
+    std::string name;
+    double margin = 0.0;
+    double distance = 0.0;
+  };
+  std::vector<Clearance> clearances() const;
   /// CPU time of the thread for the last ticks (up to kTickHistory), seconds: what the metrics
   /// add to a haptic tick.
   const std::deque<double>& tick_cpu_seconds() const { return tick_cpu_seconds_; }
@@ -39,6 +48,7 @@ class AMBFPLUS_API LiveMetrics {
   void detach() { drill_ = nullptr; }
 
  private:
+  Eigen::Vector3d tip() const;  // the burr's centre, volume frame
   Drill* drill_;
   SkillMetrics metrics_;
   ToolTick tick_;

@@ -108,6 +108,22 @@ def write_previews(out: Path, frame, world) -> dict:
     }
 
 
+def _debrief(path: Path, out: Path, resolution: int) -> str:
+    """The session assessed as a cortical mastoidectomy (the shipped task is on the 128^3
+    phantom): debrief.html and assessment.json. Returns what the summary line lists."""
+    if resolution != 128:
+        print("no debrief: the shipped tasks are on the 128^3 phantom")
+        return ""
+    from ..training import assess
+
+    result = assess(path, "cortical_mastoidectomy")
+    result.write_report(out / "debrief.html")
+    result.write_json(out / "assessment.json")
+    print(f"debrief: score {result.score:.0f} / 100 as a cortical mastoidectomy, "
+          f"{len(result.data['violations'])} violations (debrief.html)")  # fmt: skip
+    return ", debrief.html, assessment.json"
+
+
 def run_demo(out: Path, width: int, height: int, resolution: int, every: int) -> int:
     """A headless drilling session on the built-in phantom: scripted plunges at three sites
     while the stereo rig circles, recorded, validated, and previewed as PNG files."""
@@ -148,6 +164,7 @@ def run_demo(out: Path, width: int, height: int, resolution: int, every: int) ->
         meta = write_previews(out, last.left, scene.world)
     meta["recording"] = {"path": str(path), **summary}
     (out / "frame.json").write_text(json.dumps(meta, indent=2))
+    debrief = _debrief(path, out, resolution)
     covered = last.left.depth > 0
     coverage = float(covered.mean())
     contrast = float(last.left.rgb[covered].std()) if covered.any() else 0.0
@@ -155,7 +172,7 @@ def run_demo(out: Path, width: int, height: int, resolution: int, every: int) ->
         f"wrote {out}: session.h5 ({summary['frames']} stereo frames, {summary['steps']} steps, "
         f"{summary['voxels_removed']} voxels removed), montage.png, rgb.png, right_rgb.png, "
         f"depth.png, depth_preview.png, label.png, label_preview.png, segmentation.png, "
-        f"frame.json; the anatomy covers {coverage:.1%} of the last view"
+        f"frame.json{debrief}; the anatomy covers {coverage:.1%} of the last view"
     )
     problems = []
     if not report.ok:

@@ -80,7 +80,7 @@ def cavity_views(assessment, width: int = 480, height: int = 360) -> dict[str, n
             background=(0.12, 0.12, 0.14),
         )
         views["surgeon"] = np.array(surgeon.capture(passes=["rgb"]).rgb)
-    distance = 1.6 * size / math.tan(0.3) / 2
+    distance = 1.15 * (size / 2) / math.tan(0.3)  # the anatomy fills the view
     up_z = np.array([0.0, 0.0, 1.0])
     standard = {
         "lateral": (np.array([0.0, -0.2, 1.0]), np.array([0.0, 1.0, 0.0])),

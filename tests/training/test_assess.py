@@ -256,3 +256,24 @@ def test_a_cohort_table_and_group_report(sessions, tmp_path):
     bad.write_text("session,participant,date\nx.h5,a,2026\n")
     with pytest.raises(ValueError, match="bad.csv: the CSV has no column 'group'"):
         assess_cohort(bad, task)
+
+
+def test_every_kind_of_recording_is_assessed(sessions, reference_dataset, tmp_path):
+    """A replay (the same removal, so the same metrics), a dataset episode and the demo."""
+    from ambfplus.cli.demo import run_demo
+    from ambfplus.scenes import replay
+
+    task, paths = sessions
+    replayed = tmp_path / "replay.h5"
+    replay(paths["novice"], out=replayed, compare_images=False)
+    original, again = assess(paths["novice"], task), assess(replayed, task)
+    assert again.data["session"]["kind"] == "replay"
+    assert again.data["metrics"] == original.data["metrics"]
+    episode = sorted(reference_dataset.glob("shards/episode_*.h5"))[0]
+    result = assess(episode)  # no task: every critical structure protected by 1 mm
+    assert result.data["session"]["kind"] == "dataset episode"
+    assert result.data["metrics"]["ticks"] > 0 and result.data["metrics"]["structures"]
+    assert run_demo(tmp_path / "demo", 160, 120, 128, 200) == 0
+    demo = json.loads((tmp_path / "demo" / "assessment.json").read_text())
+    assert demo["session"]["kind"] == "demo" and demo["task"]["name"] == "Cortical mastoidectomy"
+    assert (tmp_path / "demo" / "debrief.html").stat().st_size > 10000

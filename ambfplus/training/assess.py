@@ -96,6 +96,7 @@ def load_session(path) -> SessionData:
             "poses": np.asarray(columns["pose"][:], float),
             "depth": (lambda i: columns["depth"][i]) if "depth" in columns else (lambda i: None),
             "rgb": (lambda i: columns["rgb"][i]) if "rgb" in columns else (lambda i: None),
+            "label": (lambda i: columns["label"][i]) if "label" in columns else None,
         }
     return SessionData(
         path=path,
@@ -291,6 +292,7 @@ def assess(session, task=None, references=(), *, measure_visibility: bool = True
             s.drill,
             ticks["burr_radii"],
             cutting,
+            label=c["label"],
         )
     protected = None
     if task.protect and ref_cavities:

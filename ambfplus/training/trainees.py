@@ -433,7 +433,7 @@ def record_trainee(
     task=None,
     *,
     capture_every: int = 50,
-    passes=("rgb", "depth"),
+    passes=("rgb", "depth", "label"),
     width: int = 320,
     height: int = 240,
     **setup,

@@ -3,8 +3,9 @@ burr against that camera's depth image at the frame's step.
 
 The burr (a sphere) is visible in a frame where, at some pixel its silhouette covers, the first
 surface the camera sees is not in front of the burr: the depth there is at least the depth of
-the burr's nearest point less a tolerance (the burr itself, or something behind it). Bone, a
-tool or anything else between the camera and the whole burr hides it.
+the burr's nearest point less a tolerance (the burr itself, or something behind it). With the
+frame's anatomy labels (the `label` pass), only anatomy hides the burr, so the drill's own shaft
+in front of it does not; without them, anything between the camera and the whole burr hides it.
 """
 
 from __future__ import annotations
@@ -23,10 +24,12 @@ def burr_visible(
     centre,
     radius: float,
     tolerance: float = DEPTH_TOLERANCE,
+    label: np.ndarray | None = None,
 ) -> bool:
     """Whether a burr of `radius` at `centre` (world, metres) is visible in a depth image
     (H x W metres, 0 where nothing was hit) taken by a camera with `intrinsics` (3x3, pixel
-    centres at half-integers) at `camera_pose` (4x4 world from the OpenCV camera frame)."""
+    centres at half-integers) at `camera_pose` (4x4 world from the OpenCV camera frame);
+    `label`: the frame's anatomy labels (0 where no anatomy), so that only anatomy hides."""
     camera_from_world = np.linalg.inv(np.asarray(camera_pose, float))
     x, y, z = camera_from_world[:3, :3] @ np.asarray(centre, float) + camera_from_world[:3, 3]
     if z <= radius:
@@ -44,15 +47,27 @@ def burr_visible(
     inside = (cc + 0.5 - u) ** 2 + (rr + 0.5 - v) ** 2 <= max(r, 0.71) ** 2
     seen = depth[rr[inside], cc[inside]]
     front = z - radius - tolerance
-    return bool(np.any((seen == 0) | (seen >= front)))
+    hides = (seen > 0) & (seen < front)
+    if label is not None:
+        hides &= label[rr[inside], cc[inside]] > 0
+    return bool(np.any(~hides))
 
 
 def visibility(
-    frame_steps, intrinsics, camera_poses, depth, steps: dict, drill: str, burr_radii, cutting
+    frame_steps,
+    intrinsics,
+    camera_poses,
+    depth,
+    steps: dict,
+    drill: str,
+    burr_radii,
+    cutting,
+    label=None,
 ):
     """The fraction of cutting time in which the burr was visible, from the surgeon camera's
     recorded frames: their steps, intrinsics (N, 3, 3) and poses (N, 4, 4), and `depth(i)`
-    giving frame i's depth image (read only for frames that stand for some cutting). Each frame
+    giving frame i's depth image (read only for frames that stand for some cutting), and
+    `label(i)` its anatomy labels where they were recorded (None otherwise). Each frame
     stands for the ticks from its step to the next frame's; `cutting` and `burr_radii` are per
     row of the step log. Returns None without frames."""
     step_index = np.asarray(steps["step"], np.int64)

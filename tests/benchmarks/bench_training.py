@@ -22,8 +22,8 @@ expert-like and 20 novice-like recorded sessions of 20 s (seeds 100.. and 200..;
 completes no target): the ROC AUC of the composite score, and of each rubric item's score (the
 direction every item is expected to move in: an expert scores higher).
 
-assessment_speed: a 10-minute novice-like session at 1 kHz with stereo at 20 Hz (320x240 rgb
-and depth) recorded on the 128^3 phantom, then assessed against the cortical mastoidectomy task
+assessment_speed: a 10-minute novice-like session at 1 kHz with stereo at 20 Hz (320x240 rgb,
+depth and labels) recorded on the 128^3 phantom, then assessed against the cortical mastoidectomy task
 (metrics, target, exposure, burr visibility from every frame with cutting, rubric, timeline):
 CPU seconds (median and worst of 3), target 20 s; and the report on top.
 
@@ -163,7 +163,7 @@ def assessment_discrimination(args):
                 for k in range(n):
                     path = folder / f"{name}_{group}_{k}.h5"
                     record_trainee(make, base + k, 20.0, path, task, capture_every=100,
-                                   passes=("depth",), width=160, height=120)  # fmt: skip
+                                   passes=("depth", "label"), width=160, height=120)  # fmt: skip
                     results[group].append(assess(path, task).data)
             items = {}
             for key in [i["key"] for i in results["expert"][0]["rubric"]]:
@@ -207,7 +207,7 @@ def assessment_speed(args):
         path = folder / "long.h5"
         started = time.process_time()
         summary = record_trainee(novice_like, 7, seconds, path, task, capture_every=50,
-                                 passes=("rgb", "depth"), width=320, height=240)  # fmt: skip
+                                 passes=("rgb", "depth", "label"), width=320, height=240)  # fmt: skip
         record_cpu = time.process_time() - started
         rounds, report = [], []
         for _ in range(3):

@@ -56,7 +56,7 @@ def sessions(tmp_path_factory):
     for name, make in (("expert", expert_like), ("novice", novice_like)):
         paths[name] = folder / f"{name}.h5"
         record_trainee(make, 3, SECONDS, paths[name], task, capture_every=100,
-                       passes=("rgb", "depth"), width=160, height=120)  # fmt: skip
+                       passes=("rgb", "depth", "label"), width=160, height=120)  # fmt: skip
     return task, paths
 
 
@@ -192,17 +192,18 @@ def test_burr_visibility_behind_a_bone_plate(tmp_path):
     drill.pose = pose
     radius = drill.burr_radius
 
-    def seen():
-        frame = camera.capture(passes=["depth"])
-        return burr_visible(frame.depth, camera.intrinsics, camera.pose, below, radius)
+    def seen(labels: bool):
+        frame = camera.capture(passes=["depth", "label"])
+        return burr_visible(frame.depth, camera.intrinsics, camera.pose, below, radius,
+                            label=frame.label if labels else None)  # fmt: skip
 
-    assert not seen()
+    assert not seen(False) and not seen(True)
     # Drill a wide channel from the surface down to the burr, toward the camera.
     eye = np.array(camera.pose)[:3, 3]
     direction = (eye - below) / np.linalg.norm(eye - below)
     for s in np.arange(0.0, 0.012, 0.0005):
         data.remove_sphere(below + direction * (s + radius), 0.0045)
-    assert seen()
+    assert seen(False) and seen(True)
 
 
 def test_the_command_line_writes_json_and_a_report_chromium_shows(sessions, tmp_path):

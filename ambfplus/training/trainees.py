@@ -227,8 +227,8 @@ class ScriptedTrainee:
             depth = layer * p["layer_depth"]
             if depth > region.depth:
                 break
-            shrink = max(0.0, 1.0 - region.taper * depth / max(region.depth, 1e-9))
-            hx, hy = (h * shrink for h in region.half_extent)
+            # Saucerised: the walls slope, each side in by `taper` per metre of depth.
+            hx, hy = (h - region.taper * depth for h in region.half_extent)
             if min(hx, hy) < 0.0005:  # the region has narrowed to nothing
                 break
             rows = max(1, int(2 * hy / p["spacing"]))

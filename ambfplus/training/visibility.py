@@ -86,8 +86,14 @@ def visibility(
         if image is None:
             return None
         row = int(rows[i])
+        labels = label(int(i)) if label is not None else None
         seen = burr_visible(
-            image, intrinsics[i], camera_poses[i], poses[row][:3, 3], float(burr_radii[row])
+            image,
+            intrinsics[i],
+            camera_poses[i],
+            poses[row][:3, 3],
+            float(burr_radii[row]),
+            label=labels,
         )
         judged += 1
         visible += seen

@@ -118,7 +118,7 @@ def test_a_careful_session_has_no_violation_and_outscores_a_novice(sessions):
     assert expert.data["target"]["outside_fraction"] < novice.data["target"]["outside_fraction"]
     # The expert cuts with the task's largest burr; visibility is measured.
     assert expert.data["burrs_cutting"] == [0.006]
-    assert 0.0 <= expert.data["visibility"]["fraction"] <= 1.0
+    assert expert.data["visibility"]["fraction"] > 0.8  # its own shaft does not hide it
 
 
 def test_the_task_must_be_of_the_recordings_anatomy(sessions):

@@ -18,8 +18,8 @@ assessment: 20 s), and per tick.
 
 assessment_discrimination: on each shipped task (cortical mastoidectomy, facial recess), 20
 expert-like and 20 novice-like recorded sessions of 20 s (seeds 100.. and 200..; stereo depth at
-10 Hz, 160x120), assessed against the task with target completion not judged (a 20 s excerpt
-completes no target): the ROC AUC of the composite score, and of each rubric item's score (the
+10 Hz, 160x120), assessed against the task with completion not judged (a 20 s excerpt completes
+neither the target nor the skeletonisation): the ROC AUC of the composite score, and of each rubric item's score (the
 direction every item is expected to move in: an expert scores higher).
 
 assessment_speed: a 10-minute novice-like session at 1 kHz with stereo at 20 Hz (320x240 rgb,
@@ -156,7 +156,10 @@ def assessment_discrimination(args):
     folder = Path(tempfile.mkdtemp(prefix="ambfplus-assess-"))
     try:
         for name in BUILTIN_TASKS:
-            task = builtin_task(name).with_thresholds(min_target_fraction=0.0)
+            # Completion (of the target, of skeletonisation) is not judged on 20 s excerpts.
+            task = builtin_task(name).with_thresholds(
+                min_target_fraction=0.0, min_exposed_fraction=0.0
+            )
             started = time.process_time()
             results = {"expert": [], "novice": []}
             for group, make, base in (("expert", expert_like, 100), ("novice", novice_like, 200)):

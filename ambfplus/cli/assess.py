@@ -49,7 +49,18 @@ def add_parser(commands) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Assesses one session (printing the score and the rubric) or a cohort."""
+    """Assesses one session (printing the score and the rubric) or a cohort; bad input ends it
+    with the message alone."""
+    from .._core import Error
+    from ..recording import RecordingError
+
+    try:
+        return _run(args)
+    except (Error, RecordingError, ValueError, OSError) as error:
+        raise SystemExit(f"ambfplus assess: {error}") from None
+
+
+def _run(args: argparse.Namespace) -> int:
     from ..training import assess, load_task
     from ..training.cohort import assess_cohort, write_group_report, write_table
 

@@ -185,6 +185,9 @@ def load_task(source) -> Task:
     if isinstance(source, str) and source in BUILTIN_TASKS:
         return builtin_task(source)
     path = Path(source)
+    if not path.exists() and isinstance(source, str) and "/" not in source:
+        raise TaskError(f"{source}: no such task file, and no built-in task of that name (the "
+                        f"built-in tasks: {', '.join(BUILTIN_TASKS)})")  # fmt: skip
     data, text = load_yaml(path, TaskError, "task")
     task = parse_task(data, path.resolve().parent, str(path))
     task.text = text

@@ -278,3 +278,16 @@ def test_every_kind_of_recording_is_assessed(sessions, reference_dataset, tmp_pa
     demo = json.loads((tmp_path / "demo" / "assessment.json").read_text())
     assert demo["session"]["kind"] == "demo" and demo["task"]["name"] == "Cortical mastoidectomy"
     assert (tmp_path / "demo" / "debrief.html").stat().st_size > 10000
+
+
+def test_the_command_line_says_what_is_wrong(sessions, tmp_path):
+    _, paths = sessions
+    with pytest.raises(SystemExit, match=r"ambfplus assess: .*none.h5: no such file"):
+        main(["assess", str(tmp_path / "none.h5")])
+    with pytest.raises(SystemExit, match="no built-in task of that name.*cortical_mastoidectomy"):
+        main(["assess", str(paths["expert"]), "--task", "cortical"])
+    other = tmp_path / "other.yaml"
+    other.write_text("version: 1\nname: x\nanatomy: {phantom: {resolution: 64}}\n"
+                     "target: {labels: [Bone]}\n")  # fmt: skip
+    with pytest.raises(SystemExit, match="other.yaml: the task's anatomy .* is not the anatomy"):
+        main(["assess", str(paths["expert"]), "--task", str(other)])

@@ -6,8 +6,8 @@ scenes' ``DrillScript``: it returns the hand's position in the device frame (wor
 from the drill's start) and its buttons (bit 0 spins the burr). It plans the whole session up
 front from the anatomy as it is when planning starts:
 
-- **expert-like**: broad strokes across the target region, layer by layer, each layer a little
-  narrower than the one above (saucerisation), the burr centre kept clear of every protected
+- **expert-like**: broad strokes along the target region's longer side, layer by layer, each
+  layer a little narrower than the one above (saucerisation), the burr centre kept clear of every protected
   structure by its margin and a little more (checked on the structures' distance fields), and a
   light touch (the hand leads the bone surface by a fraction of a millimetre);
 - **novice-like**: plunges at random sites, deep and narrow, pressing hard, with short wiggles
@@ -231,25 +231,35 @@ class ScriptedTrainee:
             hx, hy = (h - region.taper * depth for h in region.half_extent)
             if min(hx, hy) < 0.0005:  # the region has narrowed to nothing
                 break
-            rows = max(1, int(2 * hy / p["spacing"]))
+            # Strokes run along the region's longer side, rows across the shorter one.
+            along, across = (0, 1) if hx >= hy else (1, 0)
+            half = (hx, hy)
+            rows = max(1, int(2 * half[across] / p["spacing"]))
             for row in range(rows + 1):
                 if self._plan.end >= end:
                     break
-                y = region.center[1] - hy + 2 * hy * row / rows
-                xs = np.linspace(region.center[0] - hx, region.center[0] + hx, 24)
+                line = np.empty((24, 2))
+                line[:, across] = (
+                    region.center[across] - half[across] + (2 * half[across] * row / rows)
+                )
+                line[:, along] = np.linspace(
+                    region.center[along] - half[along], region.center[along] + half[along], 24
+                )
                 if row % 2:
-                    xs = xs[::-1]
-                self._stroke(xs, y, depth)
+                    line = line[::-1]
+                self._stroke(line, depth)
 
-    def _stroke(self, xs: np.ndarray, y: float, depth: float) -> None:
-        """One pass along x at height y, `depth` below the surface as it was first found."""
+    def _stroke(self, line: np.ndarray, depth: float) -> None:
+        """One pass through the (x, y) points of `line`, `depth` below the surface as it was
+        first found."""
         r, p = self.burr_radius, self.params
         path = []
-        for x in xs:
-            surface = self._surface(float(x), y)
+        for x, y in line:
+            x, y = float(x), float(y)
+            surface = self._surface(x, y)
             if surface is None:
                 continue
-            centre = np.array([x, y, self._floor(float(x), y) + r - depth - p["press"]])
+            centre = np.array([x, y, self._floor(x, y) + r - depth - p["press"]])
             # Lift the burr where it would come within a margin.
             lifted = centre.copy()
             while not self._clear(lifted) and lifted[2] < surface + r:

@@ -2,10 +2,13 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstdint>
 #include <chrono>
 #include <cmath>
 #include <cstring>
 #include <mutex>
+
+#include <dlfcn.h>
 
 #include "ambfplus/errors.h"
 #include "ambfplus/log.h"
@@ -21,8 +24,25 @@ std::int64_t now_ns() {
       .count();
 }
 
+// Callbacks over which the standing backlog is measured (about 0.17 s at 128 frames, 48 kHz).
+constexpr int kWindow = 64;
+
 // A machine without audio says so once per process, however many players it makes.
 std::atomic<bool> g_said_no_device{false};
+
+// ALSA prints every failed probe of a machine without a card to stderr; the player says why
+// once instead. libasound is the one miniaudio loaded, if it did.
+void alsa_silent(const char*, int, const char*, int, const char*, ...) {}
+void quieten_alsa() {
+  void* alsa = dlopen("libasound.so.2", RTLD_NOW | RTLD_NOLOAD);
+  if (alsa == nullptr) return;
+  using Handler = void (*)(const char*, int, const char*, int, const char*, ...);
+  using SetHandler = int (*)(Handler);
+  if (auto set = reinterpret_cast<SetHandler>(dlsym(alsa, "snd_lib_error_set_handler"))) {
+    set(&alsa_silent);
+  }
+  dlclose(alsa);
+}
 
 void add(std::atomic<std::int64_t>& counter, std::int64_t n = 1) {
   counter.fetch_add(n, std::memory_order_relaxed);
@@ -50,6 +70,10 @@ struct DrillSoundPlayer::Impl {
   std::vector<float> pending;
   int pending_count = 0, pending_at = 0;
   DrillTick last;  // repeated while no tick arrives
+  // The fewest ticks left waiting after a callback, over the last kWindow callbacks: a backlog
+  // that never drains (the queue's standing delay) is dropped once the window closes.
+  std::size_t window_min = SIZE_MAX;
+  int window_callbacks = 0;
   std::atomic<bool> muted{false};
   std::atomic<bool> open{false};
   std::atomic<std::int64_t> pushed{0}, rejected{0}, played{0}, dropped{0}, held{0}, callbacks{0},
@@ -87,6 +111,7 @@ void DrillSoundPlayer::Impl::open_output() {
     failure = std::string("no audio backend opened (") + ma_result_description(result) + ")";
   } else {
     have_context = true;
+    if (!null) quieten_alsa();
     ma_device_config config = ma_device_config_init(ma_device_type_playback);
     config.playback.format = ma_format_f32;
     config.playback.channels = 1;
@@ -179,7 +204,6 @@ bool DrillSoundPlayer::push(DrillTick tick) {
 
 void DrillSoundPlayer::fill(float* out, std::uint32_t frames) {
   Impl& p = *impl_;
-  const std::int64_t start = now_ns();
   add(p.callbacks);
   // Ticks beyond what this callback needs and the allowed backlog are the oldest: dropped.
   const double left = static_cast<double>(frames) - (p.pending_count - p.pending_at);
@@ -203,14 +227,23 @@ void DrillSoundPlayer::fill(float* out, std::uint32_t frames) {
     if (p.ticks.pop(tick)) {
       add(p.played);
       p.last = tick;
-      const double latency = (start - tick.pushed_ns) * 1e-9 + n / double(p.spec.sample_rate);
-      p.latencies.push(latency);  // dropped when nobody takes them
+      // Its first sample goes into the device's buffer now.
+      p.latencies.push((now_ns() - tick.pushed_ns) * 1e-9);  // dropped when nobody takes them
     } else {
       add(p.held);
       tick = p.last;
     }
     p.pending_count = p.synth.render_tick(tick, p.pending.data());
     p.pending_at = 0;
+  }
+  // A standing backlog is latency for nothing: trim it to one tick.
+  p.window_min = std::min(p.window_min, p.ticks.size());
+  if (++p.window_callbacks == kWindow) {
+    for (std::size_t i = 1; i < p.window_min; ++i) {
+      if (p.ticks.pop(tick)) add(p.dropped);
+    }
+    p.window_min = SIZE_MAX;
+    p.window_callbacks = 0;
   }
   if (p.muted.load(std::memory_order_relaxed)) std::fill(out, out + frames, 0.0f);
   if (p.options.capture_frames > 0) {

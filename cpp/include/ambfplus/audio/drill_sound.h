@@ -41,8 +41,9 @@ struct AMBFPLUS_API PlayerOptions {
   /// Frames per audio callback asked of the device (a hint some devices round).
   int period_frames = 128;
   /// Ticks that may wait for the audio thread beyond what its next callback needs; older ones
-  /// are dropped (a world stepped faster than real time), so the latency stays bounded.
-  int max_backlog_ticks = 8;
+  /// are dropped (a world stepped faster than real time), so the latency stays bounded. Enough
+  /// for a device that asks in bursts (miniaudio's null device wakes every 10 ms).
+  int max_backlog_ticks = 16;
   /// Capacity of the tick queue (ticks).
   int queue_ticks = 4096;
   /// Samples played that are kept for take_capture() (tests, benchmarks); 0 keeps none.
@@ -94,9 +95,9 @@ class AMBFPLUS_API DrillSoundPlayer {
   /// Stops the device (pushes are then refused); idempotent.
   void close();
 
-  /// Latencies since the last take, seconds: for each tick played, from its push to the
-  /// moment its first sample is due in the device's buffer (the callback's start plus the
-  /// frames before it in that buffer). One consumer thread at a time.
+  /// Latencies since the last take, seconds: for each tick played, from its push to the moment
+  /// the audio thread writes its first sample into the device's buffer (what the device then
+  /// adds, its own buffering, is not in it). One consumer thread at a time.
   std::vector<double> take_latencies();
   /// The samples played since the last take (after muting), up to options().capture_frames.
   std::vector<float> take_capture();

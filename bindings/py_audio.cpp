@@ -224,7 +224,8 @@ void define_audio(py::module_& m) {
       .def(py::init([](std::shared_ptr<Drill> drill, const std::string& output, bool muted,
                        bool require_device, const py::object& warnings,
                        const py::object& hardness, int sample_rate, int period_frames,
-                       int max_backlog_ticks, double capture_seconds, std::uint64_t seed) {
+                       int max_backlog_ticks, bool trim_backlog, bool paused,
+                       double capture_seconds, std::uint64_t seed) {
              DrillSoundSpec spec;
              spec.sample_rate = sample_rate;
              spec.seed = seed;
@@ -235,6 +236,8 @@ void define_audio(py::module_& m) {
              options.require_device = require_device;
              options.period_frames = period_frames;
              options.max_backlog_ticks = max_backlog_ticks;
+             options.trim_backlog = trim_backlog;
+             options.paused = paused;
              if (!(std::isfinite(capture_seconds) && capture_seconds >= 0 &&
                    capture_seconds <= 600)) {
                throw ArgumentError("DrillSound: capture_seconds must be in 0..600");
@@ -248,21 +251,31 @@ void define_audio(py::module_& m) {
            py::arg("muted") = false, py::arg("require_device") = false,
            py::arg("warnings") = py::none(), py::arg("hardness") = py::none(),
            py::arg("sample_rate") = 48000, py::arg("period_frames") = 128,
-           py::arg("max_backlog_ticks") = 16, py::arg("capture_seconds") = 0.0,
+           py::arg("max_backlog_ticks") = 16, py::arg("trim_backlog") = true,
+           py::arg("paused") = false, py::arg("capture_seconds") = 0.0,
            py::arg("seed") = 0x5eed, py::keep_alive<1, 2>(),
            "output: 'device' (the default output: PulseAudio, ALSA or JACK), 'null' "
            "(miniaudio's null device: played at the real rate, heard by nobody) or 'none'. "
            "require_device: raise ResourceError instead of carrying on silent. warnings: None "
            "(a beep per critical label of the volume, from 1 mm) or {structure: start metres, "
            "or {start, full, frequency, slow_period, fast_period}}; {} for none. hardness: "
-           "{structure: hardness relative to bone} (1 elsewhere). capture_seconds: keep that "
-           "much of what is played for take_capture().")
+           "{structure: hardness relative to bone} (1 elsewhere). max_backlog_ticks, "
+           "trim_backlog: ticks beyond what the next callback needs, and a backlog that never "
+           "drains, are dropped (bounded latency). paused: open the device without starting "
+           "it. capture_seconds: keep that much of what is played for take_capture().")
       .def_property_readonly(
           "drill", [](const DrillSound& s) { return handle(&s.drill()); }, "the drill it follows")
       .def_property(
           "muted", [](const DrillSound& s) { return s.player().muted(); },
           [](DrillSound& s, bool muted) { s.player().set_muted(muted); },
           "silences the output (the sound keeps running underneath)")
+      .def_property(
+          "paused", [](const DrillSound& s) { return s.player().paused(); },
+          [](DrillSound& s, bool paused) {
+            py::gil_scoped_release release;
+            s.player().set_paused(paused);
+          },
+          "stops or restarts the device; ticks queue meanwhile")
       .def(
           "set_muted", [](DrillSound& s, bool muted) { s.player().set_muted(muted); },
           py::arg("muted"))

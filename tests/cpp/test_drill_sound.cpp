@@ -57,8 +57,8 @@ TEST(DrillSynth, SilentExactlyOnceSpunDownAndDeterministic) {
   const std::vector<float> b = render_drill_sound(spec, ticks);
   ASSERT_EQ(a.size(), 5000u * 48u);
   EXPECT_EQ(a, b);
-  // Sound while on; exact zeros by the end of the coast (the motor stops about 3.1 s after
-  // switching off: 0.35 s x ln(0.65 / 1e-4)).
+  // Sound while on; exact zeros by the end of the coast (the motor stops about 0.4 s after
+  // switching off: 0.06 s x ln(0.65 / 1e-3)).
   float loudest = 0;
   for (std::size_t i = 0; i < 48000; ++i) loudest = std::max(loudest, std::abs(a[i]));
   EXPECT_GT(loudest, 0.05f);
@@ -90,8 +90,14 @@ TEST(DrillSoundPlayer, TheAudioThreadPathPlaysWhatTheOfflineRenderGives) {
   PlayerOptions options;
   options.output = AudioOutput::kNone;
   options.max_backlog_ticks = 4096;
+  options.trim_backlog = false;
   options.capture_frames = 1 << 16;
   DrillSoundPlayer player(spec, options);
+  // Silence before the first tick, the synthesiser untouched.
+  std::vector<float> before(300, 1.0f);
+  player.fill(before.data(), 300);
+  EXPECT_EQ(before, std::vector<float>(300, 0.0f));
+  player.take_capture();
   const std::vector<DrillTick> ticks = cutting_ticks(1000, 500);
   for (const DrillTick& t : ticks) ASSERT_TRUE(player.push(t));
   // Callbacks of an awkward size: frames straddle ticks.

@@ -70,6 +70,8 @@ struct DrillSoundPlayer::Impl {
   std::vector<float> pending;
   int pending_count = 0, pending_at = 0;
   DrillTick last;  // repeated while no tick arrives
+  bool started = false;  // a tick has been played
+  std::atomic<bool> paused{false};
   // The fewest ticks left waiting after a callback, over the last kWindow callbacks: a backlog
   // that never drains (the queue's standing delay) is dropped once the window closes.
   std::size_t window_min = SIZE_MAX;
@@ -165,7 +167,8 @@ DrillSoundPlayer::DrillSoundPlayer(const DrillSoundSpec& spec, const PlayerOptio
     impl_->period = static_cast<int>(impl_->device.playback.internalPeriodSizeInFrames);
     impl_->backend = ma_get_backend_name(impl_->context.backend);
     impl_->open = true;
-    const ma_result result = ma_device_start(&impl_->device);
+    impl_->paused = options.paused;
+    const ma_result result = options.paused ? MA_SUCCESS : ma_device_start(&impl_->device);
     if (result != MA_SUCCESS) {
       impl_->close();
       impl_->backend.clear();
@@ -183,6 +186,18 @@ DrillSoundPlayer::~DrillSoundPlayer() { impl_->close(); }
 
 const DrillSoundSpec& DrillSoundPlayer::spec() const { return impl_->spec; }
 const PlayerOptions& DrillSoundPlayer::options() const { return impl_->options; }
+void DrillSoundPlayer::set_paused(bool paused) {
+  Impl& p = *impl_;
+  std::lock_guard<std::mutex> lock(p.close_mutex);
+  if (!p.have_device || p.paused == paused) return;
+  const ma_result result = paused ? ma_device_stop(&p.device) : ma_device_start(&p.device);
+  if (result != MA_SUCCESS) {
+    throw ResourceError(std::string("DrillSoundPlayer: the audio device did not ") +
+                        (paused ? "stop" : "start") + " (" + ma_result_description(result) + ")");
+  }
+  p.paused = paused;
+}
+bool DrillSoundPlayer::paused() const { return impl_->paused; }
 void DrillSoundPlayer::set_muted(bool muted) { impl_->muted = muted; }
 bool DrillSoundPlayer::muted() const { return impl_->muted; }
 bool DrillSoundPlayer::playing() const { return impl_->open && impl_->have_device; }
@@ -215,6 +230,15 @@ void DrillSoundPlayer::fill(float* out, std::uint32_t frames) {
     if (p.ticks.pop(tick)) add(p.dropped);
   }
   std::uint32_t n = 0;
+  // Silence until the first tick, the synthesiser untouched: it starts where an offline
+  // render starts.
+  if (!p.started) {
+    if (p.ticks.size() == 0) {
+      std::fill(out, out + frames, 0.0f);
+      n = frames;
+    }
+    p.started = n == 0;
+  }
   while (n < frames) {
     if (p.pending_at < p.pending_count) {
       const std::uint32_t take =
@@ -238,10 +262,12 @@ void DrillSoundPlayer::fill(float* out, std::uint32_t frames) {
   }
   // A standing backlog is latency for nothing: trim it to one tick.
   p.window_min = std::min(p.window_min, p.ticks.size());
-  if (++p.window_callbacks == kWindow) {
+  if (++p.window_callbacks == kWindow && p.options.trim_backlog) {
     for (std::size_t i = 1; i < p.window_min; ++i) {
       if (p.ticks.pop(tick)) add(p.dropped);
     }
+  }
+  if (p.window_callbacks == kWindow) {
     p.window_min = SIZE_MAX;
     p.window_callbacks = 0;
   }

@@ -14,7 +14,7 @@ constexpr double kPi = 3.14159265358979323846;
 // Relative strength of the motor's harmonics (1st .. 4th): a whine with some edge.
 constexpr double kHarmonics[] = {1.0, 0.5, 0.3, 0.15};
 // Below this the motor is stopped and the signal exactly silent.
-constexpr double kStopped = 1e-4;
+constexpr double kStopped = 1e-3;
 // Time constants of the cutting noise's level and of a beep's edges, s: no clicks.
 constexpr double kCutSmoothing = 0.004;
 constexpr double kBeepEdge = 0.002;
@@ -47,6 +47,7 @@ void DrillSoundSpec::validate() const {
   check(std::isfinite(motor_gain) && motor_gain >= 0, "motor_gain", motor_gain, ">= 0");
   check(std::isfinite(cut_gain) && cut_gain >= 0, "cut_gain", cut_gain, ">= 0");
   check(positive(removal_reference), "removal_reference", removal_reference, "> 0 m^3/s");
+  check(positive(removal_smoothing), "removal_smoothing", removal_smoothing, "> 0 s");
   check(positive(cut_frequency), "cut_frequency", cut_frequency, "> 0 Hz");
   check(std::isfinite(cut_spread) && cut_spread >= 0, "cut_spread", cut_spread, ">= 0");
   check(positive(cut_q), "cut_q", cut_q, "> 0");
@@ -75,7 +76,7 @@ void DrillSynth::reset() {
   tick_index_ = 0;
   motor_target_ = motor_ = phase_ = 0.0;
   motor_tau_ = spec_.spin_up;
-  cut_target_ = cut_ = 0.0;
+  cut_target_ = cut_ = removal_ = 0.0;
   b0_ = b1_ = b2_ = a1_ = a2_ = 0.0;
   x1_ = x2_ = y1_ = y2_ = 0.0;
   // splitmix64 of the seed: a zero seed still gives a running xorshift state.
@@ -113,9 +114,12 @@ void DrillSynth::set_tick(const DrillTick& tick) {
   motor_tau_ = target >= motor_ ? spec_.spin_up : spec_.spin_down;
   motor_target_ = target;
 
-  // Energy follows the removal rate: amplitude as its square root.
+  // Energy follows the removal rate, averaged over removal_smoothing (whole voxels come off
+  // in single ticks): amplitude as its square root.
   const double rate = std::isfinite(tick.removal_rate) ? std::max(0.0f, tick.removal_rate) : 0.0;
-  cut_target_ = tick.on ? spec_.cut_gain * std::sqrt(rate / spec_.removal_reference) : 0.0;
+  removal_ += (rate - removal_) * (1.0 - std::exp(-spec_.tick_seconds / spec_.removal_smoothing));
+  if (rate == 0.0 && removal_ < 1e-6 * spec_.removal_reference) removal_ = 0.0;
+  cut_target_ = tick.on ? spec_.cut_gain * std::sqrt(removal_ / spec_.removal_reference) : 0.0;
   const double hardness =
       std::isfinite(tick.hardness) && tick.hardness > 0 ? tick.hardness : 1.0;
   const double fc = std::clamp(spec_.cut_frequency * std::pow(hardness, spec_.cut_spread), 150.0,

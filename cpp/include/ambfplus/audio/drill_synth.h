@@ -50,7 +50,7 @@ struct AMBFPLUS_API DrillSoundSpec {
   double tick_seconds = 0.001; ///< s between ticks (the world's step)
   double motor_frequency = 600.0;  ///< Hz, the motor's fundamental at full speed without load
   double spin_up = 0.12;       ///< s, time constant of the motor speeding up
-  double spin_down = 0.35;     ///< s, time constant of it slowing down (it coasts)
+  double spin_down = 0.06;     ///< s, time constant of it slowing down (stopped in 0.4 s)
   /// Fraction of the speed the motor loses under `load_reference` newtons (first-order droop:
   /// speed x (1 - droop x load / (load + load_reference))).
   double droop = 0.35;
@@ -58,6 +58,7 @@ struct AMBFPLUS_API DrillSoundSpec {
   double motor_gain = 0.18;        ///< amplitude of the fundamental at full speed
   double cut_gain = 0.25;          ///< amplitude of the cutting noise at the reference rate
   double removal_reference = 30e-9;  ///< m^3/s at which the cutting noise has cut_gain
+  double removal_smoothing = 0.02;   ///< s, time constant of the removal rate heard
   /// Centre of the cutting band for bone (hardness 1); it moves by hardness^cut_spread (soft
   /// tissue lower, harder higher), kept within 150 Hz .. 0.4 x sample_rate.
   double cut_frequency = 3200.0;
@@ -109,6 +110,7 @@ class AMBFPLUS_API DrillSynth {
   // Per-tick targets.
   double motor_target_ = 0.0, motor_tau_ = 0.0;
   double cut_target_ = 0.0;
+  double removal_ = 0.0;  // removal rate heard (smoothed), m^3/s
   double b0_ = 0, b1_ = 0, b2_ = 0, a1_ = 0, a2_ = 0;  // band-pass coefficients
   // Per-sample state.
   double motor_ = 0.0;      // motor speed 0..1

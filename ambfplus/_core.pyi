@@ -29,7 +29,7 @@ class OutOfRange(Error, IndexError):
     """An index outside what it indexes."""
 class ArgumentTypeError(ArgumentError, TypeError):
     """A value of the wrong type, or a keyword option that does not exist."""
-__all__: list[str] = ['ActuatorHold', 'ArgumentError', 'ArgumentTypeError', 'AssetNotFound', 'Axis', 'Camera', 'ConfigError', 'ConstraintActuator', 'ControlOutput', 'Device', 'DistanceField', 'Drill', 'Error', 'Frame', 'InputDevice', 'Joint', 'JointType', 'JoystickDevice', 'JoystickMapping', 'KeyboardDevice', 'Label', 'Light', 'LightType', 'LoadReport', 'MergedDevice', 'MeshCollision', 'Model', 'NetworkDevice', 'NotFound', 'NullDevice', 'Object', 'OpenXrSession', 'OutOfRange', 'PLUGIN_ABI_VERSION', 'PluginError', 'PluginInfo', 'PluginSite', 'ProximitySensor', 'RealTimeLoop', 'RemovalMode', 'RenderError', 'ReplayDevice', 'ResourceError', 'RigidBody', 'ScriptedDevice', 'ShapeKind', 'SimulatedDevice', 'Simulator', 'SkillMetrics', 'SoftBody', 'StateError', 'Volume', 'VolumeData', 'Window', 'World', 'capture_passes', 'gl_info', 'load_nrrd', 'load_slice_stack', 'openxr_built', 'phantom', 'plugin_search_path', 'read_colors', 'read_input_devices', 'read_label_table', 'read_launch', 'use_x11_display', 'write_image', 'write_label_table']
+__all__: list[str] = ['ActuatorHold', 'ArgumentError', 'ArgumentTypeError', 'AssetNotFound', 'Axis', 'Camera', 'ConfigError', 'ConstraintActuator', 'ControlOutput', 'Device', 'DistanceField', 'Drill', 'DrillSound', 'Error', 'Frame', 'InputDevice', 'Joint', 'JointType', 'JoystickDevice', 'JoystickMapping', 'KeyboardDevice', 'Label', 'Light', 'LightType', 'LoadReport', 'MergedDevice', 'MeshCollision', 'Model', 'NetworkDevice', 'NotFound', 'NullDevice', 'Object', 'OpenXrSession', 'OutOfRange', 'PLUGIN_ABI_VERSION', 'PluginError', 'PluginInfo', 'PluginSite', 'ProximitySensor', 'RealTimeLoop', 'RemovalMode', 'RenderError', 'ReplayDevice', 'ResourceError', 'RigidBody', 'ScriptedDevice', 'ShapeKind', 'SimulatedDevice', 'Simulator', 'SkillMetrics', 'SoftBody', 'StateError', 'Volume', 'VolumeData', 'Window', 'World', 'capture_passes', 'gl_info', 'load_nrrd', 'load_slice_stack', 'openxr_built', 'phantom', 'plugin_search_path', 'read_colors', 'read_input_devices', 'read_label_table', 'read_launch', 'render_drill_sound', 'use_x11_display', 'write_image', 'write_label_table']
 class Window:
     """
     An X11 window (GLFW's, made without a client API) showing cameras.
@@ -2406,6 +2406,93 @@ class SkillMetrics:
         """
         Everything measured so far, as a dict (distances in metres, times in seconds, forces in newtons, volumes as voxel counts with voxel_volume in cubic metres).
         """
+class DrillSound:
+    """
+    A drill's live sound, synthesised from the burr's state (spin-up and coasting, motor pitch falling with load, cutting noise following the tissue's hardness and the removal rate, proximity beeps) and fed from the drill at every step of its world, by the haptic thread of a real-time loop. Plays through miniaudio; a machine without an audio device says so once (a warning) and carries on silent. Use as a context manager, or close().
+    """
+    def __enter__(self) -> DrillSound:
+        ...
+    def __exit__(self, *args) -> bool:
+        ...
+    def __init__(self, drill: Drill, *, output: str = 'device', muted: bool = False, require_device: bool = False, warnings: typing.Any = None, hardness: typing.Any = None, sample_rate: typing.SupportsInt | typing.SupportsIndex = 48000, period_frames: typing.SupportsInt | typing.SupportsIndex = 128, max_backlog_ticks: typing.SupportsInt | typing.SupportsIndex = 16, trim_backlog: bool = True, paused: bool = False, capture_seconds: typing.SupportsFloat | typing.SupportsIndex = 0.0, seed: typing.SupportsInt | typing.SupportsIndex = 24301) -> None:
+        """
+        output: 'device' (the default output: PulseAudio, ALSA or JACK), 'null' (miniaudio's null device: played at the real rate, heard by nobody) or 'none'. require_device: raise ResourceError instead of carrying on silent. warnings: None (a beep per critical label of the volume, from 1 mm) or {structure: start metres, or {start, full, frequency, slow_period, fast_period}}; {} for none. hardness: {structure: hardness relative to bone} (1 elsewhere). max_backlog_ticks, trim_backlog: ticks beyond what the next callback needs, and a backlog that never drains, are dropped (bounded latency). paused: open the device without starting it. capture_seconds: keep that much of what is played for take_capture().
+        """
+    def close(self) -> None:
+        """
+        Stops feeding and closes the device; idempotent.
+        """
+    def set_muted(self, muted: bool) -> None:
+        ...
+    def take_capture(self) -> numpy.typing.NDArray[numpy.float32]:
+        """
+        The samples played since the last take (capture_seconds of them at most).
+        """
+    def take_latencies(self) -> numpy.typing.NDArray[numpy.float64]:
+        """
+        Seconds from each tick's push (the haptic step) to the moment its first sample is written into the device's buffer, for the ticks played since the last take.
+        """
+    def toggle_mute(self) -> bool:
+        """
+        Mutes or unmutes (a launcher's mute key); returns whether it is now muted.
+        """
+    @property
+    def backend(self) -> str:
+        """
+        the backend playing ('pulseaudio', 'alsa', 'jack', 'null'; '' for none)
+        """
+    @property
+    def closed(self) -> bool:
+        ...
+    @property
+    def device_error(self) -> typing.Any:
+        """
+        why no device plays (None when one does or none was asked for)
+        """
+    @property
+    def drill(self) -> Drill:
+        """
+        the drill it follows
+        """
+    @property
+    def muted(self) -> bool:
+        """
+        silences the output (the sound keeps running underneath)
+        """
+    @muted.setter
+    def muted(self, arg1: bool) -> None:
+        ...
+    @property
+    def paused(self) -> bool:
+        """
+        stops or restarts the device; ticks queue meanwhile
+        """
+    @paused.setter
+    def paused(self, arg1: bool) -> None:
+        ...
+    @property
+    def period_frames(self) -> int:
+        """
+        frames per audio callback the device settled on
+        """
+    @property
+    def playing(self) -> bool:
+        """
+        whether a device (or the null device) plays
+        """
+    @property
+    def sample_rate(self) -> int:
+        ...
+    @property
+    def stats(self) -> dict:
+        """
+        ticks pushed, rejected (queue full), played, dropped (backlog), held (repeated while none arrived); callbacks and frames played
+        """
+    @property
+    def warnings(self) -> list:
+        """
+        the proximity warnings, in the order of their distances
+        """
 class PluginSite:
     """
     Where a Python plugin is attached (its `_site`); handles are made on each access, so keep names on a plugin rather than handles.
@@ -2525,6 +2612,10 @@ def read_label_table(path: os.PathLike | str | bytes) -> list[Label]:
 def read_launch(path: os.PathLike | str | bytes) -> dict:
     """
     A launch file's entries as a dict, paths made absolute.
+    """
+def render_drill_sound(on: typing.Any, load: typing.Any = None, removal_rate: typing.Any = None, *, speed: typing.Any = None, hardness: typing.Any = None, distances: typing.Any = None, warnings: typing.Any = None, sample_rate: typing.SupportsInt | typing.SupportsIndex = 48000, tick_seconds: typing.SupportsFloat | typing.SupportsIndex = 0.001, seed: typing.SupportsInt | typing.SupportsIndex = 24301) -> numpy.typing.NDArray[numpy.float32]:
+    """
+    The drill sound of a tick sequence, offline: mono float32 samples at sample_rate, exactly what a DrillSound plays for the same ticks (one synthesiser). on: burr on per tick; load: N; removal_rate: m^3/s; speed: 0..1 (1); hardness: relative to bone (1); warnings: {name: start metres or {start, full, frequency, slow_period, fast_period}} with distances (ticks, len(warnings)) in metres. Deterministic.
     """
 def use_x11_display(display: typing.SupportsInt | typing.SupportsIndex) -> None:
     """

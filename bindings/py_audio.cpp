@@ -65,8 +65,8 @@ WarningTone warning_from(const std::string& name, std::uint16_t label, const py:
       } else if (k == "fast_period") {
         w.fast_period = x;
       } else {
-        throw ArgumentTypeError("warnings['" + name + "']: unknown key '" + k + "' (known: " +
-                                kWarningKeys + ")");
+        throw ArgumentTypeError("warnings['" + name + "']: unknown key '" + k +
+                                "' (known: " + kWarningKeys + ")");
       }
     }
   } else if (!value.is_none()) {
@@ -222,10 +222,9 @@ void declare_audio(py::module_& m) {
 void define_audio(py::module_& m) {
   bound<DrillSound, SoundHolder>(m, "DrillSound")
       .def(py::init([](std::shared_ptr<Drill> drill, const std::string& output, bool muted,
-                       bool require_device, const py::object& warnings,
-                       const py::object& hardness, int sample_rate, int period_frames,
-                       int max_backlog_ticks, bool trim_backlog, bool paused,
-                       double capture_seconds, std::uint64_t seed) {
+                       bool require_device, const py::object& warnings, const py::object& hardness,
+                       int sample_rate, int period_frames, int max_backlog_ticks, bool trim_backlog,
+                       bool paused, double capture_seconds, std::uint64_t seed) {
              DrillSoundSpec spec;
              spec.sample_rate = sample_rate;
              spec.seed = seed;
@@ -247,13 +246,12 @@ void define_audio(py::module_& m) {
              py::gil_scoped_release release;
              return SoundHolder(new DrillSound(*drill, spec, options, std::move(hard)));
            }),
-           py::arg("drill"), py::kw_only(), py::arg("output") = "device",
-           py::arg("muted") = false, py::arg("require_device") = false,
-           py::arg("warnings") = py::none(), py::arg("hardness") = py::none(),
-           py::arg("sample_rate") = 48000, py::arg("period_frames") = 128,
-           py::arg("max_backlog_ticks") = 16, py::arg("trim_backlog") = true,
-           py::arg("paused") = false, py::arg("capture_seconds") = 0.0,
-           py::arg("seed") = 0x5eed, py::keep_alive<1, 2>(),
+           py::arg("drill"), py::kw_only(), py::arg("output") = "device", py::arg("muted") = false,
+           py::arg("require_device") = false, py::arg("warnings") = py::none(),
+           py::arg("hardness") = py::none(), py::arg("sample_rate") = 48000,
+           py::arg("period_frames") = 128, py::arg("max_backlog_ticks") = 16,
+           py::arg("trim_backlog") = true, py::arg("paused") = false,
+           py::arg("capture_seconds") = 0.0, py::arg("seed") = 0x5eed, py::keep_alive<1, 2>(),
            "output: 'device' (the default output: PulseAudio, ALSA or JACK), 'null' "
            "(miniaudio's null device: played at the real rate, heard by nobody) or 'none'. "
            "require_device: raise ResourceError instead of carrying on silent. warnings: None "
@@ -302,8 +300,8 @@ void define_audio(py::module_& m) {
       .def_property_readonly(
           "period_frames", [](const DrillSound& s) { return s.player().period_frames(); },
           "frames per audio callback the device settled on")
-      .def_property_readonly(
-          "sample_rate", [](const DrillSound& s) { return s.player().spec().sample_rate; })
+      .def_property_readonly("sample_rate",
+                             [](const DrillSound& s) { return s.player().spec().sample_rate; })
       .def_property_readonly(
           "warnings",
           [](const DrillSound& s) {
@@ -353,8 +351,9 @@ void define_audio(py::module_& m) {
           },
           "Stops feeding and closes the device; idempotent.")
       .def_property_readonly("closed", &DrillSound::closed)
-      .def("__enter__", [](DrillSound& s) -> DrillSound& { return s; },
-           py::return_value_policy::reference)
+      .def(
+          "__enter__", [](DrillSound& s) -> DrillSound& { return s; },
+          py::return_value_policy::reference)
       .def("__exit__", [](DrillSound& s, py::args) {
         py::gil_scoped_release release;
         s.close();

@@ -51,7 +51,9 @@ def cutting_energy(segment: np.ndarray) -> float:
     return float(power[(freqs > 2600) & (freqs < 6000)].sum())
 
 
-@pytest.fixture(scope="module", params=[(novice_like, 3), (expert_like, 4)], ids=["novice", "expert"])
+@pytest.fixture(
+    scope="module", params=[(novice_like, 3), (expert_like, 4)], ids=["novice", "expert"]
+)
 def session(request):
     make, seed = request.param
     s = drill_phantom(make, seed, 8.0, PROTECT, resolution=64)
@@ -216,9 +218,7 @@ def test_renders_are_deterministic_and_seeded(session):
     s, ticks, samples = session
     again = render_session(s.steps, s.removed, s.drill.name, s.drill.volume.data.voxel_size)
     assert np.array_equal(samples, again)
-    other = render_session(
-        s.steps, s.removed, s.drill.name, s.drill.volume.data.voxel_size, seed=1
-    )
+    other = render_session(s.steps, s.removed, s.drill.name, s.drill.volume.data.voxel_size, seed=1)
     assert not np.array_equal(samples, other)
 
 

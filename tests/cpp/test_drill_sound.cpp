@@ -103,7 +103,8 @@ TEST(DrillSoundPlayer, TheAudioThreadPathPlaysWhatTheOfflineRenderGives) {
   // Callbacks of an awkward size: frames straddle ticks.
   std::vector<float> played(1000 * 48);
   for (std::size_t at = 0; at < played.size(); at += 100) {
-    player.fill(played.data() + at, static_cast<std::uint32_t>(std::min<std::size_t>(100, played.size() - at)));
+    player.fill(played.data() + at,
+                static_cast<std::uint32_t>(std::min<std::size_t>(100, played.size() - at)));
   }
   EXPECT_EQ(played, render_drill_sound(spec, ticks));
   EXPECT_EQ(player.stats().played, 1000);

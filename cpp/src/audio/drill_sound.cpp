@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cstdint>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <mutex>
 
@@ -69,7 +69,7 @@ struct DrillSoundPlayer::Impl {
   // The frames of the tick being played (rendered whole, handed out as the device asks).
   std::vector<float> pending;
   int pending_count = 0, pending_at = 0;
-  DrillTick last;  // repeated while no tick arrives
+  DrillTick last;        // repeated while no tick arrives
   bool started = false;  // a tick has been played
   std::atomic<bool> paused{false};
   // The fewest ticks left waiting after a callback, over the last kWindow callbacks: a backlog
@@ -125,8 +125,8 @@ void DrillSoundPlayer::Impl::open_output() {
     config.pUserData = nullptr;  // set by the player before the device starts
     result = ma_device_init(&context, &config, &device);
     if (result != MA_SUCCESS) {
-      failure = std::string("no audio output device opened (") + ma_result_description(result) +
-                ")";
+      failure =
+          std::string("no audio output device opened (") + ma_result_description(result) + ")";
     } else {
       have_device = true;
     }
@@ -222,7 +222,8 @@ void DrillSoundPlayer::fill(float* out, std::uint32_t frames) {
   add(p.callbacks);
   // Ticks beyond what this callback needs and the allowed backlog are the oldest: dropped.
   const double left = static_cast<double>(frames) - (p.pending_count - p.pending_at);
-  const auto needed = static_cast<std::size_t>(std::max(0.0, std::ceil(left / p.spec.frames_per_tick())));
+  const auto needed =
+      static_cast<std::size_t>(std::max(0.0, std::ceil(left / p.spec.frames_per_tick())));
   const std::size_t waiting = p.ticks.size();
   const std::size_t keep = needed + static_cast<std::size_t>(p.options.max_backlog_ticks);
   DrillTick tick;
@@ -241,8 +242,8 @@ void DrillSoundPlayer::fill(float* out, std::uint32_t frames) {
   }
   while (n < frames) {
     if (p.pending_at < p.pending_count) {
-      const std::uint32_t take =
-          std::min<std::uint32_t>(frames - n, static_cast<std::uint32_t>(p.pending_count - p.pending_at));
+      const std::uint32_t take = std::min<std::uint32_t>(
+          frames - n, static_cast<std::uint32_t>(p.pending_count - p.pending_at));
       std::memcpy(out + n, p.pending.data() + p.pending_at, take * sizeof(float));
       n += take;
       p.pending_at += static_cast<int>(take);

@@ -59,8 +59,8 @@ void DrillSoundSpec::validate() const {
     const std::string at = "warnings[" + std::to_string(i) + "] (" + w.name + ").";
     check(std::isfinite(w.full) && w.full >= 0, at + "full", w.full, ">= 0 m");
     check(std::isfinite(w.start) && w.start > w.full, at + "start", w.start, "> full");
-    check(positive(w.frequency) && w.frequency < 0.45 * sample_rate, at + "frequency",
-          w.frequency, "> 0 and below 0.45 x sample_rate");
+    check(positive(w.frequency) && w.frequency < 0.45 * sample_rate, at + "frequency", w.frequency,
+          "> 0 and below 0.45 x sample_rate");
     check(positive(w.slow_period), at + "slow_period", w.slow_period, "> 0 s");
     check(positive(w.fast_period) && w.fast_period <= w.slow_period, at + "fast_period",
           w.fast_period, "> 0 and <= slow_period");
@@ -120,8 +120,7 @@ void DrillSynth::set_tick(const DrillTick& tick) {
   removal_ += (rate - removal_) * (1.0 - std::exp(-spec_.tick_seconds / spec_.removal_smoothing));
   if (rate == 0.0 && removal_ < 1e-6 * spec_.removal_reference) removal_ = 0.0;
   cut_target_ = tick.on ? spec_.cut_gain * std::sqrt(removal_ / spec_.removal_reference) : 0.0;
-  const double hardness =
-      std::isfinite(tick.hardness) && tick.hardness > 0 ? tick.hardness : 1.0;
+  const double hardness = std::isfinite(tick.hardness) && tick.hardness > 0 ? tick.hardness : 1.0;
   const double fc = std::clamp(spec_.cut_frequency * std::pow(hardness, spec_.cut_spread), 150.0,
                                0.4 * spec_.sample_rate);
   // Band-pass biquad, 0 dB peak gain (RBJ's cookbook).

@@ -52,9 +52,9 @@ void SoundSystem::detach_all() {
 }
 
 void SoundSystem::detach(const SoundFeed* feed) {
-  feeds_.erase(std::remove_if(feeds_.begin(), feeds_.end(),
-                              [&](const auto& f) { return f.get() == feed; }),
-               feeds_.end());
+  feeds_.erase(
+      std::remove_if(feeds_.begin(), feeds_.end(), [&](const auto& f) { return f.get() == feed; }),
+      feeds_.end());
 }
 
 void SoundSystem::run(StepStage, const StepContext& context) {

@@ -18,11 +18,11 @@ inline constexpr int kMaxWarnings = 16;
 
 /// The burr's state at one haptic tick: what the sound is made from.
 struct AMBFPLUS_API DrillTick {
-  bool on = false;           ///< the burr spins
-  float speed = 1.0f;        ///< commanded speed, 0..1 of full speed
-  float load = 0.0f;         ///< N, the force on the burr (its magnitude)
-  float removal_rate = 0.0f; ///< m^3/s of tissue removed at this tick
-  float hardness = 1.0f;     ///< of the tissue cut, relative to bone (1)
+  bool on = false;            ///< the burr spins
+  float speed = 1.0f;         ///< commanded speed, 0..1 of full speed
+  float load = 0.0f;          ///< N, the force on the burr (its magnitude)
+  float removal_rate = 0.0f;  ///< m^3/s of tissue removed at this tick
+  float hardness = 1.0f;      ///< of the tissue cut, relative to bone (1)
   /// Distance (m) from the burr's surface to each structure of the warning list, in its order;
   /// infinity where unknown or out of reach.
   std::array<float, kMaxWarnings> distances;
@@ -46,26 +46,26 @@ struct AMBFPLUS_API WarningTone {
 /// The synthesiser's settings. Defaults: a 48 kHz signal from 1 kHz ticks, a motor of 600 Hz at
 /// full speed without load.
 struct AMBFPLUS_API DrillSoundSpec {
-  int sample_rate = 48000;     ///< Hz
-  double tick_seconds = 0.001; ///< s between ticks (the world's step)
+  int sample_rate = 48000;         ///< Hz
+  double tick_seconds = 0.001;     ///< s between ticks (the world's step)
   double motor_frequency = 600.0;  ///< Hz, the motor's fundamental at full speed without load
-  double spin_up = 0.12;       ///< s, time constant of the motor speeding up
-  double spin_down = 0.06;     ///< s, time constant of it slowing down (stopped in 0.4 s)
+  double spin_up = 0.12;           ///< s, time constant of the motor speeding up
+  double spin_down = 0.06;         ///< s, time constant of it slowing down (stopped in 0.4 s)
   /// Fraction of the speed the motor loses under `load_reference` newtons (first-order droop:
   /// speed x (1 - droop x load / (load + load_reference))).
   double droop = 0.35;
-  double load_reference = 2.0;     ///< N
-  double motor_gain = 0.18;        ///< amplitude of the fundamental at full speed
-  double cut_gain = 0.25;          ///< amplitude of the cutting noise at the reference rate
+  double load_reference = 2.0;       ///< N
+  double motor_gain = 0.18;          ///< amplitude of the fundamental at full speed
+  double cut_gain = 0.25;            ///< amplitude of the cutting noise at the reference rate
   double removal_reference = 30e-9;  ///< m^3/s at which the cutting noise has cut_gain
   double removal_smoothing = 0.02;   ///< s, time constant of the removal rate heard
   /// Centre of the cutting band for bone (hardness 1); it moves by hardness^cut_spread (soft
   /// tissue lower, harder higher), kept within 150 Hz .. 0.4 x sample_rate.
   double cut_frequency = 3200.0;
   double cut_spread = 0.7;
-  double cut_q = 1.2;             ///< the band-pass filter's quality factor
-  double warning_gain = 0.2;      ///< amplitude of the warning tones
-  std::uint64_t seed = 0x5eed;    ///< of the cutting noise: one seed, one signal
+  double cut_q = 1.2;                 ///< the band-pass filter's quality factor
+  double warning_gain = 0.2;          ///< amplitude of the warning tones
+  std::uint64_t seed = 0x5eed;        ///< of the cutting noise: one seed, one signal
   std::vector<WarningTone> warnings;  ///< at most kMaxWarnings
 
   /// Throws ArgumentError naming the value unless every value can be used.
@@ -110,12 +110,12 @@ class AMBFPLUS_API DrillSynth {
   // Per-tick targets.
   double motor_target_ = 0.0, motor_tau_ = 0.0;
   double cut_target_ = 0.0;
-  double removal_ = 0.0;  // removal rate heard (smoothed), m^3/s
+  double removal_ = 0.0;                               // removal rate heard (smoothed), m^3/s
   double b0_ = 0, b1_ = 0, b2_ = 0, a1_ = 0, a2_ = 0;  // band-pass coefficients
   // Per-sample state.
-  double motor_ = 0.0;      // motor speed 0..1
-  double phase_ = 0.0;      // motor phase, cycles
-  double cut_ = 0.0;        // smoothed cutting amplitude
+  double motor_ = 0.0;                        // motor speed 0..1
+  double phase_ = 0.0;                        // motor phase, cycles
+  double cut_ = 0.0;                          // smoothed cutting amplitude
   double x1_ = 0, x2_ = 0, y1_ = 0, y2_ = 0;  // band-pass memory
   std::uint64_t noise_state_ = 0;
   int warning_ = -1;

@@ -261,10 +261,10 @@ void DrillSoundPlayer::fill(float* out, std::uint32_t frames) {
     p.pending_count = p.synth.render_tick(tick, p.pending.data());
     p.pending_at = 0;
   }
-  // A standing backlog is latency for nothing: trim it to one tick.
+  // A standing backlog is latency for nothing: drop it (a tick short later is repeated).
   p.window_min = std::min(p.window_min, p.ticks.size());
   if (++p.window_callbacks == kWindow && p.options.trim_backlog) {
-    for (std::size_t i = 1; i < p.window_min; ++i) {
+    for (std::size_t i = 0; i < p.window_min; ++i) {
       if (p.ticks.pop(tick)) add(p.dropped);
     }
   }

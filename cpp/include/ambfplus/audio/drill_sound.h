@@ -44,8 +44,8 @@ struct AMBFPLUS_API PlayerOptions {
   /// are dropped (a world stepped faster than real time), so the latency stays bounded. Enough
   /// for a device that asks in bursts (miniaudio's null device wakes every 10 ms).
   int max_backlog_ticks = 16;
-  /// Drops a backlog that never drains (measured over about 0.17 s of callbacks) down to one
-  /// tick: a queue that only grew once is delay for nothing.
+  /// Drops a backlog that never drains (the fewest ticks left waiting after a callback, over
+  /// about 0.17 s of callbacks): a queue that only grew once is delay for nothing.
   bool trim_backlog = true;
   /// Opens the device without starting it (set_paused(false) starts it); ticks queue meanwhile.
   bool paused = false;

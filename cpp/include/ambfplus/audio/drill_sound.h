@@ -125,7 +125,9 @@ class AMBFPLUS_API DrillSoundPlayer {
 
 /// A drill's live sound: a player fed from the drill at every step of its world, after the
 /// drills have ticked (on the haptic thread of a real-time loop): the burr's state, its force,
-/// the tissue it removed in that step and the distances to the warning list's structures.
+/// the tissue it removed in that step and the distances to the warning list's structures. It
+/// must not outlive the world (Python's handles keep the world alive); if its drill leaves the
+/// world it stops being fed.
 class AMBFPLUS_API DrillSound {
  public:
   /// Starts feeding a player from the drill. spec.tick_seconds is set to the world's step; the

@@ -29,7 +29,7 @@ class OutOfRange(Error, IndexError):
     """An index outside what it indexes."""
 class ArgumentTypeError(ArgumentError, TypeError):
     """A value of the wrong type, or a keyword option that does not exist."""
-__all__: list[str] = ['ActuatorHold', 'ArgumentError', 'ArgumentTypeError', 'AssetNotFound', 'Axis', 'Camera', 'ConfigError', 'ConstraintActuator', 'ControlOutput', 'Device', 'DistanceField', 'Drill', 'Error', 'Frame', 'InputDevice', 'Joint', 'JointType', 'JoystickDevice', 'JoystickMapping', 'KeyboardDevice', 'Label', 'Light', 'LightType', 'LiveMetrics', 'LoadReport', 'MergedDevice', 'MeshCollision', 'Model', 'NetworkDevice', 'NotFound', 'NullDevice', 'Object', 'OpenXrSession', 'OutOfRange', 'PLUGIN_ABI_VERSION', 'PluginError', 'PluginInfo', 'PluginSite', 'ProximitySensor', 'RealTimeLoop', 'RemovalMode', 'RenderError', 'ReplayDevice', 'ResourceError', 'RigidBody', 'ScriptedDevice', 'ShapeKind', 'SimulatedDevice', 'Simulator', 'SkillMetrics', 'SoftBody', 'StateError', 'Volume', 'VolumeData', 'Window', 'World', 'capture_passes', 'gl_info', 'live_metrics', 'load_nrrd', 'load_slice_stack', 'openxr_built', 'phantom', 'plugin_search_path', 'read_colors', 'read_input_devices', 'read_label_table', 'read_launch', 'use_x11_display', 'write_image', 'write_label_table']
+__all__: list[str] = ['ActuatorHold', 'ArgumentError', 'ArgumentTypeError', 'AssetNotFound', 'Axis', 'Camera', 'ConfigError', 'ConstraintActuator', 'ControlOutput', 'Device', 'DistanceField', 'Drill', 'DrillSound', 'Error', 'Frame', 'InputDevice', 'Joint', 'JointType', 'JoystickDevice', 'JoystickMapping', 'KeyboardDevice', 'Label', 'Light', 'LightType', 'LoadReport', 'MergedDevice', 'MeshCollision', 'Model', 'NetworkDevice', 'NotFound', 'NullDevice', 'Object', 'OpenXrSession', 'OutOfRange', 'PLUGIN_ABI_VERSION', 'PluginError', 'PluginInfo', 'PluginSite', 'ProximitySensor', 'RealTimeLoop', 'RemovalMode', 'RenderError', 'ReplayDevice', 'ResourceError', 'RigidBody', 'ScriptedDevice', 'ShapeKind', 'SimulatedDevice', 'Simulator', 'SkillMetrics', 'SoftBody', 'StateError', 'Volume', 'VolumeData', 'Window', 'World', 'capture_passes', 'gl_info', 'load_nrrd', 'load_slice_stack', 'openxr_built', 'phantom', 'plugin_search_path', 'read_colors', 'read_input_devices', 'read_label_table', 'read_launch', 'render_drill_sound', 'use_x11_display', 'write_image', 'write_label_table']
 class Window:
     """
     An X11 window (GLFW's, made without a client API) showing cameras.
@@ -227,10 +227,6 @@ class VolumeData:
     def label_counts(self) -> numpy.typing.NDArray[numpy.int64]:
         """
         voxels per label id (index = id; index 0 counts the empty voxels)
-        """
-    def label_ids(self, labels: typing.Any, what: str = 'labels') -> list[int]:
-        """
-        The ids of labels given by name or id (one, or a list), by the rule every caller uses (a name first, then a number); an unknown one raises NotFound starting with `what` and listing the table's labels.
         """
     def mark_dirty(self, lo: typing.Annotated[collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], "FixedSize(3)"] | None = None, hi: typing.Annotated[collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], "FixedSize(3)"] | None = None) -> None:
         """
@@ -2390,9 +2386,9 @@ class SkillMetrics:
     """
     Skill metrics of a drilling session, fed tick by tick (live) or from a recording (offline) through the same code.
     """
-    def __init__(self, volume: VolumeData, *, protect: list = [], target_labels: typing.Any = None, target_mask: typing.Any = None, excess_force: typing.SupportsFloat | typing.SupportsIndex = 3.0, stroke_gap: typing.SupportsFloat | typing.SupportsIndex = 0.05, turn_step: typing.SupportsFloat | typing.SupportsIndex = 0.0005, turn_angle: typing.SupportsFloat | typing.SupportsIndex = 0.7853981633974483, field_band: typing.SupportsFloat | typing.SupportsIndex = 0.005, apply_removals: bool = False) -> None:
+    def __init__(self, volume: VolumeData, *, protect: list = [], target_labels: typing.Any = None, excess_force: typing.SupportsFloat | typing.SupportsIndex = 3.0, stroke_gap: typing.SupportsFloat | typing.SupportsIndex = 0.05, turn_step: typing.SupportsFloat | typing.SupportsIndex = 0.0005, turn_angle: typing.SupportsFloat | typing.SupportsIndex = 0.7853981633974483, field_band: typing.SupportsFloat | typing.SupportsIndex = 0.005, apply_removals: bool = False) -> None:
         """
-        Metrics of drilling `volume` (the volume being drilled, which the structures' distance fields follow). protect: [{'name', 'labels': names or ids, 'margin': metres}]; target_labels: the labels of the target region, or target_mask: the region voxel by voxel (an array of the volume's shape, non-zero inside); excess_force: N; stroke_gap: s; turn_step: m; turn_angle: rad; field_band: m beyond the margins; apply_removals: remove each tick's voxels from `volume` (offline, on a fresh copy of the anatomy).
+        Metrics of drilling `volume` (the volume being drilled, which the structures' distance fields follow). protect: [{'name', 'labels': names or ids, 'margin': metres}]; target_labels: the labels of the target region; excess_force: N; stroke_gap: s; turn_step: m; turn_angle: rad; field_band: m beyond the margins; apply_removals: remove each tick's voxels from `volume` (offline, on a fresh copy of the anatomy).
         """
     def add(self, step: typing.SupportsInt | typing.SupportsIndex, time: typing.SupportsFloat | typing.SupportsIndex, dt: typing.SupportsFloat | typing.SupportsIndex, tip: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], force: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], burr_radius: typing.SupportsFloat | typing.SupportsIndex, burr_on: bool, removed: typing.Annotated[numpy.typing.ArrayLike, numpy.int32] | None = None, removed_labels: typing.Annotated[numpy.typing.ArrayLike, numpy.uint16] | None = None) -> None:
         """
@@ -2410,27 +2406,92 @@ class SkillMetrics:
         """
         Everything measured so far, as a dict (distances in metres, times in seconds, forces in newtons, volumes as voxel counts with voxel_volume in cubic metres).
         """
-class LiveMetrics:
+class DrillSound:
     """
-    Skill metrics of a drill measured live: its world feeds them at every step, through the code the offline assessment runs (ambfplus.live_metrics starts them).
+    A drill's live sound, synthesised from the burr's state (spin-up and coasting, motor pitch falling with load, cutting noise following the tissue's hardness and the removal rate, proximity beeps) and fed from the drill at every step of its world, by the haptic thread of a real-time loop. Plays through miniaudio; a machine without an audio device says so once (a warning) and carries on silent. Use as a context manager, or close().
     """
-    def clearances(self) -> list:
+    def __enter__(self) -> DrillSound:
+        ...
+    def __exit__(self, *args) -> bool:
+        ...
+    def __init__(self, drill: Drill, *, output: str = 'device', muted: bool = False, require_device: bool = False, warnings: typing.Any = None, hardness: typing.Any = None, sample_rate: typing.SupportsInt | typing.SupportsIndex = 48000, period_frames: typing.SupportsInt | typing.SupportsIndex = 128, max_backlog_ticks: typing.SupportsInt | typing.SupportsIndex = 16, trim_backlog: bool = True, paused: bool = False, capture_seconds: typing.SupportsFloat | typing.SupportsIndex = 0.0, seed: typing.SupportsInt | typing.SupportsIndex = 24301) -> None:
         """
-        Each protected structure's distance (metres; None once it is gone) from the burr where it is now, with its margin: [{'name', 'margin', 'distance'}].
+        output: 'device' (the default output: PulseAudio, ALSA or JACK), 'null' (miniaudio's null device: played at the real rate, heard by nobody) or 'none'. require_device: raise ResourceError instead of carrying on silent. warnings: None (a beep per critical label of the volume, from 1 mm) or {structure: start metres, or {start, full, frequency, slow_period, fast_period}}; {} for none. hardness: {structure: hardness relative to bone} (1 elsewhere). max_backlog_ticks, trim_backlog: ticks beyond what the next callback needs, and a backlog that never drains, are dropped (bounded latency). paused: open the device without starting it. capture_seconds: keep that much of what is played for take_capture().
         """
-    def summary(self) -> dict:
+    def close(self) -> None:
         """
-        The metrics so far, as SkillMetrics.summary() gives them.
+        Stops feeding and closes the device; idempotent.
+        """
+    def set_muted(self, muted: bool) -> None:
+        ...
+    def take_capture(self) -> numpy.typing.NDArray[numpy.float32]:
+        """
+        The samples played since the last take (capture_seconds of them at most).
+        """
+    def take_latencies(self) -> numpy.typing.NDArray[numpy.float64]:
+        """
+        Seconds from each tick's push (the haptic step) to the moment its first sample is written into the device's buffer, for the ticks played since the last take.
+        """
+    def toggle_mute(self) -> bool:
+        """
+        Mutes or unmutes (a launcher's mute key); returns whether it is now muted.
         """
     @property
-    def active(self) -> bool:
+    def backend(self) -> str:
         """
-        Whether the metrics are still fed (their drill is in the world).
+        the backend playing ('pulseaudio', 'alsa', 'jack', 'null'; '' for none)
         """
     @property
-    def tick_cpu_seconds(self) -> numpy.typing.NDArray[numpy.float64]:
+    def closed(self) -> bool:
+        ...
+    @property
+    def device_error(self) -> typing.Any:
         """
-        CPU seconds the metrics added to each of the last ticks (up to 16384).
+        why no device plays (None when one does or none was asked for)
+        """
+    @property
+    def drill(self) -> Drill:
+        """
+        the drill it follows
+        """
+    @property
+    def muted(self) -> bool:
+        """
+        silences the output (the sound keeps running underneath)
+        """
+    @muted.setter
+    def muted(self, arg1: bool) -> None:
+        ...
+    @property
+    def paused(self) -> bool:
+        """
+        stops or restarts the device; ticks queue meanwhile
+        """
+    @paused.setter
+    def paused(self, arg1: bool) -> None:
+        ...
+    @property
+    def period_frames(self) -> int:
+        """
+        frames per audio callback the device settled on
+        """
+    @property
+    def playing(self) -> bool:
+        """
+        whether a device (or the null device) plays
+        """
+    @property
+    def sample_rate(self) -> int:
+        ...
+    @property
+    def stats(self) -> dict:
+        """
+        ticks pushed, rejected (queue full), played, dropped (backlog), held (repeated while none arrived); callbacks and frames played
+        """
+    @property
+    def warnings(self) -> list:
+        """
+        the proximity warnings, in the order of their distances
         """
 class PluginSite:
     """
@@ -2518,10 +2579,6 @@ def gl_info() -> dict:
     """
     Describes the OpenGL context (created on first use): vendor, renderer, version, ...
     """
-def live_metrics(drill: Drill, *, protect: list = [], target_labels: typing.Any = None, target_mask: typing.Any = None, excess_force: typing.SupportsFloat | typing.SupportsIndex = 3.0, stroke_gap: typing.SupportsFloat | typing.SupportsIndex = 0.05, turn_step: typing.SupportsFloat | typing.SupportsIndex = 0.0005, turn_angle: typing.SupportsFloat | typing.SupportsIndex = 0.7853981633974483, field_band: typing.SupportsFloat | typing.SupportsIndex = 0.005) -> LiveMetrics:
-    """
-    Starts skill metrics of `drill`, fed by its world after every step (SkillMetrics' options); its world keeps them until it goes.
-    """
 def load_nrrd(path: os.PathLike | str | bytes, kind: str = 'auto', threshold: typing.SupportsFloat | typing.SupportsIndex | None = None) -> VolumeData:
     """
     Loads an NRRD label map, intensity volume (segmented by threshold) or 3D Slicer segmentation (.seg.nrrd).
@@ -2555,6 +2612,10 @@ def read_label_table(path: os.PathLike | str | bytes) -> list[Label]:
 def read_launch(path: os.PathLike | str | bytes) -> dict:
     """
     A launch file's entries as a dict, paths made absolute.
+    """
+def render_drill_sound(on: typing.Any, load: typing.Any = None, removal_rate: typing.Any = None, *, speed: typing.Any = None, hardness: typing.Any = None, distances: typing.Any = None, warnings: typing.Any = None, sample_rate: typing.SupportsInt | typing.SupportsIndex = 48000, tick_seconds: typing.SupportsFloat | typing.SupportsIndex = 0.001, seed: typing.SupportsInt | typing.SupportsIndex = 24301) -> numpy.typing.NDArray[numpy.float32]:
+    """
+    The drill sound of a tick sequence, offline: mono float32 samples at sample_rate, exactly what a DrillSound plays for the same ticks (one synthesiser). on: burr on per tick; load: N; removal_rate: m^3/s; speed: 0..1 (1); hardness: relative to bone (1); warnings: {name: start metres or {start, full, frequency, slow_period, fast_period}} with distances (ticks, len(warnings)) in metres. Deterministic.
     """
 def use_x11_display(display: typing.SupportsInt | typing.SupportsIndex) -> None:
     """

@@ -38,6 +38,7 @@ void declare_engine(pybind11::module_& m);
 void declare_haptics(pybind11::module_& m);
 void declare_adf(pybind11::module_& m);
 void declare_training(pybind11::module_& m);
+void declare_audio(pybind11::module_& m);
 
 void define_io(pybind11::module_& m);
 void define_render(pybind11::module_& m);
@@ -48,6 +49,7 @@ void define_engine(pybind11::module_& m);
 void define_haptics(pybind11::module_& m);
 void define_adf(pybind11::module_& m);
 void define_training(pybind11::module_& m);
+void define_audio(pybind11::module_& m);
 
 void register_plugin(pybind11::module_& m);
 

@@ -41,6 +41,7 @@ PYBIND11_MODULE(_core, m) {
   b::declare_haptics(m);
   b::declare_adf(m);
   b::declare_training(m);
+  b::declare_audio(m);
   b::define_io(m);
   b::define_render(m);
   b::define_capture(m);
@@ -50,6 +51,7 @@ PYBIND11_MODULE(_core, m) {
   b::define_haptics(m);
   b::define_adf(m);
   b::define_training(m);
+  b::define_audio(m);
   b::register_plugin(m);
 
   // Info and above go to Python, whose logging decides what to show (debug only on request, by

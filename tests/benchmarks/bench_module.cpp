@@ -5,15 +5,19 @@
 
 #include <pybind11/eigen.h>
 #include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
 
 #include <time.h>
 
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <thread>
 #include <vector>
 
+#include "ambfplus/audio/drill_sound.h"
 #include "ambfplus/capture/capture.h"
 #include "ambfplus/capture/frame.h"
 #include "ambfplus/haptics/drill.h"
@@ -134,4 +138,55 @@ PYBIND11_MODULE(ambfplus_bench, m) {
         return out;
       },
       py::arg("drill"), py::arg("cursor") = 0, py::arg("iterations") = 20);
+
+  // The live drill sound's own latency, with no audio library in the way: a producer pushing a
+  // tick every millisecond and a consumer running the audio thread's fill() every period, both
+  // on absolute deadlines, as a haptic loop and a device of that period would.
+  m.def(
+      "drill_sound_paced_latency",
+      [](double seconds, int period_frames) {
+        namespace audio = ambfplus::audio;
+        audio::DrillSoundSpec spec;
+        audio::PlayerOptions options;
+        options.output = audio::AudioOutput::kNone;
+        audio::DrillSoundPlayer player(spec, options);
+        std::vector<double> latencies;
+        {
+          py::gil_scoped_release release;
+          using Clock = std::chrono::steady_clock;
+          std::atomic<bool> stop{false};
+          const auto period = std::chrono::duration_cast<Clock::duration>(
+              std::chrono::duration<double>(period_frames / double(spec.sample_rate)));
+          std::thread device([&] {
+            std::vector<float> buffer(period_frames);
+            auto next = Clock::now();
+            while (!stop) {
+              next += period;
+              std::this_thread::sleep_until(next);
+              player.fill(buffer.data(), static_cast<std::uint32_t>(period_frames));
+            }
+          });
+          audio::DrillTick tick;
+          tick.on = true;
+          tick.load = 1.0f;
+          tick.removal_rate = 20e-9f;
+          auto next = Clock::now();
+          const auto ticks = static_cast<int>(seconds * 1000);
+          for (int i = 0; i < ticks; ++i) {
+            next += std::chrono::milliseconds(1);
+            std::this_thread::sleep_until(next);
+            player.push(tick);
+            if (i % 1000 == 999) {
+              for (double v : player.take_latencies()) latencies.push_back(v);
+            }
+          }
+          std::this_thread::sleep_for(std::chrono::milliseconds(20));
+          stop = true;
+          device.join();
+          for (double v : player.take_latencies()) latencies.push_back(v);
+        }
+        return latencies;
+      },
+      py::arg("seconds"), py::arg("period_frames") = 128,
+      "Seconds from each tick's push to its first sample's write, with a paced consumer.");
 }

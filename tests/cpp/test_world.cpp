@@ -96,8 +96,9 @@ TEST(World, StepRunsSystemsStageByStageAndObjectsAreAnnounced) {
   EXPECT_EQ(log, (std::vector<std::string>{"removed gone"}));
   std::vector<std::string> names;
   for (System* s : world.systems()) names.push_back(s->name());
-  EXPECT_EQ(names, (std::vector<std::string>{"attachments", "step log", "physics", "devices",
-                                             "drills", "renderer", "plugins", "recorder"}));
+  EXPECT_EQ(names,
+            (std::vector<std::string>{"attachments", "step log", "physics", "devices", "drills",
+                                      "training", "sound", "renderer", "plugins", "recorder"}));
 }
 
 // The scene alone is a world that steps: its own systems only, no physics, renderer or plugins.

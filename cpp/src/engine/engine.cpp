@@ -1,5 +1,6 @@
 #include "ambfplus/engine/engine.h"
 
+#include "ambfplus/audio/systems.h"
 #include "ambfplus/errors.h"
 #include "ambfplus/haptics/systems.h"
 #include "ambfplus/physics/physics.h"
@@ -19,6 +20,7 @@ void install_systems(World& world) {
   world.add_system(haptics::make_device_system());
   world.add_system(haptics::make_drill_system());
   world.add_system(training::make_training_system());
+  world.add_system(audio::make_sound_system());
   world.add_system(render::make_renderer(world));
   world.add_system(std::make_unique<PluginRegistry>(world));
 }

@@ -14,8 +14,9 @@
 namespace ambfplus::engine {
 
 /// Adds the engine's systems to a world that has only the scene's own, in the order objects are
-/// announced to them: physics first (it may refuse an object), then input devices, drills and
-/// the renderer, plugins last (they hear of an object once everything else has taken it).
+/// announced to them: physics first (it may refuse an object), then input devices, drills, drill
+/// sounds and the renderer, plugins last (they hear of an object once everything else has taken
+/// it).
 AMBFPLUS_API void install_systems(World& world);
 
 /// A simulator whose world has the engine's systems: what ambfplus.Simulator is in Python.

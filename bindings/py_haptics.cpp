@@ -551,6 +551,67 @@ void define_drill(py::module_& m) {
             return out;
           },
           "metres from the burr's surface to each critical structure")
+      .def(
+          "set_fixture",
+          [](Drill& d, const py::object& structure, double start, double max_force,
+             std::optional<double> stop, bool enabled) {
+            FixtureSpec f;
+            f.structure = to_option(structure).type() == OptionValue::Type::kInteger
+                              ? std::to_string(structure.cast<long long>())
+                              : structure.cast<std::string>();
+            f.start = start;
+            f.max_force = max_force;
+            f.stop = stop.value_or(0.0);
+            f.enabled = enabled;
+            without_gil([&] {
+              auto lock = d.world().lock_state_for_copy();
+              d.set_fixture(f);
+            });
+          },
+          py::arg("structure"), py::kw_only(), py::arg("start"), py::arg("max_force") = 1.0,
+          py::arg("stop") = py::none(), py::arg("enabled") = true,
+          "sets the forbidden-region fixture of a structure (label name or id), replacing its "
+          "last: below `start` metres from the burr's surface a force up to `max_force` N at "
+          "the structure pushes the burr away; below `stop` metres (None: no hard stop) nothing "
+          "is cut and the burr is held back")
+      .def(
+          "set_fixtures",
+          [](Drill& d, const py::list& fixtures) {
+            std::vector<FixtureSpec> all;
+            for (std::size_t i = 0; i < fixtures.size(); ++i) {
+              all.push_back(fixture_from(OptionValue::mapping(to_options(fixtures[i])),
+                                         "fixtures[" + std::to_string(i) + "]"));
+            }
+            without_gil([&] {
+              auto lock = d.world().lock_state_for_copy();
+              d.set_fixtures(all);
+            });
+          },
+          py::arg("fixtures"),
+          "replaces every fixture by a list of dicts (a DRILL block's `fixtures`): structure, "
+          "start, max_force (default 1 N), stop (default None), enabled (default True); [] "
+          "removes them")
+      .def_property_readonly(
+          "fixtures",
+          [](Drill& d) {
+            py::list out;
+            for (const FixtureSpec& f : locked_copy(d, [&] { return d.fixtures(); })) {
+              py::dict e;
+              e["structure"] = f.structure;
+              e["start"] = f.start;
+              e["max_force"] = f.max_force;
+              e["stop"] = f.stop > 0 ? py::object(py::float_(f.stop)) : py::object(py::none());
+              e["enabled"] = f.enabled;
+              out.append(e);
+            }
+            return out;
+          },
+          "the fixtures as dicts (set_fixtures' form), structures by label name")
+      .def_property_readonly(
+          "fixture_force", [](Drill& d) { return Vec3(d.fixture_force()); },
+          "the part of `force` the fixtures added at the last step, N, world frame")
+      .def_property("fixture_passivity", &Drill::fixture_passivity, &Drill::set_fixture_passivity,
+                    "keep the fixtures' force passive (energy observer and damping; default on)")
       .def_property_readonly(
           "removed",
           [](Drill& d) { return removed_arrays(locked_copy(d, [&] { return d.removed(); })); },

@@ -64,10 +64,37 @@ TEST(StructureDistances, ExactInTheBandALowerBoundBeyondAndFollowingCuts) {
     const std::int64_t before = v.revision();
     const std::vector<std::uint16_t> old = v.remove_voxels(layer);
     distances.removed(before, old);
-    distances.sync();
+    for (int t = 0; t <= StructureDistances::kFollowTicks; ++t) distances.tick();
     check("after a cut");
   }
   EXPECT_TRUE(std::isinf(distances.distance(2, Eigen::Vector3d::Zero())));
+  EXPECT_EQ(distances.rebuilds(), 4);
+}
+
+// Until the rebuilt field is due, the old one answers: a lower bound after a cut, the same in
+// every run (the tick decides, not the threads).
+TEST(StructureDistances, ARebuiltFieldIsTakenAtItsTick) {
+  const LabelTable table({Label{1, "Bone", {200, 200, 200}, true, false},
+                          Label{2, "Nerve", {250, 220, 0}, true, true}});
+  VolumeData v({20, 20, 20}, Eigen::Vector3d(0.02, 0.02, 0.02), LabelType::kUInt8, table);
+  v.set_region(VoxelBox{{0, 0, 0}, {20, 20, 20}}, 1);
+  v.set_region(VoxelBox{{8, 8, 2}, {12, 12, 6}}, 2);
+  StructureDistances distances(v);
+  distances.track(2, 0.008);
+  const Eigen::Vector3d p = v.voxel_center(10, 10, 9);
+  const double d0 = distances.distance(2, p);
+  std::vector<std::array<int, 3>> top;
+  for (int j = 8; j < 12; ++j)
+    for (int i = 8; i < 12; ++i) top.push_back({i, j, 5});
+  const std::int64_t before = v.revision();
+  distances.removed(before, v.remove_voxels(top));
+  for (int t = 0; t < StructureDistances::kFollowTicks; ++t) {
+    distances.tick();
+    ASSERT_EQ(distances.distance(2, p), d0) << "tick " << t;
+  }
+  distances.tick();
+  EXPECT_NEAR(distances.distance(2, p), brute_force(v, p, 2), 1e-6);
+  EXPECT_GT(distances.distance(2, p), d0 + 0.0009);
 }
 
 // Cutting bone only does not touch a structure's field (its box is skipped, not scanned).
@@ -84,9 +111,15 @@ TEST(StructureDistances, CutsOfOtherLabelsLeaveTheFieldAsItWas) {
   const std::int64_t before = v.revision();
   const std::vector<std::uint16_t> old = v.remove_voxels({{10, 10, 15}, {10, 10, 16}});
   distances.removed(before, old);
-  distances.sync();
+  for (int t = 0; t <= 2 * StructureDistances::kFollowTicks; ++t) distances.tick();
   EXPECT_EQ(distances.distance(2, p), d0);
   EXPECT_DOUBLE_EQ(d0, brute_force(v, p, 2));
+  EXPECT_EQ(distances.rebuilds(), 0);
+  // An edit by someone else in the structure's neighbourhood is noticed (and rebuilt for).
+  v.set_region(VoxelBox{{10, 10, 6}, {11, 11, 7}}, 2);
+  for (int t = 0; t <= StructureDistances::kFollowTicks + 1; ++t) distances.tick();
+  EXPECT_EQ(distances.rebuilds(), 1);
+  EXPECT_NEAR(distances.distance(2, p), brute_force(v, p, 2), 1e-6);
 }
 
 }  // namespace

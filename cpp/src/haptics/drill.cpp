@@ -208,7 +208,7 @@ void Drill::tick(double dt, std::int64_t step) {
   age_ += dt;
   collider_->sync();
   sync_meshes();
-  structures_->sync();  // edits made between ticks
+  structures_->tick();  // fields follow the edits (see StructureDistances)
   update_cursors();
   place_drill();
   const Eigen::Vector3d tip_force = update_forces(dt);
@@ -365,8 +365,7 @@ void Drill::remove_tissue(double dt, std::int64_t step, const Eigen::Vector3d& t
 }
 
 void Drill::update_critical_distances() {
-  // From the burr's surface to each critical structure, as this tick's cut left it.
-  structures_->sync();
+  // From the burr's surface to each critical structure.
   critical_distances_.clear();
   for (std::uint16_t label : critical_labels_) {
     const double d = surface_distance(label, cursors_[0].proxy(), nullptr);

@@ -172,7 +172,9 @@ class AMBFPLUS_API Drill : public Object {
   /// distance field, which follows the drilling: the distance from the burr's centre (its tip
   /// cursor's proxy) to the nearest voxel centre of the structure, less the burr's radius and
   /// half a voxel. Exact within kExactReach of the burr's surface; beyond, a lower bound (the
-  /// distance to the box around the structure, at least kExactReach).
+  /// distance to the box around the structure, at least kExactReach). A field is rebuilt on
+  /// another thread after a cut into its structure and taken into use 50 ticks later (the same
+  /// tick in every run); until then it answers for the structure before the cut, a lower bound.
   const std::vector<std::pair<std::uint16_t, double>>& critical_distances() const {
     return critical_distances_;
   }

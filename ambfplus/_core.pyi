@@ -2028,6 +2028,10 @@ class Drill(Object):
         """
         move body with the drill
         """
+    def clear_plan(self) -> None:
+        """
+        removes the plan's fixture
+        """
     def set_fixture(self, structure: typing.Any, *, start: typing.SupportsFloat | typing.SupportsIndex, max_force: typing.SupportsFloat | typing.SupportsIndex = 1.0, stop: typing.SupportsFloat | typing.SupportsIndex | None = None, enabled: bool = True) -> None:
         """
         sets the forbidden-region fixture of a structure (label name or id), replacing its last: below `start` metres from the burr's surface a force up to `max_force` N at the structure pushes the burr away; below `stop` metres (None: no hard stop) nothing is cut and the burr is held back
@@ -2038,6 +2042,10 @@ class Drill(Object):
         """
     def set_hardness(self, label: typing.SupportsInt | typing.SupportsIndex, hardness: typing.SupportsFloat | typing.SupportsIndex) -> None:
         ...
+    def set_plan(self, target: typing.Any, *, start: typing.SupportsFloat | typing.SupportsIndex, max_force: typing.SupportsFloat | typing.SupportsIndex = 1.0, stop: typing.SupportsFloat | typing.SupportsIndex | None = None, enabled: bool = True) -> None:
+        """
+        stay in the plan: a fixture on the boundary of a planned region, `target` a boolean mask of the volume's shape (nx, ny, nz) or a list of labels (names or ids); every labelled voxel outside it is the forbidden side (with a `stop`, nothing outside it is cut)
+        """
     def set_waypoints(self, waypoints: list) -> None:
         """
         follow dicts of time (s from now), pose (4x4) and optionally on and speed, interpolating between them
@@ -2129,6 +2137,11 @@ class Drill(Object):
     @property
     def leading_cursor(self) -> int:
         ...
+    @property
+    def plan(self) -> typing.Any:
+        """
+        the plan's fixture as a dict (start, max_force, stop, enabled, voxels), or None
+        """
     @property
     def pose(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
         """

@@ -607,6 +607,72 @@ void define_drill(py::module_& m) {
             return out;
           },
           "the fixtures as dicts (set_fixtures' form), structures by label name")
+      .def(
+          "set_plan",
+          [](Drill& d, const py::object& target, double start, double max_force,
+             std::optional<double> stop, bool enabled) {
+            FixtureSpec f;
+            f.start = start;
+            f.max_force = max_force;
+            f.stop = stop.value_or(0.0);
+            f.enabled = enabled;
+            if (py::isinstance<py::array>(target)) {
+              // (nx, ny, nz), i fastest: Fortran order, as VolumeData.labels.
+              auto a = py::array_t<std::uint8_t, py::array::f_style | py::array::forcecast>::ensure(
+                  target);
+              const auto& n = d.volume().data()->shape();
+              if (!a || a.ndim() != 3 || a.shape(0) != n[0] || a.shape(1) != n[1] ||
+                  a.shape(2) != n[2]) {
+                throw ArgumentError("set_plan: a mask must have the volume's shape (" +
+                                    std::to_string(n[0]) + ", " + std::to_string(n[1]) + ", " +
+                                    std::to_string(n[2]) + ")");
+              }
+              std::vector<std::uint8_t> mask(a.data(), a.data() + a.size());
+              without_gil([&] {
+                auto lock = d.world().lock_state_for_copy();
+                d.set_plan(mask, f);
+              });
+              return;
+            }
+            std::vector<std::string> labels;
+            for (const py::handle& h : target) {
+              labels.push_back(py::isinstance<py::int_>(h) ? std::to_string(h.cast<long long>())
+                                                           : h.cast<std::string>());
+            }
+            without_gil([&] {
+              auto lock = d.world().lock_state_for_copy();
+              d.set_plan(labels, f);
+            });
+          },
+          py::arg("target"), py::kw_only(), py::arg("start"), py::arg("max_force") = 1.0,
+          py::arg("stop") = py::none(), py::arg("enabled") = true,
+          "stay in the plan: a fixture on the boundary of a planned region, `target` a boolean "
+          "mask of the volume's shape (nx, ny, nz) or a list of labels (names or ids); every "
+          "labelled voxel outside it is the forbidden side (with a `stop`, nothing outside it "
+          "is cut)")
+      .def(
+          "clear_plan",
+          [](Drill& d) {
+            without_gil([&] {
+              auto lock = d.world().lock_state_for_copy();
+              d.clear_plan();
+            });
+          },
+          "removes the plan's fixture")
+      .def_property_readonly(
+          "plan",
+          [](Drill& d) -> py::object {
+            const FixtureSpec* f = d.plan();
+            if (f == nullptr) return py::none();
+            py::dict e;
+            e["start"] = f->start;
+            e["max_force"] = f->max_force;
+            e["stop"] = f->stop > 0 ? py::object(py::float_(f->stop)) : py::object(py::none());
+            e["enabled"] = f->enabled;
+            e["voxels"] = d.plan_voxels();
+            return std::move(e);
+          },
+          "the plan's fixture as a dict (start, max_force, stop, enabled, voxels), or None")
       .def_property_readonly(
           "fixture_force", [](Drill& d) { return Vec3(d.fixture_force()); },
           "the part of `force` the fixtures added at the last step, N, world frame")

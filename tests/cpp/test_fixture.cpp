@@ -63,7 +63,7 @@ TEST(StructureDistances, ExactInTheBandALowerBoundBeyondAndFollowingCuts) {
       for (int i = 14; i < 22; ++i) layer.push_back({i, j, k});
     const std::int64_t before = v.revision();
     const std::vector<std::uint16_t> old = v.remove_voxels(layer);
-    distances.removed(before, old);
+    distances.removed(before, layer, old);
     for (int t = 0; t <= StructureDistances::kFollowTicks; ++t) distances.tick();
     check("after a cut");
   }
@@ -87,7 +87,8 @@ TEST(StructureDistances, ARebuiltFieldIsTakenAtItsTick) {
   for (int j = 8; j < 12; ++j)
     for (int i = 8; i < 12; ++i) top.push_back({i, j, 5});
   const std::int64_t before = v.revision();
-  distances.removed(before, v.remove_voxels(top));
+  const std::vector<std::uint16_t> old = v.remove_voxels(top);
+  distances.removed(before, top, old);
   for (int t = 0; t < StructureDistances::kFollowTicks; ++t) {
     distances.tick();
     ASSERT_EQ(distances.distance(2, p), d0) << "tick " << t;
@@ -109,8 +110,9 @@ TEST(StructureDistances, CutsOfOtherLabelsLeaveTheFieldAsItWas) {
   const Eigen::Vector3d p = v.voxel_center(10, 10, 9);
   const double d0 = distances.distance(2, p);
   const std::int64_t before = v.revision();
-  const std::vector<std::uint16_t> old = v.remove_voxels({{10, 10, 15}, {10, 10, 16}});
-  distances.removed(before, old);
+  const std::vector<std::array<int, 3>> far{{10, 10, 15}, {10, 10, 16}};
+  const std::vector<std::uint16_t> old = v.remove_voxels(far);
+  distances.removed(before, far, old);
   for (int t = 0; t <= 2 * StructureDistances::kFollowTicks; ++t) distances.tick();
   EXPECT_EQ(distances.distance(2, p), d0);
   EXPECT_DOUBLE_EQ(d0, brute_force(v, p, 2));

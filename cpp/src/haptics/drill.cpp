@@ -312,6 +312,12 @@ std::vector<std::pair<double, std::array<int, 3>>> Drill::cuttable_voxels() cons
     if ((c - burr.proxy()).squaredNorm() > reach * reach) continue;
     const std::uint16_t label = data->label(v[0], v[1], v[2]);
     if (label == 0 || uncuttable_[label]) continue;  // removed earlier, or behind a hard stop
+    if (plan_stop_ &&
+        (*plan_mask_)[static_cast<std::size_t>(v[0]) +
+                      static_cast<std::size_t>(data->shape()[0]) *
+                          (v[1] + static_cast<std::size_t>(data->shape()[1]) * v[2])] == 0) {
+      continue;  // outside the plan
+    }
     const Label* l = data->label_table().find(label);
     if (l != nullptr && !l->removable) continue;
     order.push_back({(c - burr.goal()).squaredNorm(), v});
@@ -356,7 +362,7 @@ void Drill::remove_tissue(double dt, std::int64_t step, const Eigen::Vector3d& t
   const std::int64_t before = data->revision();
   const std::vector<std::uint16_t> old = collider_->remove(take);
   // Fields of structures this cut did not touch skip its box.
-  structures_->removed(before, old);
+  structures_->removed(before, take, old);
   for (std::size_t i = 0; i < take.size(); ++i) {
     log_removed(RemovedVoxel{step, take[i], old[i]});
     const Label* l = data->label_table().find(old[i]);

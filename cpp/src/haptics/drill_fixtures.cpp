@@ -70,15 +70,69 @@ std::vector<FixtureSpec> Drill::fixtures() const {
   return out;
 }
 
+void Drill::set_plan(const std::vector<std::uint8_t>& mask, const FixtureSpec& fixture) {
+  const VolumeData& data = *volume_->data();
+  if (static_cast<std::int64_t>(mask.size()) != data.voxel_count()) {
+    throw ArgumentError(describe() + ": a plan needs one entry per voxel (" +
+                        std::to_string(data.voxel_count()) + "), got " +
+                        std::to_string(mask.size()));
+  }
+  FixtureSpec spec = fixture;
+  spec.structure = "plan";
+  spec.validate(describe() + ": ");
+  auto shared = std::make_shared<const std::vector<std::uint8_t>>(mask);
+  plan_voxels_ = static_cast<std::int64_t>(mask.size()) -
+                 static_cast<std::int64_t>(std::count(mask.begin(), mask.end(), 0));
+  const double largest_burr =
+      *std::max_element(spec_.burr_diameters.begin(), spec_.burr_diameters.end()) / 2;
+  const double reach =
+      std::max(spec.start, spec.stop) + largest_burr + 2 * data.voxel_size().norm();
+  structures_->set_plan(shared);
+  structures_->track(0, reach);
+  plan_mask_ = std::move(shared);
+  plan_ = ActiveFixture{spec, 0};
+  fixtures_changed();
+}
+
+void Drill::set_plan(const std::vector<std::string>& labels, const FixtureSpec& fixture) {
+  const VolumeData& data = *volume_->data();
+  std::vector<bool> wanted(65536, false);
+  for (const std::string& name : labels) {
+    wanted[resolve_label(data.label_table(), name, describe() + " plan")] = true;
+  }
+  const auto& n = data.shape();
+  std::vector<std::uint8_t> mask(static_cast<std::size_t>(data.voxel_count()));
+  std::size_t idx = 0;
+  for (int k = 0; k < n[2]; ++k) {
+    for (int j = 0; j < n[1]; ++j) {
+      for (int i = 0; i < n[0]; ++i) mask[idx++] = wanted[data.label(i, j, k)] ? 1 : 0;
+    }
+  }
+  set_plan(mask, fixture);
+}
+
+void Drill::clear_plan() {
+  plan_.reset();
+  plan_mask_.reset();
+  plan_voxels_ = 0;
+  fixtures_changed();
+}
+
 void Drill::fixtures_changed() {
   std::fill(uncuttable_.begin(), uncuttable_.end(), false);
   any_stop_ = false;
+  active_.clear();
   for (const ActiveFixture& a : fixtures_) {
-    if (a.spec.enabled && a.spec.stop > 0) {
+    if (!a.spec.enabled) continue;
+    active_.push_back(&a);
+    if (a.spec.stop > 0) {
       uncuttable_[a.label] = true;
       any_stop_ = true;
     }
   }
+  plan_stop_ = plan_ && plan_->spec.enabled && plan_->spec.stop > 0;
+  if (plan_ && plan_->spec.enabled) active_.push_back(&*plan_);
+  any_stop_ = any_stop_ || plan_stop_;
   held_valid_ = false;
   fixture_energy_ = 0.0;  // new regions: the energy observer starts anew
 }
@@ -95,7 +149,7 @@ double Drill::surface_distance(std::uint16_t label, const Eigen::Vector3d& p,
 }
 
 double Drill::structure_distance(std::uint16_t label, const Eigen::Vector3d& p) const {
-  if (!structures_->tracks(label)) {
+  if (label == 0 || !structures_->tracks(label)) {
     throw ArgumentError(describe() + ": label " + std::to_string(label) +
                         " is neither critical nor fixed");
   }
@@ -104,10 +158,10 @@ double Drill::structure_distance(std::uint16_t label, const Eigen::Vector3d& p) 
 
 double Drill::stop_clearance(const Eigen::Vector3d& p, Eigen::Vector3d* away) const {
   double best = kInf;
-  for (const ActiveFixture& a : fixtures_) {
-    if (!a.spec.enabled || a.spec.stop <= 0) continue;
+  for (const ActiveFixture* a : active_) {
+    if (a->spec.stop <= 0) continue;
     Eigen::Vector3d n;
-    const double c = surface_distance(a.label, p, &n) - a.spec.stop;
+    const double c = surface_distance(a->label, p, &n) - a->spec.stop;
     if (c < best) {
       best = c;
       if (away != nullptr) *away = n;
@@ -177,12 +231,12 @@ Eigen::Vector3d Drill::held_tip_goal(const Eigen::Vector3d& goal) {
 
 Eigen::Vector3d Drill::fixture_push(const Eigen::Vector3d& centre) const {
   Eigen::Vector3d f = Eigen::Vector3d::Zero();
-  for (const ActiveFixture& a : fixtures_) {
-    if (!a.spec.enabled || a.spec.max_force <= 0) continue;
+  for (const ActiveFixture* a : active_) {
+    if (a->spec.max_force <= 0) continue;
     Eigen::Vector3d away;
-    const double d = surface_distance(a.label, centre, &away);
-    if (d >= a.spec.start) continue;
-    f += a.spec.max_force * (1.0 - std::max(d, 0.0) / a.spec.start) * away;
+    const double d = surface_distance(a->label, centre, &away);
+    if (d >= a->spec.start) continue;
+    f += a->spec.max_force * (1.0 - std::max(d, 0.0) / a->spec.start) * away;
   }
   return f;
 }

@@ -69,9 +69,15 @@ std::unique_ptr<VolumeData> StructureDistances::copy(std::uint16_t label,
     const T wanted = static_cast<T>(label);
     for (int k = box.lo[2]; k < box.hi[2]; ++k) {
       for (int j = box.lo[1]; j < box.hi[1]; ++j) {
-        const T* row = grid + box.lo[0] +
-                       static_cast<std::size_t>(n[0]) * (j + static_cast<std::size_t>(n[1]) * k);
-        for (int i = 0; i < width; ++i) out[i] = row[i] == wanted;
+        const std::size_t start =
+            box.lo[0] + static_cast<std::size_t>(n[0]) * (j + static_cast<std::size_t>(n[1]) * k);
+        const T* row = grid + start;
+        if (label != 0) {
+          for (int i = 0; i < width; ++i) out[i] = row[i] == wanted;
+        } else {
+          const std::uint8_t* in_plan = plan_->data() + start;
+          for (int i = 0; i < width; ++i) out[i] = row[i] != 0 && in_plan[i] == 0;
+        }
         out += width;
       }
     }
@@ -127,6 +133,15 @@ std::future<std::shared_ptr<const StructureDistances::Field>> StructureDistances
                     });
 }
 
+void StructureDistances::set_plan(std::shared_ptr<const std::vector<std::uint8_t>> mask) {
+  plan_ = std::move(mask);
+  if (Entry* e = find(0)) {
+    const double band = e->band;
+    e->band = 0.0;  // rebuilt now, whatever its band
+    track(0, band);
+  }
+}
+
 void StructureDistances::track(std::uint16_t label, double band) {
   notice_edits();
   Entry* e = find(label);
@@ -144,7 +159,7 @@ void StructureDistances::track(std::uint16_t label, double band) {
   for (int k = 0; k < n[2]; ++k) {
     for (int j = 0; j < n[1]; ++j) {
       for (int i = 0; i < n[0]; ++i) {
-        if (data_.label(i, j, k) != label) continue;
+        if (!member(label, data_.label(i, j, k), i, j, k)) continue;
         any = true;
         const int c[3] = {i, j, k};
         for (int a = 0; a < 3; ++a) {
@@ -182,7 +197,7 @@ void StructureDistances::notice_edits() {
       for (int k = box.lo[2]; k < box.hi[2] && !painted; ++k) {
         for (int j = box.lo[1]; j < box.hi[1] && !painted; ++j) {
           for (int i = box.lo[0]; i < box.hi[0]; ++i) {
-            if (data_.label(i, j, k) == e.label) {
+            if (member(e.label, data_.label(i, j, k), i, j, k)) {
               painted = true;
               break;
             }
@@ -197,9 +212,13 @@ void StructureDistances::notice_edits() {
   }
 }
 
-void StructureDistances::removed(std::int64_t before, const std::vector<std::uint16_t>& labels) {
+void StructureDistances::removed(std::int64_t before, const std::vector<std::array<int, 3>>& voxels,
+                                 const std::vector<std::uint16_t>& labels) {
   for (Entry& e : entries_) {
-    if (std::find(labels.begin(), labels.end(), e.label) != labels.end()) e.changed = true;
+    for (std::size_t n = 0; n < voxels.size() && !e.changed; ++n) {
+      const std::array<int, 3>& v = voxels[n];
+      e.changed = member(e.label, labels[n], v[0], v[1], v[2]);
+    }
   }
   if (seen_ == before) seen_ = data_.revision();  // else notice_edits() scans them all
 }

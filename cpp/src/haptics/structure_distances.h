@@ -1,5 +1,6 @@
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <future>
 #include <memory>
@@ -38,13 +39,17 @@ class StructureDistances {
   static constexpr std::int64_t kFollowTicks = 50;
 
   /// Tracks a structure with a field of at least `band` metres, built now (a narrower field is
-  /// rebuilt, a wider one kept).
+  /// rebuilt, a wider one kept). Label 0 names the tissue outside the plan (set_plan).
   void track(std::uint16_t label, double band);
+  /// The planned region: mask[i + nx (j + ny k)] != 0 for voxels in the plan. The structure of
+  /// label 0 is then every labelled voxel outside it; its field is rebuilt at once if tracked.
+  void set_plan(std::shared_ptr<const std::vector<std::uint8_t>> mask);
   bool tracks(std::uint16_t label) const { return find(label) != nullptr; }
 
   /// Tells that the edit(s) from revision `before` to the volume's current one removed voxels of
   /// these labels and nothing else: their structures are rebuilt, the others skip the edits.
-  void removed(std::int64_t before, const std::vector<std::uint16_t>& labels);
+  void removed(std::int64_t before, const std::vector<std::array<int, 3>>& voxels,
+               const std::vector<std::uint16_t>& labels);
   /// One tick: notices edits made by others (their boxes are scanned), takes rebuilt fields
   /// that are due, and starts the rebuilds that are waiting.
   void tick();
@@ -86,6 +91,15 @@ class StructureDistances {
   static std::shared_ptr<const Field> finish(std::unique_ptr<VolumeData> snapshot, VoxelBox box,
                                              Eigen::Vector3d offset, double band);
   std::unique_ptr<VolumeData> copy(std::uint16_t label, const VoxelBox& box) const;
+  /// Whether voxel (i, j, k), whose label is l, belongs to the structure of `label`.
+  bool member(std::uint16_t label, std::uint16_t l, int i, int j, int k) const {
+    if (label != 0) return l == label;
+    const auto& n = data_.shape();
+    return l != 0 &&
+           !(*plan_)[static_cast<std::size_t>(i) +
+                     static_cast<std::size_t>(n[0]) *
+                         (static_cast<std::size_t>(j) + static_cast<std::size_t>(n[1]) * k)];
+  }
   void notice_edits();
 
   const VolumeData& data_;
@@ -93,6 +107,7 @@ class StructureDistances {
   std::int64_t tick_ = 0;
   std::int64_t seen_ = -1;  // the volume revision whose edits are accounted for
   std::int64_t rebuilds_ = 0;
+  std::shared_ptr<const std::vector<std::uint8_t>> plan_;
   std::future<void> retiring_;  // frees a replaced field (megabytes: munmap takes milliseconds)
 };
 

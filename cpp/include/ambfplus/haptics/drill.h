@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <deque>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -199,6 +200,21 @@ class AMBFPLUS_API Drill : public Object {
   /// the hand's velocity dissipates the excess (Hannaford and Ryu's passivity controller).
   void set_fixture_passivity(bool on) { fixture_passivity_ = on; }
   bool fixture_passivity() const { return fixture_passivity_; }
+  // --- Guidance: stay in the plan
+  /// Keeps the burr in a planned region: a fixture (the start, max_force, stop and enabled of
+  /// `fixture`; its structure is ignored) whose forbidden side is every labelled voxel outside
+  /// the region, so that with a stop nothing outside it is cut. `mask` holds one entry per
+  /// voxel, i fastest, non-zero in the plan. Throws ArgumentError for a mask of another size or
+  /// a bad spec.
+  void set_plan(const std::vector<std::uint8_t>& mask, const FixtureSpec& fixture);
+  /// The same with the plan given as the voxels of some labels (names or ids).
+  void set_plan(const std::vector<std::string>& labels, const FixtureSpec& fixture);
+  void clear_plan();
+  /// The plan's fixture (its structure "plan"), or nullptr without a plan.
+  const FixtureSpec* plan() const { return plan_ ? &plan_->spec : nullptr; }
+  /// Voxels in the plan.
+  std::int64_t plan_voxels() const { return plan_voxels_; }
+
   /// The regions' push on the burr centred at p (volume frame; N, volume axes): the sum of
   /// max_force x (1 - d / start) away from each structure nearer than its start, without the
   /// hard stops' spring or the damping (what each tick evaluates at the burr's proxy).
@@ -274,7 +290,12 @@ class AMBFPLUS_API Drill : public Object {
     std::uint16_t label;
   };
   std::vector<ActiveFixture> fixtures_;
-  std::vector<bool> uncuttable_;  // by label: a structure with an enabled hard stop
+  std::optional<ActiveFixture> plan_;  // label 0: the tissue outside the plan
+  std::shared_ptr<const std::vector<std::uint8_t>> plan_mask_;
+  std::int64_t plan_voxels_ = 0;
+  bool plan_stop_ = false;                    // nothing outside the plan is cut
+  std::vector<const ActiveFixture*> active_;  // the enabled fixtures and plan
+  std::vector<bool> uncuttable_;              // by label: a structure with an enabled hard stop
   bool any_stop_ = false;
   Eigen::Vector3d held_goal_ = Eigen::Vector3d::Zero();  // the tip's held goal, volume frame
   bool held_valid_ = false;

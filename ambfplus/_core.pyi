@@ -511,6 +511,7 @@ class World:
           cutting_rate (float): m^3 / (s N) at full speed
           voxels_per_step (list[int]): per burr (compatible removal)
           pose (numpy.ndarray): 4x4 initial goal, world from drill
+          fixtures (list[dict]): forbidden regions: {structure, start, max_force, stop, enabled} each
         """
     def add_ghost(self, name: str, shape: ShapeKind | str | None = None, *, size: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] | None = None, radius: typing.SupportsFloat | typing.SupportsIndex | None = None, height: typing.SupportsFloat | typing.SupportsIndex | None = None, mesh: os.PathLike | str | bytes | None = None, scale: typing.SupportsFloat | typing.SupportsIndex = 1.0, pose: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"] | None = None, color: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex] | None = None, visible: bool = True, **kwargs) -> RigidBody:
         """
@@ -798,6 +799,7 @@ class Model:
           cutting_rate (float): m^3 / (s N) at full speed
           voxels_per_step (list[int]): per burr (compatible removal)
           pose (numpy.ndarray): 4x4 initial goal, world from drill
+          fixtures (list[dict]): forbidden regions: {structure, start, max_force, stop, enabled} each
         """
     def add_ghost(self, name: str, shape: ShapeKind | str | None = None, *, size: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] | None = None, radius: typing.SupportsFloat | typing.SupportsIndex | None = None, height: typing.SupportsFloat | typing.SupportsIndex | None = None, mesh: os.PathLike | str | bytes | None = None, scale: typing.SupportsFloat | typing.SupportsIndex = 1.0, pose: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"] | None = None, color: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex] | None = None, visible: bool = True, **kwargs) -> RigidBody:
         """
@@ -2026,8 +2028,24 @@ class Drill(Object):
         """
         move body with the drill
         """
+    def clear_plan(self) -> None:
+        """
+        removes the plan's fixture
+        """
+    def set_fixture(self, structure: typing.Any, *, start: typing.SupportsFloat | typing.SupportsIndex, max_force: typing.SupportsFloat | typing.SupportsIndex = 1.0, stop: typing.SupportsFloat | typing.SupportsIndex | None = None, enabled: bool = True) -> None:
+        """
+        sets the forbidden-region fixture of a structure (label name or id), replacing its last: below `start` metres from the burr's surface a force up to `max_force` N at the structure pushes the burr away; below `stop` metres (None: no hard stop) nothing is cut and the burr is held back
+        """
+    def set_fixtures(self, fixtures: list) -> None:
+        """
+        replaces every fixture by a list of dicts (a DRILL block's `fixtures`): structure, start, max_force (default 1 N), stop (default None), enabled (default True); [] removes them
+        """
     def set_hardness(self, label: typing.SupportsInt | typing.SupportsIndex, hardness: typing.SupportsFloat | typing.SupportsIndex) -> None:
         ...
+    def set_plan(self, target: typing.Any, *, start: typing.SupportsFloat | typing.SupportsIndex, max_force: typing.SupportsFloat | typing.SupportsIndex = 1.0, stop: typing.SupportsFloat | typing.SupportsIndex | None = None, enabled: bool = True) -> None:
+        """
+        stay in the plan: a fixture on the boundary of a planned region, `target` a boolean mask of the volume's shape (nx, ny, nz) or a list of labels (names or ids); every labelled voxel outside it is the forbidden side (with a `stop`, nothing outside it is cut)
+        """
     def set_waypoints(self, waypoints: list) -> None:
         """
         follow dicts of time (s from now), pose (4x4) and optionally on and speed, interpolating between them
@@ -2086,6 +2104,24 @@ class Drill(Object):
         events dropped because nobody took them in time (the newest Drill.MAX_EVENTS are kept)
         """
     @property
+    def fixture_force(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        """
+        the part of `force` the fixtures added at the last step, N, world frame
+        """
+    @property
+    def fixture_passivity(self) -> bool:
+        """
+        keep the fixtures' force passive (energy observer and damping; default on)
+        """
+    @fixture_passivity.setter
+    def fixture_passivity(self, arg1: bool) -> None:
+        ...
+    @property
+    def fixtures(self) -> list:
+        """
+        the fixtures as dicts (set_fixtures' form), structures by label name
+        """
+    @property
     def force(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
         """
         force fed back (the leading cursor's), N, world frame
@@ -2101,6 +2137,11 @@ class Drill(Object):
     @property
     def leading_cursor(self) -> int:
         ...
+    @property
+    def plan(self) -> typing.Any:
+        """
+        the plan's fixture as a dict (start, max_force, stop, enabled, voxels), or None
+        """
     @property
     def pose(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
         """

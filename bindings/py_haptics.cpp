@@ -551,6 +551,133 @@ void define_drill(py::module_& m) {
             return out;
           },
           "metres from the burr's surface to each critical structure")
+      .def(
+          "set_fixture",
+          [](Drill& d, const py::object& structure, double start, double max_force,
+             std::optional<double> stop, bool enabled) {
+            FixtureSpec f;
+            f.structure = to_option(structure).type() == OptionValue::Type::kInteger
+                              ? std::to_string(structure.cast<long long>())
+                              : structure.cast<std::string>();
+            f.start = start;
+            f.max_force = max_force;
+            f.stop = stop.value_or(0.0);
+            f.enabled = enabled;
+            without_gil([&] {
+              auto lock = d.world().lock_state_for_copy();
+              d.set_fixture(f);
+            });
+          },
+          py::arg("structure"), py::kw_only(), py::arg("start"), py::arg("max_force") = 1.0,
+          py::arg("stop") = py::none(), py::arg("enabled") = true,
+          "sets the forbidden-region fixture of a structure (label name or id), replacing its "
+          "last: below `start` metres from the burr's surface a force up to `max_force` N at "
+          "the structure pushes the burr away; below `stop` metres (None: no hard stop) nothing "
+          "is cut and the burr is held back")
+      .def(
+          "set_fixtures",
+          [](Drill& d, const py::list& fixtures) {
+            std::vector<FixtureSpec> all;
+            for (std::size_t i = 0; i < fixtures.size(); ++i) {
+              all.push_back(fixture_from(OptionValue::mapping(to_options(fixtures[i])),
+                                         "fixtures[" + std::to_string(i) + "]"));
+            }
+            without_gil([&] {
+              auto lock = d.world().lock_state_for_copy();
+              d.set_fixtures(all);
+            });
+          },
+          py::arg("fixtures"),
+          "replaces every fixture by a list of dicts (a DRILL block's `fixtures`): structure, "
+          "start, max_force (default 1 N), stop (default None), enabled (default True); [] "
+          "removes them")
+      .def_property_readonly(
+          "fixtures",
+          [](Drill& d) {
+            py::list out;
+            for (const FixtureSpec& f : locked_copy(d, [&] { return d.fixtures(); })) {
+              py::dict e;
+              e["structure"] = f.structure;
+              e["start"] = f.start;
+              e["max_force"] = f.max_force;
+              e["stop"] = f.stop > 0 ? py::object(py::float_(f.stop)) : py::object(py::none());
+              e["enabled"] = f.enabled;
+              out.append(e);
+            }
+            return out;
+          },
+          "the fixtures as dicts (set_fixtures' form), structures by label name")
+      .def(
+          "set_plan",
+          [](Drill& d, const py::object& target, double start, double max_force,
+             std::optional<double> stop, bool enabled) {
+            FixtureSpec f;
+            f.start = start;
+            f.max_force = max_force;
+            f.stop = stop.value_or(0.0);
+            f.enabled = enabled;
+            if (py::isinstance<py::array>(target)) {
+              // (nx, ny, nz), i fastest: Fortran order, as VolumeData.labels.
+              auto a = py::array_t<std::uint8_t, py::array::f_style | py::array::forcecast>::ensure(
+                  target);
+              const auto& n = d.volume().data()->shape();
+              if (!a || a.ndim() != 3 || a.shape(0) != n[0] || a.shape(1) != n[1] ||
+                  a.shape(2) != n[2]) {
+                throw ArgumentError("set_plan: a mask must have the volume's shape (" +
+                                    std::to_string(n[0]) + ", " + std::to_string(n[1]) + ", " +
+                                    std::to_string(n[2]) + ")");
+              }
+              std::vector<std::uint8_t> mask(a.data(), a.data() + a.size());
+              without_gil([&] {
+                auto lock = d.world().lock_state_for_copy();
+                d.set_plan(mask, f);
+              });
+              return;
+            }
+            std::vector<std::string> labels;
+            for (const py::handle& h : target) {
+              labels.push_back(py::isinstance<py::int_>(h) ? std::to_string(h.cast<long long>())
+                                                           : h.cast<std::string>());
+            }
+            without_gil([&] {
+              auto lock = d.world().lock_state_for_copy();
+              d.set_plan(labels, f);
+            });
+          },
+          py::arg("target"), py::kw_only(), py::arg("start"), py::arg("max_force") = 1.0,
+          py::arg("stop") = py::none(), py::arg("enabled") = true,
+          "stay in the plan: a fixture on the boundary of a planned region, `target` a boolean "
+          "mask of the volume's shape (nx, ny, nz) or a list of labels (names or ids); every "
+          "labelled voxel outside it is the forbidden side (with a `stop`, nothing outside it "
+          "is cut)")
+      .def(
+          "clear_plan",
+          [](Drill& d) {
+            without_gil([&] {
+              auto lock = d.world().lock_state_for_copy();
+              d.clear_plan();
+            });
+          },
+          "removes the plan's fixture")
+      .def_property_readonly(
+          "plan",
+          [](Drill& d) -> py::object {
+            const FixtureSpec* f = d.plan();
+            if (f == nullptr) return py::none();
+            py::dict e;
+            e["start"] = f->start;
+            e["max_force"] = f->max_force;
+            e["stop"] = f->stop > 0 ? py::object(py::float_(f->stop)) : py::object(py::none());
+            e["enabled"] = f->enabled;
+            e["voxels"] = d.plan_voxels();
+            return std::move(e);
+          },
+          "the plan's fixture as a dict (start, max_force, stop, enabled, voxels), or None")
+      .def_property_readonly(
+          "fixture_force", [](Drill& d) { return Vec3(d.fixture_force()); },
+          "the part of `force` the fixtures added at the last step, N, world frame")
+      .def_property("fixture_passivity", &Drill::fixture_passivity, &Drill::set_fixture_passivity,
+                    "keep the fixtures' force passive (energy observer and damping; default on)")
       .def_property_readonly(
           "removed",
           [](Drill& d) { return removed_arrays(locked_copy(d, [&] { return d.removed(); })); },

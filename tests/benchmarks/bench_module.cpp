@@ -189,4 +189,30 @@ PYBIND11_MODULE(ambfplus_bench, m) {
       },
       py::arg("seconds"), py::arg("period_frames") = 128,
       "Seconds from each tick's push to its first sample's write, with a paced consumer.");
+
+  m.def(
+      "fixture_queries",
+      [](const Drill& d, const std::vector<Vec3>& points, int rounds) {
+        // Each query timed alone: the fixtures' push on the burr centred at a point (every
+        // fixture's field sampled), as a tick evaluates it for its tip cursor.
+        std::vector<double> seconds;
+        seconds.reserve(points.size() * rounds);
+        Vec3 sink = Vec3::Zero();
+        {
+          py::gil_scoped_release release;
+          for (int r = 0; r < rounds; ++r) {
+            for (const Vec3& p : points) {
+              const auto t0 = std::chrono::steady_clock::now();
+              sink += d.fixture_push(p);
+              const auto t1 = std::chrono::steady_clock::now();
+              seconds.push_back(std::chrono::duration<double>(t1 - t0).count());
+            }
+          }
+        }
+        py::dict out;
+        out["seconds"] = seconds;
+        out["checksum"] = sink.norm();
+        return out;
+      },
+      py::arg("drill"), py::arg("points"), py::arg("rounds") = 1);
 }

@@ -103,10 +103,11 @@ std::vector<AdfDrillBlock> read_adf_drills(const std::string& path) {
     d.identifier = id;
     DrillSpec& s = d.spec;
     s.name = adf::block_name(doc, id, block);
-    diag.unknown_keys(doc, id, block,
-                      {"name", "volume", "location", "burr diameters", "burr", "cursors",
-                       "cursor spacing", "shaft radii", "stiffness", "damping", "max force",
-                       "soft start", "friction", "removal", "cutting rate", "voxels per step"});
+    diag.unknown_keys(
+        doc, id, block,
+        {"name", "volume", "location", "burr diameters", "burr", "cursors", "cursor spacing",
+         "shaft radii", "stiffness", "damping", "max force", "soft start", "friction", "removal",
+         "cutting rate", "voxels per step", "fixtures"});
     if (!block["volume"]) adf::fail(doc, block, id, "needs 'volume' (the VOLUME block it drills)");
     d.volume = adf::text(doc, block["volume"], id, "volume");
     s.pose = adf::frame(doc, block["location"], id, "location");
@@ -114,7 +115,7 @@ std::vector<AdfDrillBlock> read_adf_drills(const std::string& path) {
     adf::set_options(doc, id, block, drill_options(), s,
                      {"burr diameters", "burr", "cursors", "cursor spacing", "shaft radii",
                       "stiffness", "damping", "max force", "soft start", "friction", "removal",
-                      "cutting rate", "voxels per step"});
+                      "cutting rate", "voxels per step", "fixtures"});
     if (!block["voxels per step"] && block["burr diameters"]) {
       // The original's counts go with its four burrs; other burrs take 1 per step.
       s.voxels_per_step.assign(s.burr_diameters.size(), 1);
@@ -189,6 +190,8 @@ std::vector<Volume*> adf::add_adf_volumes(
       try {
         add_drill(*target, spec).set_identifier(d.identifier);
       } catch (const ArgumentError& e) {
+        throw ConfigError(path, d.identifier + ": " + e.what());
+      } catch (const NotFound& e) {  // a fixture's structure the volume's labels lack
         throw ConfigError(path, d.identifier + ": " + e.what());
       }
       return true;

@@ -13,7 +13,8 @@
 #include "ambfplus/scene/rigid_body.h"
 #include "ambfplus/scene/volume.h"
 #include "ambfplus/scene/world.h"
-#include "haptics/critical_distances.h"
+#include "ambfplus/volume/label_table.h"
+#include "haptics/structure_distances.h"
 
 namespace ambfplus {
 namespace {
@@ -24,6 +25,8 @@ double thread_cpu_seconds() {
   return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 constexpr double kPi = 3.14159265358979323846;
+// Metres a burr may sit inside a hard stop before it stops cutting (rounding of the held goal).
+constexpr double kStopTolerance = 1e-6;
 
 }  // namespace
 
@@ -47,17 +50,26 @@ Drill::Drill(Model& model, const DrillSpec& spec, int id)
   set_cutting_rate(spec_.cutting_rate);
   set_burr(spec_.burr);
   collider_ = std::make_unique<VoxelCollider>(volume_->data());
-  std::vector<std::uint16_t> critical;
-  for (const Label& l : volume_->data()->label_table().labels()) {
-    if (l.critical) critical.push_back(l.id);
+  // Every critical structure gets a field wide enough for the largest burr to see kExactReach.
+  const VolumeData& data = *volume_->data();
+  half_voxel_ = 0.5 * std::cbrt(data.voxel_size().prod());
+  const double largest_burr =
+      *std::max_element(spec_.burr_diameters.begin(), spec_.burr_diameters.end()) / 2;
+  field_band_ = kExactReach + largest_burr + data.voxel_size().norm();
+  structures_ = std::make_unique<StructureDistances>(data);
+  for (const Label& l : data.label_table().labels()) {
+    if (!l.critical) continue;
+    critical_labels_.push_back(l.id);
+    structures_->track(l.id, field_band_);
   }
-  critical_ = std::make_unique<CriticalDistances>(*volume_->data(), critical);
+  uncuttable_.assign(65536, false);
   hardness_.assign(65536, 1.0);
   cursors_.resize(spec_.cursors);
   for (int i = 0; i < spec_.cursors; ++i) {
     cursors_[i].set_radius(i == 0 ? burr_radius() : spec_.shaft_radii[i - 1]);
   }
   place(checked_pose(spec_.pose));
+  set_fixtures(spec_.fixtures);
 }
 
 Drill::~Drill() = default;
@@ -69,6 +81,8 @@ void Drill::place(const Eigen::Isometry3d& pose) {
   const Eigen::Vector3d axis = volume_from_world.linear() * goal_.linear().col(0);
   for (int i = 0; i < spec_.cursors; ++i) cursors_[i].reset(tip + axis * (spec_.spacing * i));
   last_goal_position_ = goal_.translation();
+  held_valid_ = false;  // a jump: the stops hold the goal from here on
+  fixture_energy_ = 0.0;
   set_pose(goal_);
 }
 
@@ -194,6 +208,7 @@ void Drill::tick(double dt, std::int64_t step) {
   age_ += dt;
   collider_->sync();
   sync_meshes();
+  structures_->tick();  // fields follow the edits (see StructureDistances)
   update_cursors();
   place_drill();
   const Eigen::Vector3d tip_force = update_forces(dt);
@@ -206,7 +221,8 @@ void Drill::tick(double dt, std::int64_t step) {
 void Drill::update_cursors() {
   // Cursor goals along the shaft, in the volume frame; the one furthest from its goal leads.
   const Eigen::Isometry3d volume_from_world = volume_->pose().inverse();
-  const Eigen::Vector3d tip_goal = volume_from_world * goal_.translation();
+  // The hard stops hold the whole drill back, the shaft with the tip.
+  const Eigen::Vector3d tip_goal = held_tip_goal(volume_from_world * goal_.translation());
   const Eigen::Vector3d axis = volume_from_world.linear() * goal_.linear().col(0);
   double largest = -1;
   for (int i = 0; i < cursor_count(); ++i) {
@@ -257,7 +273,18 @@ Eigen::Vector3d Drill::update_forces(double dt) {
     if (i == leading_) force_ = f;
     if (i == 0) tip_force_volume = world_from_volume.transpose() * f;
   }
+  // Held back by a hard stop, the tip still presses on the tissue with the hand's whole push:
+  // the stop holds the burr, not the force it cuts with.
+  if (any_stop_ && held_valid_ && cursors_[0].contacts() > 0) {
+    const Eigen::Vector3d hand = volume_->pose().inverse() * goal_.translation();
+    tip_force_volume =
+        world_from_volume.transpose() *
+        limited(world_from_volume * (spec_.stiffness * (cursors_[0].proxy() - hand)));
+  }
   total_force_ = limited(total_force_);
+  fixture_force_ = update_fixture_force(dt, goal_velocity);
+  force_ += fixture_force_;
+  total_force_ += fixture_force_;
   return tip_force_volume;
 }
 
@@ -283,8 +310,15 @@ std::vector<std::pair<double, std::array<int, 3>>> Drill::cuttable_voxels() cons
     const Eigen::Vector3d c = covered ? Eigen::Vector3d(patch.x[n], patch.y[n], patch.z[n])
                                       : data->voxel_center(v[0], v[1], v[2]);
     if ((c - burr.proxy()).squaredNorm() > reach * reach) continue;
-    if (data->label(v[0], v[1], v[2]) == 0) continue;  // removed earlier this step
-    const Label* l = data->label_table().find(data->label(v[0], v[1], v[2]));
+    const std::uint16_t label = data->label(v[0], v[1], v[2]);
+    if (label == 0 || uncuttable_[label]) continue;  // removed earlier, or behind a hard stop
+    if (plan_stop_ &&
+        (*plan_mask_)[static_cast<std::size_t>(v[0]) +
+                      static_cast<std::size_t>(data->shape()[0]) *
+                          (v[1] + static_cast<std::size_t>(data->shape()[1]) * v[2])] == 0) {
+      continue;  // outside the plan
+    }
+    const Label* l = data->label_table().find(label);
     if (l != nullptr && !l->removable) continue;
     order.push_back({(c - burr.goal()).squaredNorm(), v});
   }
@@ -298,7 +332,9 @@ void Drill::remove_tissue(double dt, std::int64_t step, const Eigen::Vector3d& t
   const ProxyCursor& burr = cursors_[0];
   bool on_anatomy = false;  // a mesh contact alone cuts nothing
   for (int i = 0; i < burr.contacts(); ++i) on_anatomy |= burr.contact_voxel(i)[0] >= 0;
-  if (!(on_ && speed_ > 0 && leading_ == 0 && on_anatomy)) {
+  // Nothing is cut while the burr is within a hard stop (the held goal keeps it at the edge).
+  const bool stopped = any_stop_ && stop_clearance(burr.proxy(), nullptr) < -kStopTolerance;
+  if (!(on_ && speed_ > 0 && leading_ == 0 && on_anatomy) || stopped) {
     budget_ = 0;
     return;
   }
@@ -323,26 +359,23 @@ void Drill::remove_tissue(double dt, std::int64_t step, const Eigen::Vector3d& t
     if (order.empty()) budget_ = 0;
   }
   if (take.empty()) return;
+  const std::int64_t before = data->revision();
   const std::vector<std::uint16_t> old = collider_->remove(take);
+  // Fields of structures this cut did not touch skip its box.
+  structures_->removed(before, take, old);
   for (std::size_t i = 0; i < take.size(); ++i) {
     log_removed(RemovedVoxel{step, take[i], old[i]});
     const Label* l = data->label_table().find(old[i]);
-    if (l != nullptr && l->critical) {
-      log_event(DrillEvent{step, "critical", old[i], take[i]});
-      critical_->removed(take[i], old[i]);
-    }
+    if (l != nullptr && l->critical) log_event(DrillEvent{step, "critical", old[i], take[i]});
   }
 }
 
 void Drill::update_critical_distances() {
   // From the burr's surface to each critical structure.
-  const ProxyCursor& burr = cursors_[0];
   critical_distances_.clear();
-  const double half_voxel = 0.5 * std::cbrt(volume_->data()->voxel_size().prod());
-  for (std::uint16_t label : critical_->labels()) {
-    const double d = critical_->distance(burr.proxy(), label);
-    critical_distances_.emplace_back(
-        label, std::isinf(d) ? d : std::max(0.0, d - burr.radius() - half_voxel));
+  for (std::uint16_t label : critical_labels_) {
+    const double d = surface_distance(label, cursors_[0].proxy(), nullptr);
+    critical_distances_.emplace_back(label, std::max(0.0, d));
   }
 }
 

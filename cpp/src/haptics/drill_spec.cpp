@@ -18,6 +18,27 @@ bool finite_at_least(double v, double lo) { return v >= lo && std::isfinite(v); 
 
 }  // namespace
 
+FixtureSpec fixture_from(const OptionValue& value, const std::string& key) {
+  FixtureSpec f;
+  try {
+    fixture_options().apply(f, value.map(key));
+  } catch (const ArgumentTypeError& e) {
+    throw ArgumentTypeError(key + ": " + e.what());
+  } catch (const ArgumentError& e) {
+    throw ArgumentError(key + ": " + e.what());
+  }
+  if (find_option(value.map(key), "structure") == nullptr) {
+    throw ArgumentError(key + ": a fixture needs a structure (a label name or id)");
+  }
+  if (find_option(value.map(key), "start") == nullptr) {
+    throw ArgumentError(key + ": fixture '" + f.structure + "' needs a start distance (m)");
+  }
+  f.validate(key + ": ");
+  return f;
+}
+
+namespace {}  // namespace
+
 RemovalMode parse_removal_mode(const std::string& name) {
   const std::string n = to_lower(name);
   if (n == "physical") return RemovalMode::kPhysical;
@@ -57,6 +78,7 @@ void DrillSpec::validate() const {
               finite_at_least(friction.dynamic_coefficient, 0),
           who, "friction coefficients must be >= 0");
   checked_pose(pose, "drill '" + name + "'");
+  for (const FixtureSpec& f : fixtures) f.validate(who);
 }
 
 const OptionTable<DrillSpec>& drill_options() {
@@ -109,6 +131,15 @@ const OptionTable<DrillSpec>& drill_options() {
             [](S& s, V v, K k) { s.voxels_per_step = v.integers(k); }},
           O{"pose", "numpy.ndarray", "4x4 initial goal, world from drill",
             [](S& s, V v, K k) { s.pose = v.matrix4(k); }},
+          O{"fixtures", "list[dict]",
+            "forbidden regions: {structure, start, max_force, stop, enabled} each",
+            [](S& s, V v, K k) {
+              s.fixtures.clear();
+              const std::vector<OptionValue>& list = v.list(k);
+              for (std::size_t i = 0; i < list.size(); ++i) {
+                s.fixtures.push_back(fixture_from(list[i], k + "[" + std::to_string(i) + "]"));
+              }
+            }},
       });
   return table;
 }

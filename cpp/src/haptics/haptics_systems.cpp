@@ -114,6 +114,9 @@ class DrillSystem : public System {
     columns.add("total_force", 3, [](const Object& o, std::vector<double>& out) {
       push(out, as_drill(o).total_force());
     });
+    columns.add("fixture_force", 3, [](const Object& o, std::vector<double>& out) {
+      push(out, as_drill(o).fixture_force());
+    });
     columns.add("on", 1, [](const Object& o, std::vector<double>& out) {
       out.push_back(as_drill(o).on() ? 1.0 : 0.0);
     });

@@ -138,6 +138,7 @@ void DistanceField::rebuild() {
     }
   }
   structure_voxels_ = count;
+  bounds_ = count ? bounds : VoxelBox{};
   region_ = count ? region_for(bounds) : VoxelBox{};
   values_.assign(static_cast<std::size_t>(region_.count()), static_cast<float>(band_));
   mask_.assign(static_cast<std::size_t>(region_.count()), 0);
@@ -235,7 +236,10 @@ std::int64_t DistanceField::update() {
         }
       }
     }
-    if (!tight.empty()) changed.push_back(tight);
+    if (!tight.empty()) {
+      changed.push_back(tight);
+      bounds_ = bounds_.united(tight);  // still holds every structure voxel
+    }
   }
   std::int64_t recomputed = 0;
   for (const VoxelBox& box : changed) recomputed += recompute(grown_by(box, reach_));

@@ -4,11 +4,13 @@
 #include <cstdint>
 #include <deque>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <Eigen/Geometry>
 
+#include "ambfplus/haptics/fixture.h"
 #include "ambfplus/haptics/mesh_collider.h"
 #include "ambfplus/haptics/proxy.h"
 #include "ambfplus/haptics/voxel_collider.h"
@@ -17,7 +19,7 @@
 
 namespace ambfplus {
 
-class CriticalDistances;
+class StructureDistances;
 class RigidBody;
 class Volume;
 
@@ -52,6 +54,8 @@ struct AMBFPLUS_API DrillSpec {
   std::vector<int> voxels_per_step{1, 3, 6, 10};  ///< per burr (compatible mode)
   /// Initial goal: world from drill, the burr's centre at the origin and the shaft along +x.
   Eigen::Matrix4d pose = Eigen::Matrix4d::Identity();
+  /// Forbidden-region fixtures, one per structure (Drill::set_fixtures).
+  std::vector<FixtureSpec> fixtures;
 
   /// Throws ArgumentError naming the drill and the value unless every value can be used (burrs
   /// > 0 with a valid index, 1..16 cursors with spacing > 0 and one shaft radius each when
@@ -63,8 +67,12 @@ struct AMBFPLUS_API DrillSpec {
 /// add_drill's keyword options (a DRILL block's keys, spaces for underscores): burr_diameters,
 /// burr, cursors, spacing (cursor spacing), shaft_radii, stiffness, damping, max_force,
 /// soft_start, static_friction, dynamic_friction, friction ({static, dynamic}), removal,
-/// cutting_rate, voxels_per_step, pose.
+/// cutting_rate, voxels_per_step, pose, fixtures (a list of fixture_options() mappings).
 AMBFPLUS_API const OptionTable<DrillSpec>& drill_options();
+
+/// A fixture from a mapping of fixture_options() keys (structure and start required); errors
+/// name `key` (e.g. "fixtures[1]").
+AMBFPLUS_API FixtureSpec fixture_from(const OptionValue& value, const std::string& key);
 
 /// One voxel taken by the burr.
 struct AMBFPLUS_API RemovedVoxel {
@@ -161,10 +169,59 @@ class AMBFPLUS_API Drill : public Object {
   /// Surface normal at the tip's first contact (world), zero without contact.
   Eigen::Vector3d tip_normal() const;
   /// Distance from the burr's surface to each critical label of the volume (metres, 0 when
-  /// touching, infinity when none is left), in label order.
+  /// touching, infinity when none is left), in label order. It comes from each structure's
+  /// distance field, which follows the drilling: the distance from the burr's centre (its tip
+  /// cursor's proxy) to the nearest voxel centre of the structure, less the burr's radius and
+  /// half a voxel. Exact within kExactReach of the burr's surface; beyond, a lower bound (the
+  /// distance to the box around the structure, at least kExactReach). A field is rebuilt on
+  /// another thread after a cut into its structure and taken into use 50 ticks later (the same
+  /// tick in every run); until then it answers for the structure before the cut, a lower bound.
   const std::vector<std::pair<std::uint16_t, double>>& critical_distances() const {
     return critical_distances_;
   }
+  /// How far from the burr's surface (metres) distances to structures are exact.
+  static constexpr double kExactReach = 0.005;
+
+  // --- Virtual fixtures (forbidden regions around structures)
+  /// Sets the fixture of a structure, replacing the one it had: the structure is resolved by
+  /// label name or id (NotFound names the labels), the spec checked (ArgumentError), and the
+  /// structure's distance field built or widened as the fixture needs.
+  void set_fixture(const FixtureSpec& fixture);
+  /// Replaces every fixture, all checked before any is set; an empty list removes them all.
+  void set_fixtures(const std::vector<FixtureSpec>& fixtures);
+  /// The fixtures in the order set, structures by label name.
+  std::vector<FixtureSpec> fixtures() const;
+  /// The force the fixtures added to force() at the last tick (N, world frame): the regions'
+  /// push, the hard stops' spring, and the passivity damping.
+  const Eigen::Vector3d& fixture_force() const { return fixture_force_; }
+  /// Whether the fixtures' force is kept passive (on by default): an energy observer sums the
+  /// work the held force does on the hand (the goal) each tick, and when the fixtures would give
+  /// back more energy than they took (a sampled stiff region does, at 1 kHz), a damping against
+  /// the hand's velocity dissipates the excess (Hannaford and Ryu's passivity controller).
+  void set_fixture_passivity(bool on) { fixture_passivity_ = on; }
+  bool fixture_passivity() const { return fixture_passivity_; }
+  // --- Guidance: stay in the plan
+  /// Keeps the burr in a planned region: a fixture (the start, max_force, stop and enabled of
+  /// `fixture`; its structure is ignored) whose forbidden side is every labelled voxel outside
+  /// the region, so that with a stop nothing outside it is cut. `mask` holds one entry per
+  /// voxel, i fastest, non-zero in the plan. Throws ArgumentError for a mask of another size or
+  /// a bad spec.
+  void set_plan(const std::vector<std::uint8_t>& mask, const FixtureSpec& fixture);
+  /// The same with the plan given as the voxels of some labels (names or ids).
+  void set_plan(const std::vector<std::string>& labels, const FixtureSpec& fixture);
+  void clear_plan();
+  /// The plan's fixture (its structure "plan"), or nullptr without a plan.
+  const FixtureSpec* plan() const { return plan_ ? &plan_->spec : nullptr; }
+  /// Voxels in the plan.
+  std::int64_t plan_voxels() const { return plan_voxels_; }
+
+  /// The regions' push on the burr centred at p (volume frame; N, volume axes): the sum of
+  /// max_force x (1 - d / start) away from each structure nearer than its start, without the
+  /// hard stops' spring or the damping (what each tick evaluates at the burr's proxy).
+  Eigen::Vector3d fixture_push(const Eigen::Vector3d& p) const;
+  /// Distance (metres) from the burr's surface to a structure with a fixture or a critical
+  /// label, with the burr centred at p (volume frame); negative when it overlaps.
+  double structure_distance(std::uint16_t label, const Eigen::Vector3d& p) const;
   /// Voxels removed so far and not yet taken; take_* hands them over. Bounded: the newest
   /// kMaxRemoved voxels and kMaxEvents events are kept, older ones dropped and counted. Every
   /// step appends to them: read removed() and events() under the world's lock while a
@@ -204,6 +261,19 @@ class AMBFPLUS_API Drill : public Object {
   std::vector<std::pair<double, std::array<int, 3>>> cuttable_voxels() const;
   void remove_tissue(double dt, std::int64_t step, const Eigen::Vector3d& tip_force_volume);
   void update_critical_distances();
+  /// The burr surface's distance to a tracked structure with its centre at p, and the
+  /// direction away from it (unit, or zero where the field gives none).
+  double surface_distance(std::uint16_t label, const Eigen::Vector3d& p,
+                          Eigen::Vector3d* away) const;
+  /// Where the tip's goal may go (volume frame): from where it was held toward `goal`, stopped
+  /// and slid along the surface of every hard stop.
+  Eigen::Vector3d held_tip_goal(const Eigen::Vector3d& goal);
+  /// The smallest clearance (metres) of a burr centred at p from the hard stops, and the
+  /// direction away from the nearest; infinity without stops.
+  double stop_clearance(const Eigen::Vector3d& p, Eigen::Vector3d* away) const;
+  /// The fixtures' force at this tick (world frame), passivity control included.
+  Eigen::Vector3d update_fixture_force(double dt, const Eigen::Vector3d& goal_velocity);
+  void fixtures_changed();
   void log_removed(const RemovedVoxel& voxel);
   void log_event(const DrillEvent& event);
   void record_timing(double wall, double cpu);
@@ -211,7 +281,27 @@ class AMBFPLUS_API Drill : public Object {
   Volume* volume_;
   DrillSpec spec_;
   std::unique_ptr<VoxelCollider> collider_;
-  std::unique_ptr<CriticalDistances> critical_;
+  std::unique_ptr<StructureDistances> structures_;
+  std::vector<std::uint16_t> critical_labels_;
+  double half_voxel_ = 0.0;  // added to the burr's radius: distances are to voxel faces
+  double field_band_ = 0.0;  // the band of the critical labels' fields
+  struct ActiveFixture {
+    FixtureSpec spec;
+    std::uint16_t label;
+  };
+  std::vector<ActiveFixture> fixtures_;
+  std::optional<ActiveFixture> plan_;  // label 0: the tissue outside the plan
+  std::shared_ptr<const std::vector<std::uint8_t>> plan_mask_;
+  std::int64_t plan_voxels_ = 0;
+  bool plan_stop_ = false;                    // nothing outside the plan is cut
+  std::vector<const ActiveFixture*> active_;  // the enabled fixtures and plan
+  std::vector<bool> uncuttable_;              // by label: a structure with an enabled hard stop
+  bool any_stop_ = false;
+  Eigen::Vector3d held_goal_ = Eigen::Vector3d::Zero();  // the tip's held goal, volume frame
+  bool held_valid_ = false;
+  Eigen::Vector3d fixture_force_ = Eigen::Vector3d::Zero();
+  double fixture_energy_ = 0.0;  // J the fixtures took from the hand (passivity observer)
+  bool fixture_passivity_ = true;
   std::vector<ProxyCursor> cursors_;
   Eigen::Isometry3d goal_ = Eigen::Isometry3d::Identity();
   Eigen::Vector3d last_goal_position_ = Eigen::Vector3d::Zero();

@@ -61,6 +61,9 @@ class AMBFPLUS_API DistanceField {
   const std::vector<std::uint16_t>& labels() const { return labels_; }
   /// Structure voxels the field was last built or updated from.
   std::int64_t structure_voxels() const { return structure_voxels_; }
+  /// The structure's voxel bounding box at the last full build (empty without voxels): edits
+  /// that only remove voxels keep it, so it then holds the structure with room to spare.
+  const VoxelBox& bounds() const { return bounds_; }
 
   /// The signed distance at voxel (i, j, k)'s centre; throws OutOfRange outside the grid.
   double at(int i, int j, int k) const;
@@ -88,6 +91,7 @@ class AMBFPLUS_API DistanceField {
   std::int64_t revision_ = 0;
   std::int64_t structure_voxels_ = 0;
 
+  VoxelBox bounds_;                 // the structure's voxels at the last rebuild
   VoxelBox region_;                 // where values_ is stored; elsewhere the value is band
   std::vector<float> values_;       // packed over region_, i fastest
   std::vector<std::uint8_t> mask_;  // structure membership over region_ at revision_

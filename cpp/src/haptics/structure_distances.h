@@ -1,0 +1,114 @@
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <future>
+#include <memory>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "ambfplus/volume/distance_field.h"
+#include "ambfplus/volume/volume_data.h"
+
+namespace ambfplus {
+
+/// Distances from points to structures of a volume (one label each), from one DistanceField per
+/// structure that follows the volume's edits: the drill's critical-distance report and its
+/// fixtures read the same fields.
+///
+/// A field is exact (trilinear between exact voxel-centre values) up to its band; beyond it the
+/// answer is the distance to the box around the structure's voxel centres, never less than the
+/// band: a lower bound that is exact straight above a flat face and keeps every query O(1).
+///
+/// Following a cut costs a transform of the band around it (tens of milliseconds for a band of
+/// millimetres), too long for a 1 kHz tick. So each field is built on a copy of the structure's
+/// neighbourhood (its snapshot), on a thread of its own at normal priority, and the field in use
+/// is replaced kFollowTicks ticks after the edit that started the rebuild (waiting for it if the
+/// machine is slower): answers depend on the tick, never on the threads' timing, so scripted runs
+/// stay deterministic. Until then the old field answers; a cut only removes voxels, so its
+/// distances are then a lower bound, on the safe side for fixtures.
+class StructureDistances {
+ public:
+  explicit StructureDistances(const VolumeData& data) : data_(data) {}
+  ~StructureDistances();
+  StructureDistances(const StructureDistances&) = delete;
+  StructureDistances& operator=(const StructureDistances&) = delete;
+
+  /// Ticks after an edit of a structure at which its rebuilt field is taken into use.
+  static constexpr std::int64_t kFollowTicks = 50;
+
+  /// Tracks a structure with a field of at least `band` metres, built now (a narrower field is
+  /// rebuilt, a wider one kept). Label 0 names the tissue outside the plan (set_plan).
+  void track(std::uint16_t label, double band);
+  /// The planned region: mask[i + nx (j + ny k)] != 0 for voxels in the plan. The structure of
+  /// label 0 is then every labelled voxel outside it; its field is rebuilt at once if tracked.
+  void set_plan(std::shared_ptr<const std::vector<std::uint8_t>> mask);
+  bool tracks(std::uint16_t label) const { return find(label) != nullptr; }
+
+  /// Tells that the edit(s) from revision `before` to the volume's current one removed voxels of
+  /// these labels and nothing else: their structures are rebuilt, the others skip the edits.
+  void removed(std::int64_t before, const std::vector<std::array<int, 3>>& voxels,
+               const std::vector<std::uint16_t>& labels);
+  /// One tick: notices edits made by others (their boxes are scanned), takes rebuilt fields
+  /// that are due, and starts the rebuilds that are waiting.
+  void tick();
+
+  /// Distance (metres) from p (volume frame) to the nearest centre of a voxel of `label`,
+  /// negative inside, infinity when none is left; its gradient when asked (zero beyond the
+  /// band). The label must be tracked.
+  double distance(std::uint16_t label, const Eigen::Vector3d& p,
+                  Eigen::Vector3d* gradient = nullptr) const;
+  /// Rebuilt fields taken into use so far (for tests).
+  std::int64_t rebuilds() const { return rebuilds_; }
+
+ private:
+  /// A field on a snapshot of the structure's neighbourhood; immutable once built.
+  struct Field {
+    std::unique_ptr<VolumeData> snapshot;  // membership (1) over `box` of the volume
+    std::unique_ptr<DistanceField> field;
+    VoxelBox box;            // the snapshot's voxels in the volume
+    Eigen::Vector3d offset;  // volume frame minus snapshot frame
+    Eigen::Vector3d lo, hi;  // the box around the structure's voxel centres, volume frame
+    VoxelBox bounds;         // the structure's voxels in the volume (empty: none)
+  };
+  struct Entry {
+    std::uint16_t label;
+    double band;
+    std::shared_ptr<const Field> current;
+    std::future<std::shared_ptr<const Field>> next;
+    std::int64_t due = 0;  // the tick at which `next` is taken
+    bool changed = false;  // edited since `next`'s snapshot (or with no rebuild running)
+    VoxelBox grown;        // where edits may have added voxels beyond current->bounds
+  };
+  Entry* find(std::uint16_t label);
+  const Entry* find(std::uint16_t label) const;
+  /// The structure's voxels over `bounds` grown by the band, copied; a field is built from it
+  /// on another thread.
+  std::future<std::shared_ptr<const Field>> rebuild(const Entry& e, const VoxelBox& bounds) const;
+  std::shared_ptr<const Field> build(std::uint16_t label, double band,
+                                     const VoxelBox& bounds) const;
+  static std::shared_ptr<const Field> finish(std::unique_ptr<VolumeData> snapshot, VoxelBox box,
+                                             Eigen::Vector3d offset, double band);
+  std::unique_ptr<VolumeData> copy(std::uint16_t label, const VoxelBox& box) const;
+  /// Whether voxel (i, j, k), whose label is l, belongs to the structure of `label`.
+  bool member(std::uint16_t label, std::uint16_t l, int i, int j, int k) const {
+    if (label != 0) return l == label;
+    const auto& n = data_.shape();
+    return l != 0 &&
+           !(*plan_)[static_cast<std::size_t>(i) +
+                     static_cast<std::size_t>(n[0]) *
+                         (static_cast<std::size_t>(j) + static_cast<std::size_t>(n[1]) * k)];
+  }
+  void notice_edits();
+
+  const VolumeData& data_;
+  std::vector<Entry> entries_;
+  std::int64_t tick_ = 0;
+  std::int64_t seen_ = -1;  // the volume revision whose edits are accounted for
+  std::int64_t rebuilds_ = 0;
+  std::shared_ptr<const std::vector<std::uint8_t>> plan_;
+  std::future<void> retiring_;  // frees a replaced field (megabytes: munmap takes milliseconds)
+};
+
+}  // namespace ambfplus

@@ -14,7 +14,8 @@ the launch file names the anatomy for the drilling plugin (``--labels``). Keyboa
   instead of the proxy, Ctrl+C the cursors, Ctrl+R resets the drill, Ctrl+T / Alt+T change the
   voxels per step in compatible removal);
 - the session: Ctrl+N resets the volumes, Alt+R resets the world (volumes, drill, plugins),
-  Esc or Q quits;
+  Ctrl+G turns the virtual fixtures (``--fixtures``) off and on, Ctrl+M mutes the drill's sound
+  (``--audio``), Esc or Q quits;
 - the camera: left drag orbits about the point it looks at, right (or Shift+left) drag pans,
   the wheel zooms.
 

@@ -92,6 +92,19 @@ def build_parser() -> argparse.ArgumentParser:
                    "--record names a file)")  # fmt: skip
     p.add_argument("--metrics", type=Path, help="with --task: write the live metrics (JSON) "
                    "here when the session ends")  # fmt: skip
+    p.add_argument("--fixtures", nargs="?", const="task", metavar="FILE",
+                   help="virtual fixtures on the drill: a YAML list of {structure, start, "
+                   "max_force, stop} (metres, N; a DRILL block's fixtures), or, alone, from "
+                   "--task: each protected structure pushes the burr away from its margin + 1 mm "
+                   "and stops it at half its margin. Ctrl+G turns them off and on")  # fmt: skip
+    p.add_argument("--audio", action="store_true", help="play the drill's sound (with --task, "
+                   "proximity beeps from twice each structure's margin); a machine without an "
+                   "audio device says so and carries on silent")  # fmt: skip
+    p.add_argument(
+        "--mute",
+        action="store_true",
+        help="start the drill's sound muted (implies --audio); Ctrl+M unmutes",
+    )
     p.add_argument("--seconds", type=float, help="quit after this many seconds")
     p.add_argument("--status", type=Path, help="write the status (JSON) here as it changes")
     p.add_argument("--latency-log", type=Path, help="log key-to-screen latencies (JSON lines)")

@@ -81,6 +81,9 @@ class LaunchSession:
                                                        **options)  # fmt: skip
         self.initial_goal = self.drill.goal.copy() if self.drill is not None else None
         self.task, self.metrics = self._task(args)
+        self.fixtures: list[dict] = self._fixtures(args)
+        self.fixtures_on = bool(self.fixtures)
+        self.sound = self._sound(args)
         self.report, self.metrics_path = args.report, args.metrics
         self.record_path = args.record
         if self.report is not None and self.record_path is None:
@@ -129,8 +132,81 @@ class LaunchSession:
             raise SystemExit(f"ambfplus-launch: --task: {error}") from None
         return task, metrics
 
+    def _fixtures(self, args: argparse.Namespace) -> list[dict]:
+        """--fixtures: from a YAML file, or from --task's protected structures."""
+        if args.fixtures is None:
+            return []
+        if self.drill is None:
+            raise SystemExit("ambfplus-launch: --fixtures: the launch file has no drill")
+        from .._core import ConfigError
+
+        if args.fixtures == "task":
+            if self.task is None:
+                raise SystemExit("ambfplus-launch: --fixtures without a file needs --task")
+            data = self.drill.volume.data
+            names = {label.id: label.name for label in data.label_table}
+            fixtures = [
+                {"structure": names[i], "start": p.length + 0.001, "max_force": 1.5,
+                 "stop": p.length / 2}
+                for p in self.task.protect
+                for i in self.task.label_ids(data, p)
+            ]  # fmt: skip
+        else:
+            import yaml
+
+            path = Path(args.fixtures)
+            try:
+                fixtures = yaml.safe_load(path.read_text())
+            except (OSError, yaml.YAMLError) as error:
+                raise SystemExit(f"ambfplus-launch: --fixtures {path}: {error}") from None
+            if not isinstance(fixtures, list):
+                raise SystemExit(f"ambfplus-launch: --fixtures {path}: expected a list of "
+                                 "fixtures ({structure, start, max_force, stop})")  # fmt: skip
+        try:
+            self.drill.set_fixtures(fixtures)
+        except (ConfigError, ValueError, TypeError) as error:
+            raise SystemExit(f"ambfplus-launch: --fixtures: {error}") from None
+        return list(self.drill.fixtures)
+
+    def toggle_fixtures(self) -> bool:
+        """Ctrl+G: the fixtures off, or back on; whether they are on now."""
+        if not self.fixtures or self.drill is None:
+            return False
+        self.fixtures_on = not self.fixtures_on
+        with self.world.lock():
+            self.drill.set_fixtures([{**f, "enabled": f["enabled"] and self.fixtures_on}
+                                     for f in self.fixtures])  # fmt: skip
+        return self.fixtures_on
+
+    def _sound(self, args: argparse.Namespace):
+        """--audio / --mute: the drill's sound, beeping near the task's structures."""
+        if not (args.audio or args.mute) or self.drill is None:
+            return None
+        from .._core import DrillSound
+
+        warnings = None
+        if self.task is not None:
+            data = self.drill.volume.data
+            names = {label.id: label.name for label in data.label_table}
+            warnings = {
+                names[i]: max(2 * p.length, 0.001)
+                for p in self.task.protect
+                for i in self.task.label_ids(data, p)
+            }
+        sound = DrillSound(self.drill, output="device", muted=args.mute, warnings=warnings)
+        if sound.device_error:
+            print(f"ambfplus-launch: no sound: {sound.device_error}", flush=True)
+        return sound
+
+    def toggle_mute(self) -> bool:
+        """Ctrl+M: mutes or unmutes the drill's sound; whether it is muted now."""
+        return self.sound.toggle_mute() if self.sound is not None else True
+
     def finish(self) -> None:
-        """The session's end: the recording closed, then --metrics and --report written."""
+        """The session's end: the sound stopped, the recording closed, then --metrics and
+        --report written."""
+        if self.sound is not None:
+            self.sound.close()
         if self.recorder is not None:
             self.recorder.close()
             self.recorder = None
@@ -256,6 +332,8 @@ class LaunchSession:
             status.critical, status.critical_mm = name, distance * 1000
         if self.metrics is not None:
             self._task_status(status)
+        status.fixtures = "on" if self.fixtures_on else ("off" if self.fixtures else "")
+        status.sound = "" if self.sound is None else ("muted" if self.sound.muted else "on")
         events = self.drill.events
         cut = [e for e in events if e["kind"] == "critical"]
         if cut or status.critical_mm < WARN_DISTANCE * 1000:

@@ -36,6 +36,8 @@ class Status:
     nearest_mm: float = math.inf
     nearest_margin_mm: float = 0.0
     violations: int = 0
+    fixtures: str = ""  # "on", "off" (Ctrl+G) or "" (none)
+    sound: str = ""  # "on", "muted" (Ctrl+M) or "" (no sound)
 
     @property
     def level(self) -> str:
@@ -61,7 +63,12 @@ class Status:
             else "no critical structure"
         )
         rates = f"graphics {self.fps:.1f} fps | physics {self.physics_hz:.0f} Hz"
-        return [f"{burr} | {self.mode} | {critical} | {rates}"] + (
+        extra = "".join(
+            f" | {name} {value}"
+            for name, value in (("fixtures", self.fixtures), ("sound", self.sound))
+            if value
+        )
+        return [f"{burr} | {self.mode} | {critical} | {rates}{extra}"] + (
             [self.task_line()] if self.task else []
         )
 

@@ -16,7 +16,7 @@ from .status import Status, draw_overlay
 from .views import Views, look_distance
 
 # GLFW's codes for the keys and buttons the launcher handles itself.
-KEY_ESCAPE, KEY_Q, KEY_N, KEY_R = 256, 81, 78, 82
+KEY_ESCAPE, KEY_Q, KEY_N, KEY_R, KEY_G, KEY_M = 256, 81, 78, 82, 71, 77
 MOD_SHIFT, MOD_CONTROL, MOD_ALT = 0x1, 0x2, 0x4
 PRESS, RELEASE = 1, 0
 
@@ -54,6 +54,10 @@ def run_window(glfw, args: argparse.Namespace, plugin_args: list[str]) -> int:
             session.reset_volumes()
         elif action == PRESS and key == KEY_R and mods == MOD_ALT:
             session.reset_world()
+        elif action == PRESS and key == KEY_G and mods == MOD_CONTROL:
+            session.toggle_fixtures()
+        elif action == PRESS and key == KEY_M and mods == MOD_CONTROL:
+            session.toggle_mute()
         if session.keyboard.key(key, action, mods) and action != RELEASE:
             pending_keys.append((time.perf_counter(), world.step_index))
         world.keyboard(key, scancode, action, mods)

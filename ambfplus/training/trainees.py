@@ -7,9 +7,10 @@ from the drill's start) and its buttons (bit 0 spins the burr). It plans the who
 front from the anatomy as it is when planning starts:
 
 - **expert-like**: broad strokes along the target region's longer side, layer by layer, each
-  layer a little narrower than the one above (saucerisation), the burr centre kept clear of every protected
-  structure by its margin and a little more (checked on the structures' distance fields), and a
-  light touch (the hand leads the bone surface by a fraction of a millimetre);
+  layer a little narrower than the one above (saucerisation), the burr centre kept clear of
+  every protected structure by its margin and a little more (checked on the structures'
+  distance fields), and a light touch (the hand leads the bone surface by a fraction of a
+  millimetre);
 - **novice-like**: plunges at random sites, deep and narrow, pressing hard, with short wiggles
   instead of strokes, and now and then drifting toward a protected structure, ignoring margins.
 

@@ -19,12 +19,12 @@ assessment: 20 s), and per tick.
 assessment_discrimination: on each shipped task (cortical mastoidectomy, facial recess), 20
 expert-like and 20 novice-like recorded sessions of 20 s (seeds 100.. and 200..; stereo depth at
 10 Hz, 160x120), assessed against the task with completion not judged (a 20 s excerpt completes
-neither the target nor the skeletonisation): the ROC AUC of the composite score, and of each rubric item's score (the
-direction every item is expected to move in: an expert scores higher).
+neither the target nor the skeletonisation): the ROC AUC of the composite score, and of each
+rubric item's score (the direction every item is expected to move in: an expert scores higher).
 
 assessment_speed: a 10-minute novice-like session at 1 kHz with stereo at 20 Hz (320x240 rgb,
-depth and labels) recorded on the 128^3 phantom, then assessed against the cortical mastoidectomy task
-(metrics, target, exposure, burr visibility from every frame with cutting, rubric, timeline):
+depth and labels) recorded on the 128^3 phantom, then assessed against the cortical
+mastoidectomy task (metrics, target, exposure, burr visibility from every frame with cutting, rubric, timeline):
 CPU seconds (median and worst of 3), target 20 s; and the report on top.
 
 live_metrics_tick: what live skill metrics add to a haptic tick, measured in C++ (the thread's
@@ -209,8 +209,10 @@ def assessment_speed(args):
         task = builtin_task("cortical_mastoidectomy")
         path = folder / "long.h5"
         started = time.process_time()
-        summary = record_trainee(novice_like, 7, seconds, path, task, capture_every=50,
-                                 passes=("rgb", "depth", "label"), width=320, height=240)  # fmt: skip
+        summary = record_trainee(
+            novice_like, 7, seconds, path, task, capture_every=50,
+            passes=("rgb", "depth", "label"), width=320, height=240,
+        )  # fmt: skip
         record_cpu = time.process_time() - started
         rounds, report = [], []
         for _ in range(3):

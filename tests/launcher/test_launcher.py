@@ -140,24 +140,40 @@ def test_a_task_session_shows_its_metrics_and_they_equal_the_offline_assessment(
         "  - {structure: Sinus_+_Dura, margin: 1.0}\n"
     )
     record, metrics, report = tmp_path / "s.h5", tmp_path / "live.json", tmp_path / "d.html"
-    process, status_file, _ = launch(display, tmp_path, launch_file, 14, "--record", str(record),
-                                     "--task", str(task_file), "--metrics", str(metrics),
-                                     "--report", str(report))  # fmt: skip
+    process, status_file, window = launch(display, tmp_path, launch_file, 14, "--record",
+                                          str(record), "--task", str(task_file), "--metrics",
+                                          str(metrics), "--report", str(report), "--fixtures",
+                                          "--audio")  # fmt: skip
     xdo(display, "key", "space")
     xdo(display, "key", "--delay", "20", "--repeat", "85", "ctrl+i")
     time.sleep(2.0)
     shot = screenshot(display)
+    left, top = window_origin(display, window)
     output = finish(process)
     status = json.loads(status_file.read_text())
     assert status["task"] == "Ear drilling" and status["elapsed_s"] > 1, output
     assert status["nearest"] in ("Facial_Nerve", "Sinus_+_Dura")
-    assert shot[:80].std() > 5  # the status lines over the view
+    assert status["fixtures"] == "on" and status["sound"] == "on", output
+    # The task line is drawn in its level's colour (green, amber or red) over the view.
+    band = shot[top : top + 80, left : left + WIDTH].astype(int)
+    levels = [(120, 230, 120), (255, 200, 60), (255, 90, 90)]
+    level = levels[["clear", "near", "inside"].index(_level(status))]
+    assert (np.abs(band - level).max(axis=2) < 30).sum() > 50, "no task line in its colour"
+    with ambfplus.recording.open_recording(record) as rec:
+        assert rec.steps["drill.fixture_force"].shape[1] == 3  # the fixtures' forces recorded
     live = json.loads(metrics.read_text())
     offline = assess(record, load_task(task_file)).data["metrics"]
     offline = json.loads(json.dumps({k: v for k, v in offline.items() if k != "removed_by_name"}))
     assert sum(live["removed_by_label"].values()) > 100, "the session drilled"
     assert_same(live, offline)
     assert report.is_file() and "Debrief: Ear drilling" in report.read_text()
+
+
+def _level(status: dict) -> str:
+    nearest, margin = status["nearest_mm"], status["nearest_margin_mm"]
+    if nearest is None or nearest > 2 * margin:
+        return "clear"
+    return "inside" if nearest <= margin else "near"
 
 
 def assert_same(live, offline, path="metrics"):

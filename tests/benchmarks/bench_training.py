@@ -24,8 +24,8 @@ rubric item's score (the direction every item is expected to move in: an expert 
 
 assessment_speed: a 10-minute novice-like session at 1 kHz with stereo at 20 Hz (320x240 rgb,
 depth and labels) recorded on the 128^3 phantom, then assessed against the cortical
-mastoidectomy task (metrics, target, exposure, burr visibility from every frame with cutting, rubric, timeline):
-CPU seconds (median and worst of 3), target 20 s; and the report on top.
+mastoidectomy task (metrics, target, exposure, burr visibility from every frame with cutting,
+rubric, timeline): CPU seconds (median and worst of 3), target 20 s; and the report on top.
 
 live_metrics_tick: what live skill metrics add to a haptic tick, measured in C++ (the thread's
 CPU time around each tick's metrics, LiveMetrics.tick_cpu_seconds) over the last 16384 ticks of

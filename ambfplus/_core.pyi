@@ -29,7 +29,7 @@ class OutOfRange(Error, IndexError):
     """An index outside what it indexes."""
 class ArgumentTypeError(ArgumentError, TypeError):
     """A value of the wrong type, or a keyword option that does not exist."""
-__all__: list[str] = ['ActuatorHold', 'ArgumentError', 'ArgumentTypeError', 'AssetNotFound', 'Axis', 'Camera', 'ConfigError', 'ConstraintActuator', 'ControlOutput', 'Device', 'DistanceField', 'Drill', 'DrillSound', 'Error', 'Frame', 'InputDevice', 'Joint', 'JointType', 'JoystickDevice', 'JoystickMapping', 'KeyboardDevice', 'Label', 'Light', 'LightType', 'LoadReport', 'MergedDevice', 'MeshCollision', 'Model', 'NetworkDevice', 'NotFound', 'NullDevice', 'Object', 'OpenXrSession', 'OutOfRange', 'PLUGIN_ABI_VERSION', 'PluginError', 'PluginInfo', 'PluginSite', 'ProximitySensor', 'RealTimeLoop', 'RemovalMode', 'RenderError', 'ReplayDevice', 'ResourceError', 'RigidBody', 'ScriptedDevice', 'ShapeKind', 'SimulatedDevice', 'Simulator', 'SkillMetrics', 'SoftBody', 'StateError', 'Volume', 'VolumeData', 'Window', 'World', 'capture_passes', 'gl_info', 'load_nrrd', 'load_slice_stack', 'openxr_built', 'phantom', 'plugin_search_path', 'read_colors', 'read_input_devices', 'read_label_table', 'read_launch', 'render_drill_sound', 'use_x11_display', 'write_image', 'write_label_table']
+__all__: list[str] = ['ActuatorHold', 'ArgumentError', 'ArgumentTypeError', 'AssetNotFound', 'Axis', 'Camera', 'ConfigError', 'ConstraintActuator', 'ControlOutput', 'Device', 'DistanceField', 'Drill', 'DrillSound', 'Error', 'Frame', 'InputDevice', 'Joint', 'JointType', 'JoystickDevice', 'JoystickMapping', 'KeyboardDevice', 'Label', 'Light', 'LightType', 'LiveMetrics', 'LoadReport', 'MergedDevice', 'MeshCollision', 'Model', 'NetworkDevice', 'NotFound', 'NullDevice', 'Object', 'OpenXrSession', 'OutOfRange', 'PLUGIN_ABI_VERSION', 'PluginError', 'PluginInfo', 'PluginSite', 'ProximitySensor', 'RealTimeLoop', 'RemovalMode', 'RenderError', 'ReplayDevice', 'ResourceError', 'RigidBody', 'ScriptedDevice', 'ShapeKind', 'SimulatedDevice', 'Simulator', 'SkillMetrics', 'SoftBody', 'StateError', 'Volume', 'VolumeData', 'Window', 'World', 'capture_passes', 'gl_info', 'live_metrics', 'load_nrrd', 'load_slice_stack', 'openxr_built', 'phantom', 'plugin_search_path', 'read_colors', 'read_input_devices', 'read_label_table', 'read_launch', 'render_drill_sound', 'use_x11_display', 'write_image', 'write_label_table']
 class Window:
     """
     An X11 window (GLFW's, made without a client API) showing cameras.
@@ -227,6 +227,10 @@ class VolumeData:
     def label_counts(self) -> numpy.typing.NDArray[numpy.int64]:
         """
         voxels per label id (index = id; index 0 counts the empty voxels)
+        """
+    def label_ids(self, labels: typing.Any, what: str = 'labels') -> list[int]:
+        """
+        The ids of labels given by name or id (one, or a list), by the rule every caller uses (a name first, then a number); an unknown one raises NotFound starting with `what` and listing the table's labels.
         """
     def mark_dirty(self, lo: typing.Annotated[collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], "FixedSize(3)"] | None = None, hi: typing.Annotated[collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], "FixedSize(3)"] | None = None) -> None:
         """
@@ -2427,9 +2431,9 @@ class SkillMetrics:
     """
     Skill metrics of a drilling session, fed tick by tick (live) or from a recording (offline) through the same code.
     """
-    def __init__(self, volume: VolumeData, *, protect: list = [], target_labels: typing.Any = None, excess_force: typing.SupportsFloat | typing.SupportsIndex = 3.0, stroke_gap: typing.SupportsFloat | typing.SupportsIndex = 0.05, turn_step: typing.SupportsFloat | typing.SupportsIndex = 0.0005, turn_angle: typing.SupportsFloat | typing.SupportsIndex = 0.7853981633974483, field_band: typing.SupportsFloat | typing.SupportsIndex = 0.005, apply_removals: bool = False) -> None:
+    def __init__(self, volume: VolumeData, *, protect: list = [], target_labels: typing.Any = None, target_mask: typing.Any = None, excess_force: typing.SupportsFloat | typing.SupportsIndex = 3.0, stroke_gap: typing.SupportsFloat | typing.SupportsIndex = 0.05, turn_step: typing.SupportsFloat | typing.SupportsIndex = 0.0005, turn_angle: typing.SupportsFloat | typing.SupportsIndex = 0.7853981633974483, field_band: typing.SupportsFloat | typing.SupportsIndex = 0.005, apply_removals: bool = False) -> None:
         """
-        Metrics of drilling `volume` (the volume being drilled, which the structures' distance fields follow). protect: [{'name', 'labels': names or ids, 'margin': metres}]; target_labels: the labels of the target region; excess_force: N; stroke_gap: s; turn_step: m; turn_angle: rad; field_band: m beyond the margins; apply_removals: remove each tick's voxels from `volume` (offline, on a fresh copy of the anatomy).
+        Metrics of drilling `volume` (the volume being drilled, which the structures' distance fields follow). protect: [{'name', 'labels': names or ids, 'margin': metres}]; target_labels: the labels of the target region, or target_mask: the region voxel by voxel (an array of the volume's shape, non-zero inside); excess_force: N; stroke_gap: s; turn_step: m; turn_angle: rad; field_band: m beyond the margins; apply_removals: remove each tick's voxels from `volume` (offline, on a fresh copy of the anatomy).
         """
     def add(self, step: typing.SupportsInt | typing.SupportsIndex, time: typing.SupportsFloat | typing.SupportsIndex, dt: typing.SupportsFloat | typing.SupportsIndex, tip: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], force: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], burr_radius: typing.SupportsFloat | typing.SupportsIndex, burr_on: bool, removed: typing.Annotated[numpy.typing.ArrayLike, numpy.int32] | None = None, removed_labels: typing.Annotated[numpy.typing.ArrayLike, numpy.uint16] | None = None) -> None:
         """
@@ -2446,6 +2450,28 @@ class SkillMetrics:
     def summary(self) -> dict:
         """
         Everything measured so far, as a dict (distances in metres, times in seconds, forces in newtons, volumes as voxel counts with voxel_volume in cubic metres).
+        """
+class LiveMetrics:
+    """
+    Skill metrics of a drill measured live: its world feeds them at every step, through the code the offline assessment runs (ambfplus.live_metrics starts them).
+    """
+    def clearances(self) -> list:
+        """
+        Each protected structure's distance (metres; None once it is gone) from the burr where it is now, with its margin: [{'name', 'margin', 'distance'}].
+        """
+    def summary(self) -> dict:
+        """
+        The metrics so far, as SkillMetrics.summary() gives them.
+        """
+    @property
+    def active(self) -> bool:
+        """
+        Whether the metrics are still fed (their drill is in the world).
+        """
+    @property
+    def tick_cpu_seconds(self) -> numpy.typing.NDArray[numpy.float64]:
+        """
+        CPU seconds the metrics added to each of the last ticks (up to 16384).
         """
 class DrillSound:
     """
@@ -2619,6 +2645,10 @@ def capture_passes() -> list:
 def gl_info() -> dict:
     """
     Describes the OpenGL context (created on first use): vendor, renderer, version, ...
+    """
+def live_metrics(drill: Drill, *, protect: list = [], target_labels: typing.Any = None, target_mask: typing.Any = None, excess_force: typing.SupportsFloat | typing.SupportsIndex = 3.0, stroke_gap: typing.SupportsFloat | typing.SupportsIndex = 0.05, turn_step: typing.SupportsFloat | typing.SupportsIndex = 0.0005, turn_angle: typing.SupportsFloat | typing.SupportsIndex = 0.7853981633974483, field_band: typing.SupportsFloat | typing.SupportsIndex = 0.005) -> LiveMetrics:
+    """
+    Starts skill metrics of `drill`, fed by its world after every step (SkillMetrics' options); its world keeps them until it goes.
     """
 def load_nrrd(path: os.PathLike | str | bytes, kind: str = 'auto', threshold: typing.SupportsFloat | typing.SupportsIndex | None = None) -> VolumeData:
     """

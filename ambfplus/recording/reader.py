@@ -172,6 +172,22 @@ class Recording:
             return {}
         return {name: column[:] for name, column in self._columns("steps").items()}
 
+    def read_columns(self, group: str, names) -> dict[str, np.ndarray]:
+        """Some whole columns of a group (``steps``, ``removed``, ...), read part by part so
+        that each part is opened once however many parts a long recording has."""
+        if group not in self._groups:
+            raise KeyError(f"{self.path}: the recording has no group {group!r}")
+        columns = self._columns(group)
+        missing = [n for n in names if n not in columns]
+        if missing:
+            raise KeyError(f"{self.path}: {group} has no column {missing[0]!r} (it has "
+                           f"{', '.join(sorted(columns))})")  # fmt: skip
+        chunks: dict[str, list] = {n: [] for n in names}
+        for piece in range(len(self._groups[group][0])):
+            for n in names:
+                chunks[n].append(columns[n].read_piece(piece))
+        return {n: np.concatenate(c) if c else columns[n][:0] for n, c in chunks.items()}
+
     @cached_property
     def removed(self) -> dict:
         """Removed voxels: ``step`` (M,), ``voxel`` (M, 3), ``label`` (M,) and ``volume``."""
@@ -278,6 +294,11 @@ class Column(Sequence):
     def _read_rows(self, indices) -> np.ndarray:
         rows = [self._read_row(i) for i in indices]
         return np.array(rows, dtype=self.dtype) if rows else self._empty()
+
+    def read_piece(self, piece: int) -> np.ndarray:
+        """The rows this column holds in one part (piece `piece` of its parts)."""
+        with _damage_is_an_error(self._files.path(self._parts[piece]), f"reading {self.path}"):
+            return np.asarray(self._dataset(piece)[:])
 
     def _read_range(self, start: int, stop: int) -> np.ndarray:
         chunks = []

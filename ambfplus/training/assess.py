@@ -81,19 +81,26 @@ def load_session(path) -> SessionData:
     drill = scene.drill
     if drill is None:
         raise ValueError(f"{path}: the recorded scene has no drill: nothing to assess")
-    steps = rec.steps
-    if f"{drill.name}.pose" not in steps:
-        raise ValueError(f"{path}: the step log has no columns of drill '{drill.name}'")
+    wanted = ["step", "time"] + [f"{drill.name}.{c}" for c in ("pose", "force", "on", "burr")]
+    try:
+        # Only the columns assessment reads (a long session's step log holds many more).
+        steps = rec.read_columns("steps", wanted)
+    except KeyError as error:
+        raise ValueError(
+            f"{path}: the step log lacks what assessment needs of drill "
+            f"'{drill.name}': {error.args[0]}"
+        ) from None
     camera = None
     rig = rec.rigs.get(meta.get("rig", "rig"))
     stream = rig.left if rig is not None else rec.cameras.get(meta.get("camera", ""))
     if stream is not None and len(stream):
         columns = stream.columns
+        small = rec.read_columns(f"cameras/{stream.name}", ["step", "intrinsics", "pose"])
         camera = {
             "name": stream.camera,
-            "steps": np.asarray(columns["step"][:], np.int64),
-            "intrinsics": np.asarray(columns["intrinsics"][:], float),
-            "poses": np.asarray(columns["pose"][:], float),
+            "steps": np.asarray(small["step"], np.int64),
+            "intrinsics": np.asarray(small["intrinsics"], float),
+            "poses": np.asarray(small["pose"], float),
             "depth": (lambda i: columns["depth"][i]) if "depth" in columns else (lambda i: None),
             "rgb": (lambda i: columns["rgb"][i]) if "rgb" in columns else (lambda i: None),
             "label": (lambda i: columns["label"][i]) if "label" in columns else None,

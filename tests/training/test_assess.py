@@ -291,3 +291,15 @@ def test_the_command_line_says_what_is_wrong(sessions, tmp_path):
                      "target: {labels: [Bone]}\n")  # fmt: skip
     with pytest.raises(SystemExit, match="other.yaml: the task's anatomy .* is not the anatomy"):
         main(["assess", str(paths["expert"]), "--task", str(other)])
+
+
+def test_columns_are_read_part_by_part_as_whole_columns_are(sessions):
+    _, paths = sessions
+    with ambfplus.recording.open_recording(paths["novice"]) as rec:
+        assert len(rec.parts) > 1
+        names = ["step", "drill.pose", "drill.on"]
+        some = rec.read_columns("steps", names)
+        for name in names:
+            np.testing.assert_array_equal(some[name], rec.steps[name])
+        with pytest.raises(KeyError, match="steps has no column 'drill.nothing'"):
+            rec.read_columns("steps", ["drill.nothing"])

@@ -234,7 +234,7 @@ def assessment_speed(args):
             "report_worst_cpu_s": round(max(report), 3),
             "visibility_frames": result.data["visibility"]["frames"],
             "record_cpu_s": round(record_cpu, 1),
-            "what": "assessing a 1 kHz session with 20 Hz stereo (320x240 rgb+depth) recorded on "
+            "what": "assessing a 1 kHz session with 20 Hz stereo (320x240 rgb, depth, labels) on "
             "the 128^3 phantom against the cortical mastoidectomy task; median and worst of 3, "
             "process CPU time; the report (renders of the cavity) on top",
             "quick": args.quick,

@@ -208,7 +208,7 @@ void Drill::tick(double dt, std::int64_t step) {
   age_ += dt;
   collider_->sync();
   sync_meshes();
-  structures_->tick();  // fields follow the edits (see StructureDistances)
+  structures_->tick(!realtime_);  // fields follow the edits (see StructureDistances)
   update_cursors();
   place_drill();
   const Eigen::Vector3d tip_force = update_forces(dt);

@@ -129,7 +129,10 @@ class DrillSystem : public System {
   }
 
   void run(StepStage, const StepContext& context) override {
-    for (Drill* d : drills_) d->tick(context.dt, context.step);
+    for (Drill* d : drills_) {
+      d->set_realtime(context.realtime);
+      d->tick(context.dt, context.step);
+    }
   }
 
  private:

@@ -1,5 +1,7 @@
 #include "haptics/structure_distances.h"
 
+#include <chrono>
+
 #include <pthread.h>
 #include <sched.h>
 
@@ -223,11 +225,13 @@ void StructureDistances::removed(std::int64_t before, const std::vector<std::arr
   if (seen_ == before) seen_ = data_.revision();  // else notice_edits() scans them all
 }
 
-void StructureDistances::tick() {
+void StructureDistances::tick(bool wait) {
   ++tick_;
   notice_edits();
   for (Entry& e : entries_) {
-    if (e.next.valid() && tick_ >= e.due) {
+    const bool ready = e.next.valid() && (wait || e.next.wait_for(std::chrono::seconds(0)) ==
+                                                      std::future_status::ready);
+    if (ready && tick_ >= e.due) {
       std::shared_ptr<const Field> old = std::move(e.current);
       e.current = e.next.get();  // waits only if the machine is slower than kFollowTicks
       ++rebuilds_;

@@ -51,8 +51,10 @@ class StructureDistances {
   void removed(std::int64_t before, const std::vector<std::array<int, 3>>& voxels,
                const std::vector<std::uint16_t>& labels);
   /// One tick: notices edits made by others (their boxes are scanned), takes rebuilt fields
-  /// that are due, and starts the rebuilds that are waiting.
-  void tick();
+  /// that are due, and starts the rebuilds that are waiting. `wait`: a due field not yet built
+  /// is waited for (deterministic, scripted stepping); without it (a real-time loop, which must
+  /// never block) it is taken at the first tick after it is ready.
+  void tick(bool wait = true);
 
   /// Distance (metres) from p (volume frame) to the nearest centre of a voxel of `label`,
   /// negative inside, infinity when none is left; its gradient when asked (zero beyond the

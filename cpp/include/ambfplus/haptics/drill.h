@@ -151,6 +151,9 @@ class AMBFPLUS_API Drill : public Object {
 
   /// One haptic step: cursors, force, removal. Called by World::step.
   void tick(double dt, std::int64_t step);
+  /// Whether a real-time loop steps it (the drills system says so before each tick): a tick
+  /// then never waits for a structure's rebuilt distance field, taking it once it is ready.
+  void set_realtime(bool on) { realtime_ = on; }
   /// The world's rigid bodies changed (one was added or is about to be removed): the cursors'
   /// mesh collider is rebuilt at the next tick (the drills system calls it).
   void bodies_changed() { meshes_stale_ = true; }
@@ -327,6 +330,7 @@ class AMBFPLUS_API Drill : public Object {
   std::vector<DrillWaypoint> waypoints_;
   double waypoint_clock_ = 0.0;
   bool meshes_follow_goal_ = false;
+  bool realtime_ = false;
 };
 
 }  // namespace ambfplus

@@ -15,15 +15,12 @@
 #include "ambfplus/scene/world.h"
 #include "ambfplus/volume/label_table.h"
 #include "haptics/structure_distances.h"
+#include "util/clock.h"
 
 namespace ambfplus {
 namespace {
 
-double thread_cpu_seconds() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
+using util::thread_cpu_seconds;
 constexpr double kPi = 3.14159265358979323846;
 // Metres a burr may sit inside a hard stop before it stops cutting (rounding of the held goal).
 constexpr double kStopTolerance = 1e-6;

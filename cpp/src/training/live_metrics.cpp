@@ -9,15 +9,12 @@
 #include "ambfplus/haptics/drill.h"
 #include "ambfplus/scene/volume.h"
 #include "ambfplus/scene/world.h"
+#include "util/clock.h"
 
 namespace ambfplus {
 namespace {
 
-double thread_cpu_seconds() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
+using util::thread_cpu_seconds;
 
 }  // namespace
 

@@ -95,3 +95,60 @@ else()
   message(STATUS "OpenXR headers not found (libopenxr-dev): OpenXR sessions not built")
 endif()
 add_library(ambfplus::dep_openxr ALIAS ambfplus_dep_openxr)
+
+# miniaudio 0.11.25 (cpp/third_party/miniaudio/README.md says why this library): one header, not
+# packaged by Debian 12 and not kept in this repository. Taken at configure time from the source
+# distribution of the `miniaudio` package on PyPI (version 1.71), checked against the archive's
+# and the header's SHA-256, and kept in the build tree, so a rebuild downloads nothing. Offline,
+# point AMBFPLUS_MINIAUDIO_HEADER at a copy of that header (the same hash is checked).
+set(AMBFPLUS_MINIAUDIO_HEADER "" CACHE FILEPATH
+  "miniaudio.h 0.11.25 to use instead of downloading it from PyPI")
+set(_ma_url "https://files.pythonhosted.org/packages/d8/d5/e5439dc08561f73656bfeb3340fc64ab63163e101426593d8fb9a025ff1e/miniaudio-1.71.tar.gz")
+set(_ma_archive_sha256 ff51e2887bb673e2e757752b586b3dc924d59aa5fbcae9bbc45f4a111bd3262b)
+set(_ma_header_sha256 ac7af4de748b7e26b777f37e01cee313a308a7296a3eb080e2906b320cc55c89)
+set(AMBFPLUS_MINIAUDIO_INCLUDE_DIR ${CMAKE_BINARY_DIR}/third_party)
+set(_ma_header ${AMBFPLUS_MINIAUDIO_INCLUDE_DIR}/miniaudio/miniaudio.h)
+
+function(_ambfplus_check_miniaudio path out_ok)
+  set(${out_ok} FALSE PARENT_SCOPE)
+  if(EXISTS "${path}")
+    file(SHA256 "${path}" hash)
+    if(hash STREQUAL "${_ma_header_sha256}")
+      set(${out_ok} TRUE PARENT_SCOPE)
+    endif()
+  endif()
+endfunction()
+
+_ambfplus_check_miniaudio("${_ma_header}" _ma_ok)
+if(NOT _ma_ok AND AMBFPLUS_MINIAUDIO_HEADER)
+  _ambfplus_check_miniaudio("${AMBFPLUS_MINIAUDIO_HEADER}" _ma_given_ok)
+  if(NOT _ma_given_ok)
+    message(FATAL_ERROR "AMBFPLUS_MINIAUDIO_HEADER=${AMBFPLUS_MINIAUDIO_HEADER}: not miniaudio.h "
+      "0.11.25 (expected SHA-256 ${_ma_header_sha256}: the file miniaudio/miniaudio.h of "
+      "${_ma_url})")
+  endif()
+  configure_file("${AMBFPLUS_MINIAUDIO_HEADER}" "${_ma_header}" COPYONLY)
+elseif(NOT _ma_ok)
+  set(_ma_archive ${CMAKE_BINARY_DIR}/_downloads/miniaudio-1.71.tar.gz)
+  message(STATUS "Downloading miniaudio 0.11.25 (PyPI miniaudio 1.71 source distribution)")
+  file(DOWNLOAD "${_ma_url}" "${_ma_archive}" EXPECTED_HASH SHA256=${_ma_archive_sha256}
+    TLS_VERIFY ON STATUS _ma_status)
+  list(GET _ma_status 0 _ma_code)
+  if(NOT _ma_code EQUAL 0)
+    list(GET _ma_status 1 _ma_message)
+    file(REMOVE "${_ma_archive}")
+    message(FATAL_ERROR "Could not download miniaudio (${_ma_message}) from ${_ma_url}. "
+      "Without a network, download that file elsewhere and pass "
+      "-DAMBFPLUS_MINIAUDIO_HEADER=<path to its miniaudio/miniaudio.h> (pip: -C "
+      "cmake.define.AMBFPLUS_MINIAUDIO_HEADER=...).")
+  endif()
+  file(ARCHIVE_EXTRACT INPUT "${_ma_archive}" DESTINATION ${CMAKE_BINARY_DIR}/_downloads
+    PATTERNS miniaudio-1.71/miniaudio/miniaudio.h)
+  configure_file(${CMAKE_BINARY_DIR}/_downloads/miniaudio-1.71/miniaudio/miniaudio.h
+    "${_ma_header}" COPYONLY)
+  _ambfplus_check_miniaudio("${_ma_header}" _ma_ok)
+  if(NOT _ma_ok)
+    message(FATAL_ERROR "${_ma_archive}: its miniaudio/miniaudio.h is not the expected header "
+      "(SHA-256 ${_ma_header_sha256})")
+  endif()
+endif()

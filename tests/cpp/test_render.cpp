@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 
 #include "ambfplus/engine/engine.h"
@@ -106,4 +107,31 @@ TEST(Render, ShaderErrorsNameTheFileAndCarryTheLog) {
 }
 
 }  // namespace
+// A driver that tears itself down before the engine's context at exit (NVIDIA's EGL library runs
+// its own exit handler first) must not make the exit abort: the context then makes no GL call.
+// Simulated here by terminating the display after a capture; the child process must exit 0.
+TEST(RenderDeathTest, ExitAfterTheDriverWasTornDownIsClean) {
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  EXPECT_EXIT(
+      {
+        auto sim = engine::create_simulator();
+        World& world = sim->world();
+        RigidBodySpec box;
+        box.name = "box";
+        box.dynamics.mass = 0;
+        world.default_model().add_body(box);
+        CameraSpec spec;
+        spec.name = "cam";
+        spec.width = 32;
+        spec.height = 24;
+        Camera& cam = world.default_model().add_camera(spec);
+        cam.look_at({0, 0, 3}, {0, 0, 0}, {0, 1, 0});
+        capture_frame(cam);  // compiles the programs the context keeps until exit
+        sim.reset();
+        eglTerminate(render::Context::get().display());
+        std::exit(0);
+      },
+      ::testing::ExitedWithCode(0), "");
+}
+
 }  // namespace ambfplus

@@ -317,15 +317,18 @@ Context::Context() : pid_(getpid()) {
 }
 
 Context::~Context() {
-  if (pid_ != getpid()) {
-    // A forked child must not tear down its parent's driver state.
-    for (auto& p : programs_) p.second.release();
+  // Runs at exit. A driver may have torn itself down before: NVIDIA's EGL library registers an
+  // exit handler of its own, after this context's, so it runs first. No GL call may then be made
+  // (libepoxy aborts the process when no context is current): the programs go with the process.
+  // A forked child must not tear down its parent's driver state either.
+  if (pid_ == getpid() && eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_)) {
+    programs_.clear();
+    eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    eglDestroyContext(display_, context_);
+    eglTerminate(display_);
     return;
   }
-  if (eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_)) programs_.clear();
-  eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
-  eglDestroyContext(display_, context_);
-  eglTerminate(display_);
+  for (auto& p : programs_) p.second.release();
 }
 
 bool Context::exists() {

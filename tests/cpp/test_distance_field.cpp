@@ -7,6 +7,7 @@
 #include "ambfplus/errors.h"
 #include "ambfplus/volume/distance_field.h"
 #include "ambfplus/volume/volume_data.h"
+#include "haptics/structure_distances.h"
 
 namespace ambfplus {
 namespace {
@@ -147,6 +148,56 @@ TEST(DistanceField, RefusesBadArguments) {
   EXPECT_EQ(empty.structure_voxels(), 0);
   EXPECT_DOUBLE_EQ(empty.at(1, 2, 3), 0.001);
   EXPECT_THROW(empty.at(4, 0, 0), OutOfRange);
+}
+
+// The fields a drill reads follow its cuts: after kFollowTicks ticks the structure's distance
+// equals a fresh field's of the edited volume wherever that is within the band, whether the
+// successor was a local update (cuts told through removed(), or seen as another's edit) or a new
+// build (the structure painted beyond its neighbourhood).
+TEST(StructureDistances, FollowCutsAsAFreshFieldWould) {
+  VolumeData v({40, 36, 30}, Eigen::Vector3d(0.008, 0.0072, 0.009), LabelType::kUInt8, anatomy());
+  v.set_region(VoxelBox{{0, 0, 0}, {40, 36, 30}}, 1);
+  v.set_region(VoxelBox{{12, 10, 8}, {28, 26, 22}}, 2);  // a structure to cut into
+  v.set_region(VoxelBox{{14, 12, 10}, {16, 14, 12}}, 3);
+  v.commit();
+  const double band = 0.0012;
+  StructureDistances distances(v);
+  distances.track(2, band);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> where(-0.002, 0.002);
+  for (int round = 0; round < 8; ++round) {
+    const std::int64_t before = v.revision();
+    if (round == 6) {
+      v.set_region(VoxelBox{{0, 0, 0}, {2, 2, 2}}, 2);  // beyond its neighbourhood: a new build
+    } else {
+      const Eigen::Vector3d c(where(rng), where(rng), where(rng));
+      v.take_edit_log();
+      v.remove_sphere(c, 0.0011, false);
+      if (round % 2 == 0) {  // as the drill tells it; odd rounds are seen as others' edits
+        const auto log = v.take_edit_log();
+        ASSERT_EQ(log.size(), 1u);
+        distances.removed(before, log.front().voxels, log.front().old_labels);
+      }
+    }
+    for (std::int64_t t = 0; t <= StructureDistances::kFollowTicks; ++t) distances.tick(true);
+    const DistanceField fresh(v, {2}, band);
+    const auto& n = v.shape();
+    int compared = 0;
+    for (int k = 0; k < n[2]; k += 2)
+      for (int j = 0; j < n[1]; j += 2)
+        for (int i = 0; i < n[0]; i += 2) {
+          const Eigen::Vector3d p = v.voxel_center(i, j, k) + Eigen::Vector3d(0.001, -0.0007, 0.0);
+          const double want = fresh.sample(p).distance;
+          if (std::abs(want) >= band) continue;
+          ASSERT_NEAR(distances.distance(2, p), want, 1e-9)
+              << round << ": " << i << " " << j << " " << k;
+          ++compared;
+        }
+    EXPECT_GT(compared, 100) << round;
+  }
+  EXPECT_GE(distances.rebuilds(), 7);
+  EXPECT_GE(distances.local_updates(), 5);  // the cuts; round 6 was a new build
+  EXPECT_LT(distances.local_updates(), distances.rebuilds());
 }
 
 }  // namespace

@@ -22,6 +22,14 @@ void run_at_normal_priority() {
   pthread_setschedparam(pthread_self(), SCHED_OTHER, &p);
 }
 
+// Whether box a lies inside box b.
+bool within(const VoxelBox& a, const VoxelBox& b) {
+  for (int axis = 0; axis < 3; ++axis) {
+    if (a.lo[axis] < b.lo[axis] || a.hi[axis] > b.hi[axis]) return false;
+  }
+  return true;
+}
+
 bool overlap(const VoxelBox& a, const VoxelBox& b) {
   for (int axis = 0; axis < 3; ++axis) {
     if (a.hi[axis] <= b.lo[axis] || b.hi[axis] <= a.lo[axis]) return false;
@@ -89,11 +97,13 @@ std::unique_ptr<VolumeData> StructureDistances::copy(std::uint16_t label,
 }
 
 std::shared_ptr<const StructureDistances::Field> StructureDistances::finish(
-    std::unique_ptr<VolumeData> snapshot, VoxelBox box, Eigen::Vector3d offset, double band) {
+    std::unique_ptr<VolumeData> snapshot, std::unique_ptr<DistanceField> field, VoxelBox box,
+    Eigen::Vector3d offset) {
   auto f = std::make_shared<Field>();
-  f->field = std::make_unique<DistanceField>(*snapshot, std::vector<std::uint16_t>{1}, band);
-  const VoxelBox& b = f->field->bounds();
-  if (!b.empty()) {
+  // A field brought up to date keeps the box of its first build (cuts only shrink the
+  // structure): still around every voxel, so the distance beyond the band stays a lower bound.
+  const VoxelBox& b = field->bounds();
+  if (!b.empty() && field->structure_voxels() > 0) {
     const Eigen::Vector3d a = snapshot->voxel_center(b.lo[0], b.lo[1], b.lo[2]) + offset;
     const Eigen::Vector3d c =
         snapshot->voxel_center(b.hi[0] - 1, b.hi[1] - 1, b.hi[2] - 1) + offset;
@@ -104,10 +114,52 @@ std::shared_ptr<const StructureDistances::Field> StructureDistances::finish(
       f->bounds.hi[axis] = b.hi[axis] + box.lo[axis];
     }
   }
+  f->field = std::move(field);
   f->snapshot = std::move(snapshot);
   f->box = box;
   f->offset = offset;
   return f;
+}
+
+std::future<std::shared_ptr<const StructureDistances::Field>> StructureDistances::follow(
+    const Entry& e) const {
+  std::shared_ptr<const Field> old = e.current;
+  // The structure's voxels over the cut, as they are now, copied here (the other thread never
+  // reads the volume), in the snapshot's coordinates.
+  VoxelBox cut = e.cut;
+  std::unique_ptr<VolumeData> patch = copy(e.label, cut);
+  for (int a = 0; a < 3; ++a) {
+    cut.lo[a] -= old->box.lo[a];
+    cut.hi[a] -= old->box.lo[a];
+  }
+  return std::async(
+      std::launch::async,
+      [old = std::move(old), patch = std::move(patch), cut]() -> std::shared_ptr<const Field> {
+        run_at_normal_priority();
+        const VolumeData& from = *old->snapshot;
+        auto snapshot = std::make_unique<VolumeData>(from.shape(), from.dimensions(),
+                                                     LabelType::kUInt8, from.label_table());
+        const std::size_t count = static_cast<std::size_t>(from.voxel_count());
+        std::copy_n(static_cast<const std::uint8_t*>(from.label_data()), count,
+                    static_cast<std::uint8_t*>(snapshot->label_data()));
+        auto field = std::make_unique<DistanceField>(*old->field, *snapshot);
+        const auto& n = from.shape();
+        const auto* in = static_cast<const std::uint8_t*>(patch->label_data());
+        auto* out = static_cast<std::uint8_t*>(snapshot->label_data());
+        const int width = cut.hi[0] - cut.lo[0];
+        for (int k = cut.lo[2]; k < cut.hi[2]; ++k) {
+          for (int j = cut.lo[1]; j < cut.hi[1]; ++j) {
+            std::copy_n(in, width,
+                        out + cut.lo[0] +
+                            static_cast<std::size_t>(n[0]) *
+                                (static_cast<std::size_t>(j) + static_cast<std::size_t>(n[1]) * k));
+            in += width;
+          }
+        }
+        snapshot->mark_dirty(cut);
+        field->update();
+        return finish(std::move(snapshot), std::move(field), old->box, old->offset);
+      });
 }
 
 std::future<std::shared_ptr<const StructureDistances::Field>> StructureDistances::rebuild(
@@ -128,11 +180,12 @@ std::future<std::shared_ptr<const StructureDistances::Field>> StructureDistances
   const Eigen::Vector3d offset =
       data_.voxel_center(box.lo[0], box.lo[1], box.lo[2]) - snapshot->voxel_center(0, 0, 0);
   const double band = e.band;
-  return std::async(std::launch::async,
-                    [snapshot = std::move(snapshot), box, offset, band]() mutable {
-                      run_at_normal_priority();
-                      return finish(std::move(snapshot), box, offset, band);
-                    });
+  return std::async(std::launch::async, [snapshot = std::move(snapshot), box, offset,
+                                         band]() mutable {
+    run_at_normal_priority();
+    auto field = std::make_unique<DistanceField>(*snapshot, std::vector<std::uint16_t>{1}, band);
+    return finish(std::move(snapshot), std::move(field), box, offset);
+  });
 }
 
 void StructureDistances::set_plan(std::shared_ptr<const std::vector<std::uint8_t>> mask) {
@@ -149,7 +202,7 @@ void StructureDistances::track(std::uint16_t label, double band) {
   Entry* e = find(label);
   if (e != nullptr && e->band >= band) return;
   if (e == nullptr) {
-    entries_.push_back(Entry{label, band, nullptr, {}, 0, false, VoxelBox{}});
+    entries_.push_back(Entry{label, band, nullptr, {}, 0, false, VoxelBox{}, VoxelBox{}, false});
     e = &entries_.back();
   }
   if (e->next.valid()) e->next.wait();
@@ -175,6 +228,8 @@ void StructureDistances::track(std::uint16_t label, double band) {
   e->next = {};
   e->changed = false;
   e->grown = VoxelBox{};
+  e->cut = VoxelBox{};
+  e->whole = false;
   seen_ = data_.revision();
 }
 
@@ -191,7 +246,15 @@ void StructureDistances::notice_edits() {
     for (const VoxelBox& dirty : boxes) {
       const VoxelBox box = dirty.clipped(data_.shape());
       if (overlap(box, e.current->box)) {
-        e.changed = true;  // within the structure's neighbourhood: rebuild, to be sure
+        // Within the structure's neighbourhood: followed locally when the edit stayed inside
+        // it, else built anew (the structure may have been painted beyond it).
+        e.changed = true;
+        if (within(box, e.current->box)) {
+          e.cut = e.cut.united(box);
+        } else {
+          e.whole = true;
+          e.grown = e.grown.united(box);
+        }
         continue;
       }
       // Farther away an edit matters only if it painted the structure there.
@@ -217,12 +280,29 @@ void StructureDistances::notice_edits() {
 void StructureDistances::removed(std::int64_t before, const std::vector<std::array<int, 3>>& voxels,
                                  const std::vector<std::uint16_t>& labels) {
   for (Entry& e : entries_) {
-    for (std::size_t n = 0; n < voxels.size() && !e.changed; ++n) {
+    for (std::size_t n = 0; n < voxels.size(); ++n) {
       const std::array<int, 3>& v = voxels[n];
-      e.changed = member(e.label, labels[n], v[0], v[1], v[2]);
+      if (!member(e.label, labels[n], v[0], v[1], v[2])) continue;
+      e.changed = true;
+      // A removed voxel of the structure lies inside its bounds, so inside the snapshot's box.
+      e.cut = e.cut.united(VoxelBox{v, {v[0] + 1, v[1] + 1, v[2] + 1}});
     }
   }
   if (seen_ == before) seen_ = data_.revision();  // else notice_edits() scans them all
+}
+
+void StructureDistances::start(Entry& e) {
+  const Field& f = *e.current;
+  // Local while the structure stays inside the snapshot's box and the cut is not most of it.
+  const bool local = !e.whole && e.grown.empty() && !f.bounds.empty() && !e.cut.empty() &&
+                     within(e.cut, f.box) && 4 * e.cut.count() < f.box.count();
+  e.next = local ? follow(e) : rebuild(e, f.bounds.united(e.grown).united(e.cut));
+  local_updates_ += local ? 1 : 0;
+  e.due = tick_ + kFollowTicks;
+  e.changed = false;
+  e.grown = VoxelBox{};
+  e.cut = VoxelBox{};
+  e.whole = false;
 }
 
 void StructureDistances::tick(bool wait) {
@@ -241,12 +321,7 @@ void StructureDistances::tick(bool wait) {
         old.reset();
       });
     }
-    if (!e.next.valid() && e.changed) {
-      e.next = rebuild(e, e.current->bounds.united(e.grown));
-      e.due = tick_ + kFollowTicks;
-      e.changed = false;
-      e.grown = VoxelBox{};
-    }
+    if (!e.next.valid() && e.changed) start(e);
   }
 }
 

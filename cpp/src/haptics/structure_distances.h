@@ -22,12 +22,15 @@ namespace ambfplus {
 /// band: a lower bound that is exact straight above a flat face and keeps every query O(1).
 ///
 /// Following a cut costs a transform of the band around it (tens of milliseconds for a band of
-/// millimetres), too long for a 1 kHz tick. So each field is built on a copy of the structure's
-/// neighbourhood (its snapshot), on a thread of its own at normal priority, and the field in use
-/// is replaced kFollowTicks ticks after the edit that started the rebuild (waiting for it if the
-/// machine is slower): answers depend on the tick, never on the threads' timing, so scripted runs
-/// stay deterministic. Until then the old field answers; a cut only removes voxels, so its
-/// distances are then a lower bound, on the safe side for fixtures.
+/// millimetres), too long for a 1 kHz tick. So each field lives on a copy of the structure's
+/// neighbourhood (its snapshot) and its successor is made on a thread of its own at normal
+/// priority: a copy of the field and snapshot with the cut voxels applied, brought up to date
+/// locally (DistanceField::update: only the band around the cut is recomputed), or a build from
+/// a new snapshot when the structure grew beyond its neighbourhood or another edit's box reaches
+/// out of it. The field in use is replaced kFollowTicks ticks after the edit that started the
+/// work (waiting for it if the machine is slower): answers depend on the tick, never on the
+/// threads' timing, so scripted runs stay deterministic. Until then the old field answers; a cut
+/// only removes voxels, so its distances are then a lower bound, on the safe side for fixtures.
 class StructureDistances {
  public:
   explicit StructureDistances(const VolumeData& data) : data_(data) {}
@@ -63,6 +66,8 @@ class StructureDistances {
                   Eigen::Vector3d* gradient = nullptr) const;
   /// Rebuilt fields taken into use so far (for tests).
   std::int64_t rebuilds() const { return rebuilds_; }
+  /// Of the successors started so far, those made by a local update (for tests).
+  std::int64_t local_updates() const { return local_updates_; }
 
  private:
   /// A field on a snapshot of the structure's neighbourhood; immutable once built.
@@ -82,6 +87,10 @@ class StructureDistances {
     std::int64_t due = 0;  // the tick at which `next` is taken
     bool changed = false;  // edited since `next`'s snapshot (or with no rebuild running)
     VoxelBox grown;        // where edits may have added voxels beyond current->bounds
+    // The changes since `next`'s snapshot, for a local update: the box (volume voxels, inside
+    // current->box) holding every changed voxel; `whole` when only a new build will do.
+    VoxelBox cut;
+    bool whole = false;
   };
   Entry* find(std::uint16_t label);
   const Entry* find(std::uint16_t label) const;
@@ -90,8 +99,14 @@ class StructureDistances {
   std::future<std::shared_ptr<const Field>> rebuild(const Entry& e, const VoxelBox& bounds) const;
   std::shared_ptr<const Field> build(std::uint16_t label, double band,
                                      const VoxelBox& bounds) const;
-  static std::shared_ptr<const Field> finish(std::unique_ptr<VolumeData> snapshot, VoxelBox box,
-                                             Eigen::Vector3d offset, double band);
+  static std::shared_ptr<const Field> finish(std::unique_ptr<VolumeData> snapshot,
+                                             std::unique_ptr<DistanceField> field, VoxelBox box,
+                                             Eigen::Vector3d offset);
+  /// The successor of e.current with the structure's voxels over e.cut as they are now: a copy
+  /// brought up to date locally, on another thread.
+  std::future<std::shared_ptr<const Field>> follow(const Entry& e) const;
+  /// Starts e's successor (a local update or a new build) and clears e's record of changes.
+  void start(Entry& e);
   std::unique_ptr<VolumeData> copy(std::uint16_t label, const VoxelBox& box) const;
   /// Whether voxel (i, j, k), whose label is l, belongs to the structure of `label`.
   bool member(std::uint16_t label, std::uint16_t l, int i, int j, int k) const {
@@ -109,6 +124,7 @@ class StructureDistances {
   std::int64_t tick_ = 0;
   std::int64_t seen_ = -1;  // the volume revision whose edits are accounted for
   std::int64_t rebuilds_ = 0;
+  std::int64_t local_updates_ = 0;
   std::shared_ptr<const std::vector<std::uint8_t>> plan_;
   std::future<void> retiring_;  // frees a replaced field (megabytes: munmap takes milliseconds)
 };

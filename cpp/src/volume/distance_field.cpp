@@ -36,60 +36,92 @@ bool contains(const VoxelBox& box, int i, int j, int k) {
          k < box.hi[2];
 }
 
-/// One line of the exact squared distance transform: f holds squared distances (metres^2, or
-/// infinity) at samples `spacing` metres apart; on return it holds, for each sample, the least
-/// f(q) + (spacing * (p - q))^2 over q. v, z and g are scratch of at least n + 1 entries.
-void transform_line(double* f, int n, double spacing, int* v, double* z, double* g) {
+/// One line of the exact squared distance transform: f[q * stride] (q < n) holds squared
+/// distances (metres^2, or infinity) at samples `spacing` metres apart; on return each holds the
+/// least f(q) + (spacing * (p - q))^2 over q. v, z and g are scratch of at least n + 1 entries.
+void transform_line(double* f, std::ptrdiff_t stride, int n, double spacing, int* v, double* z,
+                    double* g) {
   // The lower envelope of the parabolas rooted at the finite samples.
   int k = -1;
   for (int q = 0; q < n; ++q) {
-    if (f[q] == kInf) continue;
+    const double fq = f[q * stride];
+    if (fq == kInf) continue;
     const double x = spacing * q;
-    const double root = f[q] + x * x;
+    const double root = fq + x * x;
     double s = -kInf;
     while (k >= 0) {
       const double xv = spacing * v[k];
-      s = (root - (f[v[k]] + xv * xv)) / (2.0 * (x - xv));
+      s = (root - (g[k] + xv * xv)) / (2.0 * (x - xv));
       if (s > z[k]) break;
       --k;
     }
     ++k;
     v[k] = q;
+    g[k] = fq;  // the root's value, kept beside it
     z[k] = k == 0 ? -kInf : s;
     z[k + 1] = kInf;
   }
   if (k < 0) return;  // no finite sample: the line stays infinite
-  for (int q = 0; q < n; ++q) g[q] = f[q];
   int j = 0;
   for (int q = 0; q < n; ++q) {
     const double x = spacing * q;
     while (z[j + 1] < x) ++j;
     const double d = x - spacing * v[j];
-    f[q] = d * d + g[v[j]];
+    f[q * stride] = d * d + g[j];
   }
 }
 
-/// Squared Euclidean distance from each voxel of a packed box (dims n, i fastest) to the nearest
-/// voxel whose `source` flag is set, with per-axis spacing.
-void squared_distances(std::vector<double>& f, const std::array<int, 3>& n,
-                       const Eigen::Vector3d& spacing) {
+/// Lines transformed side by side: a tile of kTile neighbouring lines, gathered so that each
+/// step along the lines reads kTile consecutive values (one or two cache lines) instead of one
+/// value a row or a slice away.
+constexpr int kTile = 16;
+
+/// Squared Euclidean distance (stored as float: it is rounded to float in the end anyway) from
+/// each voxel of a packed box (dims n, i fastest) to the nearest source, a voxel holding 0 (the
+/// others hold infinity), with per-axis spacing. The sources lie in [lo, hi) (box coordinates):
+/// the first pass visits only the rows through that box and the second only its slices, since
+/// every other line holds no source then.
+void squared_distances(std::vector<float>& f, const std::array<int, 3>& n,
+                       const Eigen::Vector3d& spacing, const std::array<int, 3>& lo,
+                       const std::array<int, 3>& hi) {
   const int longest = std::max({n[0], n[1], n[2]});
   std::vector<int> v(longest + 1);
-  std::vector<double> z(longest + 2), g(longest + 1), line(longest);
-  const std::size_t stride[3] = {1, static_cast<std::size_t>(n[0]),
-                                 static_cast<std::size_t>(n[0]) * n[1]};
-  for (int axis = 0; axis < 3; ++axis) {
-    const int a1 = axis == 0 ? 1 : 0;
-    const int a2 = axis == 2 ? 1 : 2;
-    for (int y = 0; y < n[a2]; ++y) {
-      for (int x = 0; x < n[a1]; ++x) {
-        const std::size_t base = x * stride[a1] + y * stride[a2];
-        for (int q = 0; q < n[axis]; ++q) line[q] = f[base + q * stride[axis]];
-        transform_line(line.data(), n[axis], spacing[axis], v.data(), z.data(), g.data());
-        for (int q = 0; q < n[axis]; ++q) f[base + q * stride[axis]] = line[q];
-      }
+  std::vector<double> z(longest + 2), g(longest + 1);
+  std::vector<double> tile(static_cast<std::size_t>(longest) * kTile);
+  const std::size_t row = static_cast<std::size_t>(n[0]);
+  const std::size_t slice = row * n[1];
+  // Along i: contiguous rows.
+  for (int k = lo[2]; k < hi[2]; ++k) {
+    for (int j = lo[1]; j < hi[1]; ++j) {
+      float* line = f.data() + j * row + k * slice;
+      for (int q = 0; q < n[0]; ++q) tile[q] = line[q];
+      transform_line(tile.data(), 1, n[0], spacing[0], v.data(), z.data(), g.data());
+      for (int q = 0; q < n[0]; ++q) line[q] = static_cast<float>(tile[q]);
     }
   }
+  // Along j and then k, kTile lines at a time.
+  auto tiled = [&](int axis, std::size_t step, std::size_t base) {
+    for (int i0 = 0; i0 < n[0]; i0 += kTile) {
+      const int count = std::min(kTile, n[0] - i0);
+      float* first = f.data() + base + i0;
+      for (int q = 0; q < n[axis]; ++q) {
+        const float* in = first + q * step;
+        double* out = tile.data() + static_cast<std::size_t>(q) * kTile;
+        for (int b = 0; b < count; ++b) out[b] = in[b];
+      }
+      for (int b = 0; b < count; ++b) {
+        transform_line(tile.data() + b, kTile, n[axis], spacing[axis], v.data(), z.data(),
+                       g.data());
+      }
+      for (int q = 0; q < n[axis]; ++q) {
+        float* out = first + q * step;
+        const double* in = tile.data() + static_cast<std::size_t>(q) * kTile;
+        for (int b = 0; b < count; ++b) out[b] = static_cast<float>(in[b]);
+      }
+    }
+  };
+  for (int k = lo[2]; k < hi[2]; ++k) tiled(1, row, k * slice);
+  for (int j = 0; j < n[1]; ++j) tiled(2, slice, j * row);
 }
 
 }  // namespace
@@ -111,6 +143,26 @@ DistanceField::DistanceField(const VolumeData& data, std::vector<std::uint16_t> 
     reach_[a] = static_cast<int>(std::ceil(band_ / s[a])) + 1;
   }
   rebuild();
+}
+
+DistanceField::DistanceField(const DistanceField& other, const VolumeData& data)
+    : data_(data),
+      labels_(other.labels_),
+      is_member_(other.is_member_),
+      band_(other.band_),
+      reach_(other.reach_),
+      revision_(data.revision()),
+      structure_voxels_(other.structure_voxels_),
+      bounds_(other.bounds_),
+      region_(other.region_),
+      values_(other.values_),
+      mask_(other.mask_) {
+  if (data.shape() != other.data_.shape() ||
+      !data.voxel_size().isApprox(other.data_.voxel_size(), 1e-12)) {
+    throw ArgumentError(
+        "DistanceField: a copy must follow a volume of the same shape and voxel "
+        "size as the original's");
+  }
 }
 
 bool DistanceField::member(int i, int j, int k) const { return is_member_[data_.label(i, j, k)]; }
@@ -153,23 +205,54 @@ std::int64_t DistanceField::recompute(const VoxelBox& wanted) {
   const VoxelBox src = grown_by(out, reach_).clipped(data_.shape());
   const std::array<int, 3> n{src.hi[0] - src.lo[0], src.hi[1] - src.lo[1], src.hi[2] - src.lo[2]};
   const std::size_t total = static_cast<std::size_t>(n[0]) * n[1] * n[2];
-  std::vector<double> outside(total), inside(total);
-  bool any_member = false, any_other = false;
+  const float inf = std::numeric_limits<float>::infinity();
+  // Squared distance to the structure, over src; membership is where it is 0.
+  std::vector<float> outside(total);
+  std::array<int, 3> lo{n[0], n[1], n[2]}, hi{0, 0, 0};  // the members' box, src coordinates
+  std::int64_t members = 0;
   std::size_t idx = 0;
-  for (int k = src.lo[2]; k < src.hi[2]; ++k) {
-    for (int j = src.lo[1]; j < src.hi[1]; ++j) {
-      for (int i = src.lo[0]; i < src.hi[0]; ++i, ++idx) {
-        const bool m = member(i, j, k);
-        any_member |= m;
-        any_other |= !m;
-        outside[idx] = m ? 0.0 : kInf;
-        inside[idx] = m ? kInf : 0.0;
+  for (int k = 0; k < n[2]; ++k) {
+    for (int j = 0; j < n[1]; ++j) {
+      for (int i = 0; i < n[0]; ++i, ++idx) {
+        const bool m = member(src.lo[0] + i, src.lo[1] + j, src.lo[2] + k);
+        outside[idx] = m ? 0.0f : inf;
+        if (!m) continue;
+        ++members;
+        const int c[3] = {i, j, k};
+        for (int a = 0; a < 3; ++a) {
+          lo[a] = std::min(lo[a], c[a]);
+          hi[a] = std::max(hi[a], c[a] + 1);
+        }
       }
     }
   }
   const Eigen::Vector3d spacing = data_.voxel_size();
-  if (any_member) squared_distances(outside, n, spacing);
-  if (any_member && any_other) squared_distances(inside, n, spacing);
+  if (members > 0) squared_distances(outside, n, spacing, lo, hi);
+  // Squared distance to the nearest non-member, needed only at members. The nearest one to a
+  // member is never beyond the members' box grown by one voxel: clamping any non-member's
+  // coordinates to that box gives a voxel no farther away that is also not a member (it is
+  // either the same voxel or outside the members' box). So the transform runs over that box only.
+  std::array<int, 3> in_lo{}, in_n{};
+  std::vector<float> inside;
+  const bool any_other = members < static_cast<std::int64_t>(total);
+  if (members > 0 && any_other) {
+    for (int a = 0; a < 3; ++a) {
+      in_lo[a] = std::max(lo[a] - 1, 0);
+      in_n[a] = std::min(hi[a] + 1, n[a]) - in_lo[a];
+    }
+    inside.resize(static_cast<std::size_t>(in_n[0]) * in_n[1] * in_n[2]);
+    std::size_t t = 0;
+    for (int k = 0; k < in_n[2]; ++k) {
+      for (int j = 0; j < in_n[1]; ++j) {
+        const float* o =
+            outside.data() + in_lo[0] +
+            static_cast<std::size_t>(n[0]) * (static_cast<std::size_t>(in_lo[1] + j) +
+                                              static_cast<std::size_t>(n[1]) * (in_lo[2] + k));
+        for (int i = 0; i < in_n[0]; ++i) inside[t++] = o[i] == 0.0f ? inf : 0.0f;
+      }
+    }
+    squared_distances(inside, in_n, spacing, {0, 0, 0}, in_n);
+  }
 
   const int rn0 = region_.hi[0] - region_.lo[0];
   const int rn1 = region_.hi[1] - region_.lo[1];
@@ -177,18 +260,27 @@ std::int64_t DistanceField::recompute(const VoxelBox& wanted) {
   for (int k = out.lo[2]; k < out.hi[2]; ++k) {
     for (int j = out.lo[1]; j < out.hi[1]; ++j) {
       for (int i = out.lo[0]; i < out.hi[0]; ++i) {
-        const std::size_t s =
-            static_cast<std::size_t>(i - src.lo[0]) +
-            static_cast<std::size_t>(n[0]) * (static_cast<std::size_t>(j - src.lo[1]) +
-                                              static_cast<std::size_t>(n[1]) * (k - src.lo[2]));
+        const int a = i - src.lo[0], b = j - src.lo[1], c = k - src.lo[2];
+        const std::size_t s = static_cast<std::size_t>(a) +
+                              static_cast<std::size_t>(n[0]) * (static_cast<std::size_t>(b) +
+                                                                static_cast<std::size_t>(n[1]) * c);
         const std::size_t r =
             static_cast<std::size_t>(i - region_.lo[0]) +
             static_cast<std::size_t>(rn0) * (static_cast<std::size_t>(j - region_.lo[1]) +
                                              static_cast<std::size_t>(rn1) * (k - region_.lo[2]));
-        const bool m = outside[s] == 0.0;
-        const double d = m ? -std::sqrt(inside[s]) : std::sqrt(outside[s]);
-        values_[r] = static_cast<float>(std::clamp(d, -band_, band_));
-        if (!std::isfinite(d)) values_[r] = m ? -band : band;
+        const bool m = outside[s] == 0.0f;
+        double d = kInf;
+        if (!m) {
+          d = std::sqrt(static_cast<double>(outside[s]));
+        } else if (any_other) {
+          const std::size_t t = static_cast<std::size_t>(a - in_lo[0]) +
+                                static_cast<std::size_t>(in_n[0]) *
+                                    (static_cast<std::size_t>(b - in_lo[1]) +
+                                     static_cast<std::size_t>(in_n[1]) * (c - in_lo[2]));
+          d = -std::sqrt(static_cast<double>(inside[t]));
+        }
+        values_[r] = std::isfinite(d) ? static_cast<float>(std::clamp(d, -band_, band_))
+                                      : (m ? -band : band);
         mask_[r] = m ? 1 : 0;
       }
     }

@@ -43,6 +43,13 @@ class AMBFPLUS_API DistanceField {
   /// positive finite number.
   DistanceField(const VolumeData& data, std::vector<std::uint16_t> labels, double band);
 
+  /// A copy of `other` that follows `data` from now on: data must have other's volume's shape
+  /// and voxel size and hold what that volume held at other.revision(). The copy reflects data's
+  /// current revision; update() then recomputes only around data's later edits (how a field on
+  /// a snapshot is brought up to date on another snapshot without a full build). Throws
+  /// ArgumentError for another shape or voxel size.
+  DistanceField(const DistanceField& other, const VolumeData& data);
+
   /// Brings the field up to the volume's current revision: recomputes the regions whose
   /// structure voxels changed since, and returns the number of voxels recomputed (0 when no
   /// edit touched the structure).

@@ -2034,7 +2034,11 @@ class Drill(Object):
         """
     def clear_plan(self) -> None:
         """
-        removes the plan's fixture
+        removes the plan's fixture (and its attraction, follow_plan)
+        """
+    def follow_plan(self, *, max_force: typing.SupportsFloat | typing.SupportsIndex = 0.5, start: typing.SupportsFloat | typing.SupportsIndex = 0.002, enabled: bool = True) -> None:
+        """
+        follow the plan: draws the burr toward the nearest voxel of the plan not yet removed, max_force x min(1, d / start) N for a burr surface d metres from it, fading to zero between 2 x start and 3 x start, none once touching; part of fixture_force, kept passive. Needs a plan (set_plan); clear_plan ends it
         """
     def set_fixture(self, structure: typing.Any, *, start: typing.SupportsFloat | typing.SupportsIndex, max_force: typing.SupportsFloat | typing.SupportsIndex = 1.0, stop: typing.SupportsFloat | typing.SupportsIndex | None = None, enabled: bool = True) -> None:
         """
@@ -2124,6 +2128,11 @@ class Drill(Object):
     def fixtures(self) -> list:
         """
         the fixtures as dicts (set_fixtures' form), structures by label name
+        """
+    @property
+    def follows_plan(self) -> typing.Any:
+        """
+        the plan's attraction as {max_force, start}, or None when off
         """
     @property
     def force(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:

@@ -658,7 +658,31 @@ void define_drill(py::module_& m) {
               d.clear_plan();
             });
           },
-          "removes the plan's fixture")
+          "removes the plan's fixture (and its attraction, follow_plan)")
+      .def(
+          "follow_plan",
+          [](Drill& d, double max_force, double start, bool enabled) {
+            without_gil([&] {
+              auto lock = d.world().lock_state_for_copy();
+              d.follow_plan(max_force, start, enabled);
+            });
+          },
+          py::kw_only(), py::arg("max_force") = 0.5, py::arg("start") = 0.002,
+          py::arg("enabled") = true,
+          "follow the plan: draws the burr toward the nearest voxel of the plan not yet removed, "
+          "max_force x min(1, d / start) N for a burr surface d metres from it, fading to zero "
+          "between 2 x start and 3 x start, none once touching; part of fixture_force, kept "
+          "passive. Needs a plan (set_plan); clear_plan ends it")
+      .def_property_readonly(
+          "follows_plan",
+          [](Drill& d) -> py::object {
+            if (!d.follows_plan()) return py::none();
+            py::dict e;
+            e["max_force"] = d.follow_max_force();
+            e["start"] = d.follow_start();
+            return e;
+          },
+          "the plan's attraction as {max_force, start}, or None when off")
       .def_property_readonly(
           "plan",
           [](Drill& d) -> py::object {

@@ -6,8 +6,8 @@
 
 #include "ambfplus/errors.h"
 #include "ambfplus/volume/distance_field.h"
+#include "ambfplus/volume/structure_distances.h"
 #include "ambfplus/volume/volume_data.h"
-#include "haptics/structure_distances.h"
 
 namespace ambfplus {
 namespace {

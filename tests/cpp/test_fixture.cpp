@@ -4,8 +4,8 @@
 #include <limits>
 #include <random>
 
+#include "ambfplus/volume/structure_distances.h"
 #include "ambfplus/volume/volume_data.h"
-#include "haptics/structure_distances.h"
 
 namespace ambfplus {
 namespace {

@@ -14,7 +14,7 @@
 #include "ambfplus/scene/volume.h"
 #include "ambfplus/scene/world.h"
 #include "ambfplus/volume/label_table.h"
-#include "haptics/structure_distances.h"
+#include "ambfplus/volume/structure_distances.h"
 #include "util/clock.h"
 
 namespace ambfplus {

@@ -8,7 +8,7 @@
 #include "ambfplus/haptics/drill.h"
 #include "ambfplus/scene/volume.h"
 #include "ambfplus/volume/label_table.h"
-#include "haptics/structure_distances.h"
+#include "ambfplus/volume/structure_distances.h"
 
 namespace ambfplus {
 namespace {
@@ -111,7 +111,27 @@ void Drill::set_plan(const std::vector<std::string>& labels, const FixtureSpec& 
   set_plan(mask, fixture);
 }
 
+void Drill::follow_plan(double max_force, double start, bool enabled) {
+  const std::string who = describe() + ": follow_plan: ";
+  if (!std::isfinite(max_force) || max_force < 0) {
+    throw ArgumentError(who + "max_force must be a finite number of newtons >= 0, got " +
+                        std::to_string(max_force));
+  }
+  if (!std::isfinite(start) || start <= 0) {
+    throw ArgumentError(who + "start must be a positive number of metres, got " +
+                        std::to_string(start));
+  }
+  if (!plan_mask_) throw ArgumentError(who + "there is no plan to follow (set_plan first)");
+  const double largest_burr =
+      *std::max_element(spec_.burr_diameters.begin(), spec_.burr_diameters.end()) / 2;
+  structures_->track(StructureDistances::kPlanTarget,
+                     3 * start + largest_burr + 2 * volume_->data()->voxel_size().norm());
+  follow_ = Follow{enabled, max_force, start};
+  fixtures_changed();
+}
+
 void Drill::clear_plan() {
+  follow_ = Follow{};
   plan_.reset();
   plan_mask_.reset();
   plan_voxels_ = 0;
@@ -237,6 +257,14 @@ Eigen::Vector3d Drill::fixture_push(const Eigen::Vector3d& centre) const {
     const double d = surface_distance(a->label, centre, &away);
     if (d >= a->spec.start) continue;
     f += a->spec.max_force * (1.0 - std::max(d, 0.0) / a->spec.start) * away;
+  }
+  if (follow_.enabled && follow_.max_force > 0) {
+    Eigen::Vector3d away;
+    const double d = surface_distance(StructureDistances::kPlanTarget, centre, &away);
+    const double s = follow_.start;
+    // Rising over [0, s], held to 2 s, falling to zero at 3 s (within the field's band).
+    const double scale = std::clamp(std::min(d / s, 3.0 - d / s), 0.0, 1.0);
+    if (std::isfinite(d)) f -= follow_.max_force * scale * away;
   }
   return f;
 }

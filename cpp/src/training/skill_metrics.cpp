@@ -23,7 +23,10 @@ void check_non_negative(double value, const std::string& what) {
 }  // namespace
 
 SkillMetrics::SkillMetrics(VolumeData& volume, MetricsConfig config)
-    : volume_(volume), config_(std::move(config)), in_target_(65536, false) {
+    : volume_(volume),
+      config_(std::move(config)),
+      in_target_(65536, false),
+      distances_(std::make_unique<StructureDistances>(volume)) {
   check_non_negative(config_.excess_force, "excess_force");
   check_non_negative(config_.stroke_gap, "stroke_gap");
   check_non_negative(config_.turn_angle, "turn_angle");
@@ -49,7 +52,12 @@ SkillMetrics::SkillMetrics(VolumeData& volume, MetricsConfig config)
     }
     check_non_negative(s.margin, "the margin of '" + s.name + "'");
     Watch w;
-    w.field = std::make_unique<DistanceField>(volume_, s.labels, s.margin + config_.field_band);
+    w.band = s.margin + config_.field_band;
+    if (!(w.band > 0.0) || !std::isfinite(w.band)) {
+      throw ArgumentError("SkillMetrics: the field of '" + s.name +
+                          "' needs a positive margin + field_band");
+    }
+    w.key = distances_->track_labels(s.labels, w.band);
     w.metrics.name = s.name;
     w.metrics.margin = s.margin;
     w.metrics.closest = std::numeric_limits<double>::infinity();
@@ -60,7 +68,8 @@ SkillMetrics::SkillMetrics(VolumeData& volume, MetricsConfig config)
 }
 
 double SkillMetrics::clearance(std::size_t s, const Eigen::Vector3d& p, double r) const {
-  return watches_.at(s).field->sample(p).distance - r;
+  const Watch& w = watches_.at(s);
+  return std::min(distances_->distance(w.key, p), w.band) - r;
 }
 
 void SkillMetrics::close(OpenStroke& open, std::vector<Stroke>& strokes) {
@@ -117,6 +126,12 @@ void SkillMetrics::add(const ToolTick& tick) {
     ++(inside ? sum_.removed_in_target : sum_.removed_outside_target);
   }
 
+  // The fields follow the structures' own edits: told this tick's removed voxels (every edit of
+  // the volume since the last tick), they start local updates, taken kFollowTicks later.
+  if (!watches_.empty()) {
+    distances_->removed(-1, tick.removed, tick.removed_labels);
+    distances_->tick(!realtime_);
+  }
   for (std::size_t s = 0; s < watches_.size(); ++s) {
     Watch& w = watches_[s];
     const auto& labels = config_.protect[s].labels;
@@ -124,17 +139,12 @@ void SkillMetrics::add(const ToolTick& tick) {
     for (std::uint16_t label : tick.removed_labels) {
       breached += std::find(labels.begin(), labels.end(), label) != labels.end();
     }
-    // The field follows the structure's own edits; a tick that removed none of its voxels
-    // changed nothing it measures.
     if (breached > 0) {
-      w.field->update();
       if (w.metrics.first_breach_step < 0) {
         w.metrics.first_breach_step = tick.step;
         w.metrics.first_breach_time = tick.time;
       }
       w.metrics.voxels_removed += breached;
-    } else {
-      w.field->skip_to(volume_.revision());
     }
     const double c = clearance(s, tick.tip, tick.burr_radius);
     if (c < w.metrics.closest) {

@@ -154,6 +154,7 @@ class AMBFPLUS_API Drill : public Object {
   /// Whether a real-time loop steps it (the drills system says so before each tick): a tick
   /// then never waits for a structure's rebuilt distance field, taking it once it is ready.
   void set_realtime(bool on) { realtime_ = on; }
+  bool realtime() const { return realtime_; }
   /// The world's rigid bodies changed (one was added or is about to be removed): the cursors'
   /// mesh collider is rebuilt at the next tick (the drills system calls it).
   void bodies_changed() { meshes_stale_ = true; }
@@ -217,6 +218,18 @@ class AMBFPLUS_API Drill : public Object {
   const FixtureSpec* plan() const { return plan_ ? &plan_->spec : nullptr; }
   /// Voxels in the plan.
   std::int64_t plan_voxels() const { return plan_voxels_; }
+  // --- Guidance: follow the plan
+  /// Draws the burr toward the nearest voxel of the plan not yet removed (any labelled voxel in
+  /// the planned region): a force along the direction to it of max_force x min(1, d / start) for
+  /// a burr surface d metres away, falling back to zero over the next `start` beyond 2 x start
+  /// (so it never jumps), and none once the burr touches the target. It follows the drilling as
+  /// the critical structures' fields do, joins the fixtures' force (kept passive likewise) and
+  /// needs a plan (set_plan; ArgumentError without one). `enabled` false keeps the settings off.
+  void follow_plan(double max_force, double start, bool enabled = true);
+  /// Whether the burr is drawn toward the plan, and with what (max_force N, start m).
+  bool follows_plan() const { return follow_.enabled; }
+  double follow_max_force() const { return follow_.max_force; }
+  double follow_start() const { return follow_.start; }
 
   /// The regions' push on the burr centred at p (volume frame; N, volume axes): the sum of
   /// max_force x (1 - d / start) away from each structure nearer than its start, without the
@@ -292,6 +305,12 @@ class AMBFPLUS_API Drill : public Object {
     FixtureSpec spec;
     std::uint16_t label;
   };
+  struct Follow {
+    bool enabled = false;
+    double max_force = 0.0;
+    double start = 0.0;
+  };
+  Follow follow_;  // follow the plan (label kPlanTarget of the structures' fields)
   std::vector<ActiveFixture> fixtures_;
   std::optional<ActiveFixture> plan_;  // label 0: the tissue outside the plan
   std::shared_ptr<const std::vector<std::uint8_t>> plan_mask_;

@@ -10,6 +10,7 @@
 
 #include "ambfplus/export.h"
 #include "ambfplus/volume/distance_field.h"
+#include "ambfplus/volume/structure_distances.h"
 #include "ambfplus/volume/volume_data.h"
 
 namespace ambfplus {
@@ -134,12 +135,18 @@ class AMBFPLUS_API SkillMetrics {
   MetricsSummary summary() const;
   const MetricsConfig& config() const { return config_; }
   /// The distance (metres) from a sphere of radius r at p (volume frame) to structure s's
-  /// surface, from its field as of the last tick: what the contacts are measured with.
+  /// surface, from its field as of the last tick: what the contacts are measured with. Beyond
+  /// the field's band (margin + field_band) it reads as the band.
   double clearance(std::size_t s, const Eigen::Vector3d& p, double r) const;
+  /// In a real-time loop (set by LiveMetrics from its drill) a structure's field brought up to
+  /// date after a breach is taken once ready, never waited for; otherwise (offline, scripted)
+  /// it is taken StructureDistances::kFollowTicks ticks after the breach, deterministically.
+  void set_realtime(bool on) { realtime_ = on; }
 
  private:
   struct Watch {
-    std::unique_ptr<DistanceField> field;
+    int key = 0;  // the structure's key in distances_
+    double band = 0.0;
     StructureMetrics metrics;
     bool inside = false;
     double force_sum = 0.0;
@@ -158,7 +165,11 @@ class AMBFPLUS_API SkillMetrics {
   VolumeData& volume_;
   MetricsConfig config_;
   std::vector<bool> in_target_;  // by label id
+  // The protected structures' fields, following the drilling off the caller's thread (a breach
+  // costs a local update of tens of milliseconds, too long for a haptic tick).
+  std::unique_ptr<StructureDistances> distances_;
   std::vector<Watch> watches_;
+  bool realtime_ = false;
   MetricsSummary sum_;
   std::vector<float> cutting_forces_;
   double cutting_force_sum_ = 0.0;

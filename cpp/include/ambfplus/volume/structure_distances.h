@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 
+#include "ambfplus/export.h"
 #include "ambfplus/volume/distance_field.h"
 #include "ambfplus/volume/volume_data.h"
 
@@ -31,7 +32,7 @@ namespace ambfplus {
 /// work (waiting for it if the machine is slower): answers depend on the tick, never on the
 /// threads' timing, so scripted runs stay deterministic. Until then the old field answers; a cut
 /// only removes voxels, so its distances are then a lower bound, on the safe side for fixtures.
-class StructureDistances {
+class AMBFPLUS_API StructureDistances {
  public:
   explicit StructureDistances(const VolumeData& data) : data_(data) {}
   ~StructureDistances();
@@ -41,16 +42,26 @@ class StructureDistances {
   /// Ticks after an edit of a structure at which its rebuilt field is taken into use.
   static constexpr std::int64_t kFollowTicks = 50;
 
-  /// Tracks a structure with a field of at least `band` metres, built now (a narrower field is
-  /// rebuilt, a wider one kept). Label 0 names the tissue outside the plan (set_plan).
-  void track(std::uint16_t label, double band);
-  /// The planned region: mask[i + nx (j + ny k)] != 0 for voxels in the plan. The structure of
-  /// label 0 is then every labelled voxel outside it; its field is rebuilt at once if tracked.
+  /// The structures that are not a label: every labelled voxel outside the planned region, and
+  /// every labelled voxel inside it (the plan's target not yet removed). Labels are 1..65535.
+  static constexpr int kOutsidePlan = 0;
+  static constexpr int kPlanTarget = -1;
+
+  /// Tracks a structure (a label, kOutsidePlan or kPlanTarget) with a field of at least `band`
+  /// metres, built now (a narrower field is rebuilt, a wider one kept).
+  void track(int label, double band);
+  /// Tracks the structure made of several labels (ids must be non-zero) and returns the key its
+  /// distance is asked with (a key below kPlanTarget; the same labels give the same key).
+  int track_labels(const std::vector<std::uint16_t>& labels, double band);
+  /// The planned region: mask[i + nx (j + ny k)] != 0 for voxels in the plan, which the
+  /// structures kOutsidePlan and kPlanTarget are made of; their fields are rebuilt at once if
+  /// tracked.
   void set_plan(std::shared_ptr<const std::vector<std::uint8_t>> mask);
-  bool tracks(std::uint16_t label) const { return find(label) != nullptr; }
+  bool tracks(int label) const { return find(label) != nullptr; }
 
   /// Tells that the edit(s) from revision `before` to the volume's current one removed voxels of
   /// these labels and nothing else: their structures are rebuilt, the others skip the edits.
+  /// `before` < 0: every edit since the last tick (a caller told of all of them).
   void removed(std::int64_t before, const std::vector<std::array<int, 3>>& voxels,
                const std::vector<std::uint16_t>& labels);
   /// One tick: notices edits made by others (their boxes are scanned), takes rebuilt fields
@@ -62,8 +73,7 @@ class StructureDistances {
   /// Distance (metres) from p (volume frame) to the nearest centre of a voxel of `label`,
   /// negative inside, infinity when none is left; its gradient when asked (zero beyond the
   /// band). The label must be tracked.
-  double distance(std::uint16_t label, const Eigen::Vector3d& p,
-                  Eigen::Vector3d* gradient = nullptr) const;
+  double distance(int label, const Eigen::Vector3d& p, Eigen::Vector3d* gradient = nullptr) const;
   /// Rebuilt fields taken into use so far (for tests).
   std::int64_t rebuilds() const { return rebuilds_; }
   /// Of the successors started so far, those made by a local update (for tests).
@@ -80,7 +90,7 @@ class StructureDistances {
     VoxelBox bounds;         // the structure's voxels in the volume (empty: none)
   };
   struct Entry {
-    std::uint16_t label;
+    int label;
     double band;
     std::shared_ptr<const Field> current;
     std::future<std::shared_ptr<const Field>> next;
@@ -92,13 +102,12 @@ class StructureDistances {
     VoxelBox cut;
     bool whole = false;
   };
-  Entry* find(std::uint16_t label);
-  const Entry* find(std::uint16_t label) const;
+  Entry* find(int label);
+  const Entry* find(int label) const;
   /// The structure's voxels over `bounds` grown by the band, copied; a field is built from it
   /// on another thread.
   std::future<std::shared_ptr<const Field>> rebuild(const Entry& e, const VoxelBox& bounds) const;
-  std::shared_ptr<const Field> build(std::uint16_t label, double band,
-                                     const VoxelBox& bounds) const;
+  std::shared_ptr<const Field> build(int label, double band, const VoxelBox& bounds) const;
   static std::shared_ptr<const Field> finish(std::unique_ptr<VolumeData> snapshot,
                                              std::unique_ptr<DistanceField> field, VoxelBox box,
                                              Eigen::Vector3d offset);
@@ -107,15 +116,18 @@ class StructureDistances {
   std::future<std::shared_ptr<const Field>> follow(const Entry& e) const;
   /// Starts e's successor (a local update or a new build) and clears e's record of changes.
   void start(Entry& e);
-  std::unique_ptr<VolumeData> copy(std::uint16_t label, const VoxelBox& box) const;
+  std::unique_ptr<VolumeData> copy(int label, const VoxelBox& box) const;
   /// Whether voxel (i, j, k), whose label is l, belongs to the structure of `label`.
-  bool member(std::uint16_t label, std::uint16_t l, int i, int j, int k) const {
-    if (label != 0) return l == label;
+  bool member(int label, std::uint16_t l, int i, int j, int k) const {
+    if (label > 0) return l == label;
+    if (l == 0) return false;
+    if (label < kPlanTarget) return sets_[static_cast<std::size_t>(kPlanTarget - 1 - label)][l];
     const auto& n = data_.shape();
-    return l != 0 &&
-           !(*plan_)[static_cast<std::size_t>(i) +
-                     static_cast<std::size_t>(n[0]) *
-                         (static_cast<std::size_t>(j) + static_cast<std::size_t>(n[1]) * k)];
+    const bool planned =
+        (*plan_)[static_cast<std::size_t>(i) +
+                 static_cast<std::size_t>(n[0]) *
+                     (static_cast<std::size_t>(j) + static_cast<std::size_t>(n[1]) * k)] != 0;
+    return label == kPlanTarget ? planned : !planned;
   }
   void notice_edits();
 
@@ -126,6 +138,8 @@ class StructureDistances {
   std::int64_t rebuilds_ = 0;
   std::int64_t local_updates_ = 0;
   std::shared_ptr<const std::vector<std::uint8_t>> plan_;
+  std::vector<std::vector<bool>> sets_;  // by key kPlanTarget - 1 - n: membership by label id
+  std::vector<std::vector<std::uint16_t>> set_labels_;
   std::future<void> retiring_;  // frees a replaced field (megabytes: munmap takes milliseconds)
 };
 

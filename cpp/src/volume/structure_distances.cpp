@@ -1,4 +1,4 @@
-#include "haptics/structure_distances.h"
+#include "ambfplus/volume/structure_distances.h"
 
 #include <chrono>
 
@@ -10,6 +10,7 @@
 #include <limits>
 #include <type_traits>
 
+#include "ambfplus/errors.h"
 #include "volume/grid_access.h"
 
 namespace ambfplus {
@@ -46,22 +47,21 @@ StructureDistances::~StructureDistances() {
   if (retiring_.valid()) retiring_.wait();
 }
 
-StructureDistances::Entry* StructureDistances::find(std::uint16_t label) {
+StructureDistances::Entry* StructureDistances::find(int label) {
   for (Entry& e : entries_) {
     if (e.label == label) return &e;
   }
   return nullptr;
 }
 
-const StructureDistances::Entry* StructureDistances::find(std::uint16_t label) const {
+const StructureDistances::Entry* StructureDistances::find(int label) const {
   for (const Entry& e : entries_) {
     if (e.label == label) return &e;
   }
   return nullptr;
 }
 
-std::unique_ptr<VolumeData> StructureDistances::copy(std::uint16_t label,
-                                                     const VoxelBox& box) const {
+std::unique_ptr<VolumeData> StructureDistances::copy(int label, const VoxelBox& box) const {
   const std::array<int, 3> shape{box.hi[0] - box.lo[0], box.hi[1] - box.lo[1],
                                  box.hi[2] - box.lo[2]};
   const Eigen::Vector3d size =
@@ -82,11 +82,17 @@ std::unique_ptr<VolumeData> StructureDistances::copy(std::uint16_t label,
         const std::size_t start =
             box.lo[0] + static_cast<std::size_t>(n[0]) * (j + static_cast<std::size_t>(n[1]) * k);
         const T* row = grid + start;
-        if (label != 0) {
+        if (label > 0) {
           for (int i = 0; i < width; ++i) out[i] = row[i] == wanted;
-        } else {
+        } else if (label < kPlanTarget) {
+          const std::vector<bool>& in = sets_[static_cast<std::size_t>(kPlanTarget - 1 - label)];
+          for (int i = 0; i < width; ++i) out[i] = in[row[i]];
+        } else if (label == kOutsidePlan) {
           const std::uint8_t* in_plan = plan_->data() + start;
           for (int i = 0; i < width; ++i) out[i] = row[i] != 0 && in_plan[i] == 0;
+        } else {
+          const std::uint8_t* in_plan = plan_->data() + start;
+          for (int i = 0; i < width; ++i) out[i] = row[i] != 0 && in_plan[i] != 0;
         }
         out += width;
       }
@@ -190,14 +196,36 @@ std::future<std::shared_ptr<const StructureDistances::Field>> StructureDistances
 
 void StructureDistances::set_plan(std::shared_ptr<const std::vector<std::uint8_t>> mask) {
   plan_ = std::move(mask);
-  if (Entry* e = find(0)) {
-    const double band = e->band;
-    e->band = 0.0;  // rebuilt now, whatever its band
-    track(0, band);
+  for (int label : {kOutsidePlan, kPlanTarget}) {
+    if (Entry* e = find(label)) {
+      const double band = e->band;
+      e->band = 0.0;  // rebuilt now, whatever its band
+      track(label, band);
+    }
   }
 }
 
-void StructureDistances::track(std::uint16_t label, double band) {
+int StructureDistances::track_labels(const std::vector<std::uint16_t>& labels, double band) {
+  std::vector<std::uint16_t> sorted = labels;
+  std::sort(sorted.begin(), sorted.end());
+  sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
+  if (sorted.empty() || sorted.front() == 0) {
+    throw ArgumentError("StructureDistances: a structure needs labels, none of them 0");
+  }
+  std::size_t n = 0;
+  while (n < set_labels_.size() && set_labels_[n] != sorted) ++n;
+  if (n == set_labels_.size()) {
+    std::vector<bool> in(65536, false);
+    for (std::uint16_t id : sorted) in[id] = true;
+    sets_.push_back(std::move(in));
+    set_labels_.push_back(sorted);
+  }
+  const int key = kPlanTarget - 1 - static_cast<int>(n);
+  track(key, band);
+  return key;
+}
+
+void StructureDistances::track(int label, double band) {
   notice_edits();
   Entry* e = find(label);
   if (e != nullptr && e->band >= band) return;
@@ -288,7 +316,7 @@ void StructureDistances::removed(std::int64_t before, const std::vector<std::arr
       e.cut = e.cut.united(VoxelBox{v, {v[0] + 1, v[1] + 1, v[2] + 1}});
     }
   }
-  if (seen_ == before) seen_ = data_.revision();  // else notice_edits() scans them all
+  if (before < 0 || seen_ == before) seen_ = data_.revision();  // else notice_edits() scans
 }
 
 void StructureDistances::start(Entry& e) {
@@ -325,7 +353,7 @@ void StructureDistances::tick(bool wait) {
   }
 }
 
-double StructureDistances::distance(std::uint16_t label, const Eigen::Vector3d& p,
+double StructureDistances::distance(int label, const Eigen::Vector3d& p,
                                     Eigen::Vector3d* gradient) const {
   const Field& f = *find(label)->current;
   if (f.bounds.empty()) {

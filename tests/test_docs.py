@@ -21,6 +21,9 @@ from pathlib import Path
 import pytest
 from helpers.browser import Browser, chromium_path, skip_or_fail
 
+# Building the site executes the notebooks: minutes on two cores, so not in the fast loop.
+pytestmark = pytest.mark.slow
+
 # The checkout's root: the folder above this file that holds pyproject.toml (tests may be regrouped
 # into subfolders).
 HERE = Path(__file__).resolve()

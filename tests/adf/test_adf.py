@@ -533,6 +533,7 @@ def test_enclosure_when_no_environment(fixtures, tmp_path):
     assert p[0] < 1.0 - 0.05 + 2e-3  # not through the wall
 
 
+@pytest.mark.slow
 def test_drilling_fixture_cameras_ride_on_the_main_camera(fixtures):
     # The original drilling scene: its stereo pair and its headlight are children of a camera,
     # placed in that camera's AMBF frame (x back from the view, y right, z up).

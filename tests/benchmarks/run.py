@@ -410,16 +410,33 @@ def realtime_scene():
     return world, drill, camera, into
 
 
-def realtime_session(seconds: float, drilling: bool, witness=None):
+def guide(world, drill):
+    """Everything guidance and training add to the haptic loop: a forbidden-region fixture on
+    every critical structure (from 1 mm, 0.3 N: the hand's push then still cuts bone, and the
+    fixture of the structure it drills toward holds the burr), the drill's sound played to
+    miniaudio's null device (with a warning beep per critical structure) and live skill metrics
+    protecting every critical structure. Returns what must stay alive (the sound)."""
+    data = world.volumes[0].data
+    critical = [label.id for label in data.label_table if label.critical]
+    drill.set_fixtures([{"structure": i, "start": 0.001, "max_force": 0.3} for i in critical])
+    ambfplus.live_metrics(
+        drill, protect=[{"name": str(i), "labels": [i], "margin": 0.001} for i in critical]
+    )
+    return ambfplus.DrillSound(drill, output="null")
+
+
+def realtime_session(seconds: float, drilling: bool, witness=None, guided: bool = False):
     """A real-time session of the scene driven by a simulated hand, a camera capturing
     continuously in another thread: loop statistics, frames, the input log, and what tells a
     stall of the machine from ours (rt_witness: the loop's steps against CLOCK_MONOTONIC, its
-    thread's counters; a running witness is put out of the loop's phase)."""
+    thread's counters; a running witness is put out of the loop's phase). `guided`: with
+    fixtures, sound and live metrics on (guide())."""
     import threading
 
     from rt_witness import anchored, loop_thread, thread_counters
 
     world, drill, camera, into = realtime_scene()
+    sound = guide(world, drill) if guided else None
     hand = ambfplus.SimulatedDevice()
     binding = world.add_input_device("hand", hand, drill)
     camera.capture()  # uploads and programs before the clock starts
@@ -450,6 +467,8 @@ def realtime_session(seconds: float, drilling: bool, witness=None):
         stop.set()
         thread.join()
         after = thread_counters(tid)
+    if sound is not None:
+        sound.close()
     counters = {k: round(after[k] - before[k], 3) for k in before if k != "timer_slack_ns"}
     counters["timer_slack_ns"] = before.get("timer_slack_ns")
     return world, drill, binding, loop, frames[0], anchors, counters
@@ -465,14 +484,15 @@ def realtime(args) -> Iterator[dict]:
     from rt_witness import Witness, realtime_attribution
 
     seconds = 3.0 if args.quick else 10.0
-    for drilling in (False, True):
+    for drilling, guided in ((False, False), (True, False), (True, True)):
         with Witness() as witness:
             world, drill, binding, loop, frames, anchors, counters = realtime_session(
-                seconds, drilling, witness
+                seconds, drilling, witness, guided
             )
         s = loop.stats
+        name = "realtime_loop_guided" if guided else "realtime_loop_drilling"
         line = {
-            "bench": "realtime_loop_drilling" if drilling else "realtime_loop",
+            "bench": name if drilling else "realtime_loop",
             "value": round(s["p99"] * 1e3, 4),
             "unit": "ms (p99 period)",
             "target": 1.2,
@@ -498,9 +518,12 @@ def realtime(args) -> Iterator[dict]:
             "scheduling": loop.scheduling,
             "seconds": round(s["seconds"], 2),
             "what": "periods of the physics thread while a 640x480 camera captures in a thread"
-            + (", drilling" if drilling else ""),
+            + (", drilling" if drilling else "")
+            + (", fixtures, sound and live metrics on" if guided else ""),
         }
-        if drilling:
+        if guided:
+            line["voxels_removed"] = len(drill.removed["step"])
+        if drilling and not guided:
             removed = drill.removed
             log = binding.take_log()
             replay_world, replay_drill, _, _ = realtime_scene()

@@ -166,6 +166,7 @@ def test_the_live_view_says_when_its_port_is_taken():
             FoxgloveServer(world, [], port=first.port).start()
 
 
+@pytest.mark.slow
 def test_the_launcher_serves_its_session_live(fixtures, tmp_path):
     """ambfplus-launch --foxglove: the original drilling scene, headless, advertises its camera,
     calibration, TF and the drill's channels to a client."""

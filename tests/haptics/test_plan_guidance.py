@@ -69,6 +69,7 @@ def sessions():
     return {plan: [novice_session(seed, plan) for seed in SEEDS] for plan in (False, True)}
 
 
+@pytest.mark.slow
 def test_staying_in_the_plan_removes_far_less_outside_it(sessions):
     outside_without = sum(s[0] for s in sessions[False])
     outside_with = sum(s[0] for s in sessions[True])

@@ -440,6 +440,7 @@ def test_the_depth_experiment_runs_at_small_size(tmp_path):
     ) is False  # fmt: skip
 
 
+@pytest.mark.slow
 def test_the_tracking_experiment_runs_at_small_size(tmp_path):
     example = load_example("tracking_experiment")
     assert example.main([str(tmp_path), "--small"]) == 0

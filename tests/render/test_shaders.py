@@ -216,6 +216,7 @@ def test_legacy_built_ins_carry_material_lights_and_matrices(tmp_path):
         np.testing.assert_allclose(seen, want, atol=1.5 / 255, err_msg=name)
 
 
+@pytest.mark.slow
 def test_fixture_legacy_shaders_run(fixtures):
     """The drilling scene's matcap (model shaders of the drills) and preprocessing shaders
     (segmentation_camera) compile on the compatibility context and draw non-black images."""

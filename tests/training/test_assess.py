@@ -78,6 +78,7 @@ class Plunge:
         return {"position": tuple(p - self.start), "buttons": 1}
 
 
+@pytest.mark.slow
 def test_a_breach_of_the_facial_nerve_is_flagged(tmp_path, sessions):
     task, _ = sessions
     scene = drilling_phantom(resolution=RESOLUTION, width=160, height=120)
@@ -206,6 +207,7 @@ def test_burr_visibility_behind_a_bone_plate(tmp_path):
     assert seen(False) and seen(True)
 
 
+@pytest.mark.slow
 def test_the_command_line_writes_json_and_a_report_chromium_shows(sessions, tmp_path):
     task, paths = sessions
     task_file = tmp_path / "task.yaml"
@@ -235,6 +237,7 @@ def test_the_command_line_writes_json_and_a_report_chromium_shows(sessions, tmp_
     assert ((image[..., 0] > 180) & (image[..., 1] < 80) & (image[..., 2] < 80)).sum() > 50
 
 
+@pytest.mark.slow
 def test_a_cohort_table_and_group_report(sessions, tmp_path):
     task, paths = sessions
     table = tmp_path / "cohort.csv"
@@ -259,6 +262,7 @@ def test_a_cohort_table_and_group_report(sessions, tmp_path):
         assess_cohort(bad, task)
 
 
+@pytest.mark.slow
 def test_every_kind_of_recording_is_assessed(sessions, reference_dataset, tmp_path):
     """A replay (the same removal, so the same metrics), a dataset episode and the demo."""
     from ambfplus.cli.demo import run_demo

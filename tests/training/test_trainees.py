@@ -45,6 +45,7 @@ def sessions():
     }
 
 
+@pytest.mark.slow
 def test_every_session_drills_and_is_measured(sessions):
     for group in sessions.values():
         for summary in group:

@@ -98,3 +98,67 @@ def test_a_plan_from_labels_and_its_errors():
         drill.set_plan(["Marrow"], start=0.001)
     drill.clear_plan()
     assert drill.plan is None
+
+
+def follow_world():
+    """A 20 mm cube at 0.2 mm voxels, bone (label 1) below z = 0, and a plan: the bone's top
+    2 mm over the central 12 mm x 12 mm, so the plan's top voxel centres lie at z = -0.1 mm."""
+    grid = np.zeros((100, 100, 100), np.uint8)
+    grid[:, :, :50] = 1
+    data = ambfplus.VolumeData(
+        grid, voxel_size=(0.0002,) * 3, label_table=[ambfplus.Label(1, "Bone")]
+    )
+    world = ambfplus.World()
+    volume = world.add_volume("bone", data)
+    up = ambfplus.rotation_between((1, 0, 0), (0, 0, 1))
+    drill = world.add_drill(
+        "drill", volume, burr=1, cursors=1, pose=ambfplus.make_pose((0, 0, 0.01), rotation=up)
+    )
+    plan = np.zeros(grid.shape, bool)
+    plan[20:80, 20:80, 40:50] = True
+    return world, drill, volume, plan, up
+
+
+def test_following_the_plan_draws_the_burr_toward_what_is_left_of_it():
+    world, drill, volume, plan, up = follow_world()
+    with pytest.raises(ambfplus.ArgumentError, match="set_plan first"):
+        drill.follow_plan(max_force=0.6, start=0.002)
+    drill.set_plan(plan, start=0.001, max_force=1.0, enabled=False)  # no "stay" force
+    drill.follow_plan(max_force=0.6, start=0.002)
+    assert drill.follows_plan == {"max_force": 0.6, "start": 0.002}
+    radius = drill.burr_radius
+    assert radius == pytest.approx(0.001)
+
+    def force_at(z: float) -> np.ndarray:
+        drill.pose = ambfplus.make_pose((0.0003, -0.0002, z), rotation=up)  # at rest there
+        world.step()
+        return drill.fixture_force
+
+    def expected(d: float) -> float:
+        """The law: rising over [0, s], held to 2 s, falling to 0 at 3 s (s = 2 mm)."""
+        return 0.6 * float(np.clip(min(d / 0.002, 3.0 - d / 0.002), 0.0, 1.0))
+
+    top = -0.0001  # the plan's top voxel centres; the burr's surface distance is measured to
+    # them less half a voxel, as the fixtures' is
+    for z in (0.0015, 0.002, 0.0035, 0.005, 0.0065, 0.008):
+        d = z - top - radius - 0.0001
+        np.testing.assert_allclose(force_at(z), (0, 0, -expected(d)), atol=1e-6, err_msg=z)
+    # Drilled away under the burr: the 1 mm of plan beneath it is gone (an edit of the volume),
+    # and kFollowTicks (50) steps later the burr is drawn toward what is left, 1 mm farther.
+    volume.data.set_region((0, 0, 45), (100, 100, 50), 0)
+    force_at(0.0025)
+    for _ in range(50):
+        world.step()
+    d = 0.0025 - (top - 0.001) - radius - 0.0001
+    np.testing.assert_allclose(force_at(0.0025), (0, 0, -expected(d)), atol=1e-6)
+    assert expected(d) != pytest.approx(expected(d - 0.001))  # the edit changed the force
+    # Off, and gone with the plan.
+    drill.follow_plan(max_force=0.6, start=0.002, enabled=False)
+    assert drill.follows_plan is None
+    assert not force_at(0.0025).any()
+    drill.follow_plan(max_force=0.6, start=0.002)
+    drill.clear_plan()
+    assert drill.follows_plan is None
+    drill.set_plan(plan, start=0.001, enabled=False)
+    with pytest.raises(ambfplus.ArgumentError, match="start must be a positive"):
+        drill.follow_plan(start=0.0)

@@ -157,8 +157,7 @@ void Drill::fixtures_changed() {
   fixture_energy_ = 0.0;  // new regions: the energy observer starts anew
 }
 
-double Drill::surface_distance(int label, const Eigen::Vector3d& p,
-                               Eigen::Vector3d* away) const {
+double Drill::surface_distance(int label, const Eigen::Vector3d& p, Eigen::Vector3d* away) const {
   Eigen::Vector3d g;
   const double d = structures_->distance(label, p, &g) - burr_radius() - half_voxel_;
   if (away != nullptr) {

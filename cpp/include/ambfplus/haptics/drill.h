@@ -279,8 +279,7 @@ class AMBFPLUS_API Drill : public Object {
   void update_critical_distances();
   /// The burr surface's distance to a tracked structure with its centre at p, and the
   /// direction away from it (unit, or zero where the field gives none).
-  double surface_distance(int label, const Eigen::Vector3d& p,
-                          Eigen::Vector3d* away) const;
+  double surface_distance(int label, const Eigen::Vector3d& p, Eigen::Vector3d* away) const;
   /// Where the tip's goal may go (volume frame): from where it was held toward `goal`, stopped
   /// and slid along the surface of every hard stop.
   Eigen::Vector3d held_tip_goal(const Eigen::Vector3d& goal);

@@ -1,6 +1,11 @@
 #include "ambfplus/volume/structure_distances.h"
 
 #include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <functional>
+#include <mutex>
+#include <thread>
 
 #include <pthread.h>
 #include <sched.h>
@@ -40,11 +45,57 @@ bool overlap(const VoxelBox& a, const VoxelBox& b) {
 
 }  // namespace
 
-StructureDistances::~StructureDistances() {
-  for (Entry& e : entries_) {
-    if (e.next.valid()) e.next.wait();
+class StructureDistances::Worker {
+ public:
+  Worker() : thread_([this] { run(); }) {}
+  ~Worker() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    wake_.notify_one();
+    thread_.join();  // after the jobs handed over so far
   }
-  if (retiring_.valid()) retiring_.wait();
+  template <class F>
+  auto submit(F&& job) -> std::future<decltype(job())> {
+    using R = decltype(job());
+    auto task = std::make_shared<std::packaged_task<R()>>(std::forward<F>(job));
+    std::future<R> done = task->get_future();
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      jobs_.emplace_back([task] { (*task)(); });
+    }
+    wake_.notify_one();
+    return done;
+  }
+
+ private:
+  void run() {
+    run_at_normal_priority();
+    for (;;) {
+      std::function<void()> job;
+      {
+        std::unique_lock<std::mutex> lock(mutex_);
+        wake_.wait(lock, [this] { return stop_ || !jobs_.empty(); });
+        if (jobs_.empty()) return;  // stopping, and nothing left
+        job = std::move(jobs_.front());
+        jobs_.pop_front();
+      }
+      job();
+    }
+  }
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::deque<std::function<void()>> jobs_;
+  bool stop_ = false;
+  std::thread thread_;
+};
+
+StructureDistances::StructureDistances(const VolumeData& data)
+    : data_(data), worker_(std::make_unique<Worker>()) {}
+
+StructureDistances::~StructureDistances() {
+  worker_.reset();  // every job handed over has run
 }
 
 StructureDistances::Entry* StructureDistances::find(int label) {
@@ -127,45 +178,73 @@ std::shared_ptr<const StructureDistances::Field> StructureDistances::finish(
   return f;
 }
 
-std::future<std::shared_ptr<const StructureDistances::Field>> StructureDistances::follow(
-    const Entry& e) const {
-  std::shared_ptr<const Field> old = e.current;
+namespace {
+
+// Writes `patch` (the structure's voxels over `box`, snapshot coordinates) into `snapshot`.
+void write_patch(VolumeData& snapshot, const VolumeData& patch, const VoxelBox& box) {
+  const auto& n = snapshot.shape();
+  const auto* in = static_cast<const std::uint8_t*>(patch.label_data());
+  auto* out = static_cast<std::uint8_t*>(snapshot.label_data());
+  const int width = box.hi[0] - box.lo[0];
+  for (int k = box.lo[2]; k < box.hi[2]; ++k) {
+    for (int j = box.lo[1]; j < box.hi[1]; ++j) {
+      std::copy_n(in, width,
+                  out + box.lo[0] +
+                      static_cast<std::size_t>(n[0]) *
+                          (static_cast<std::size_t>(j) + static_cast<std::size_t>(n[1]) * k));
+      in += width;
+    }
+  }
+  snapshot.mark_dirty(box);
+}
+
+}  // namespace
+
+std::future<std::shared_ptr<const StructureDistances::Field>> StructureDistances::follow(Entry& e) {
+  std::shared_ptr<const Field> base = e.current;
+  // The spare (the field current replaced) is brought up to date in place when it has the
+  // same box: over the cut and over where it lags behind current.
+  std::shared_ptr<const Field> spare;
+  VoxelBox cut = e.cut;
+  if (e.spare != nullptr && e.spare->box == base->box) {
+    spare = std::move(e.spare);
+    cut = cut.united(e.spare_lag);
+  } else if (e.spare != nullptr) {
+    worker_->submit([old = std::move(e.spare)]() mutable { old.reset(); });
+  }
+  e.spare = nullptr;
+  e.spare_lag = VoxelBox{};
+  e.next_patch = cut;
   // The structure's voxels over the cut, as they are now, copied here (the other thread never
   // reads the volume), in the snapshot's coordinates.
-  VoxelBox cut = e.cut;
   std::unique_ptr<VolumeData> patch = copy(e.label, cut);
   for (int a = 0; a < 3; ++a) {
-    cut.lo[a] -= old->box.lo[a];
-    cut.hi[a] -= old->box.lo[a];
+    cut.lo[a] -= base->box.lo[a];
+    cut.hi[a] -= base->box.lo[a];
   }
-  return std::async(
-      std::launch::async,
-      [old = std::move(old), patch = std::move(patch), cut]() -> std::shared_ptr<const Field> {
-        run_at_normal_priority();
-        const VolumeData& from = *old->snapshot;
-        auto snapshot = std::make_unique<VolumeData>(from.shape(), from.dimensions(),
-                                                     LabelType::kUInt8, from.label_table());
-        const std::size_t count = static_cast<std::size_t>(from.voxel_count());
-        std::copy_n(static_cast<const std::uint8_t*>(from.label_data()), count,
-                    static_cast<std::uint8_t*>(snapshot->label_data()));
-        auto field = std::make_unique<DistanceField>(*old->field, *snapshot);
-        const auto& n = from.shape();
-        const auto* in = static_cast<const std::uint8_t*>(patch->label_data());
-        auto* out = static_cast<std::uint8_t*>(snapshot->label_data());
-        const int width = cut.hi[0] - cut.lo[0];
-        for (int k = cut.lo[2]; k < cut.hi[2]; ++k) {
-          for (int j = cut.lo[1]; j < cut.hi[1]; ++j) {
-            std::copy_n(in, width,
-                        out + cut.lo[0] +
-                            static_cast<std::size_t>(n[0]) *
-                                (static_cast<std::size_t>(j) + static_cast<std::size_t>(n[1]) * k));
-            in += width;
-          }
-        }
-        snapshot->mark_dirty(cut);
-        field->update();
-        return finish(std::move(snapshot), std::move(field), old->box, old->offset);
-      });
+  if (spare != nullptr) {
+    return worker_->submit([spare = std::move(spare), patch = std::move(patch),
+                            cut]() mutable -> std::shared_ptr<const Field> {
+      // Nothing else holds the spare: the entry gave it up, and only `current` is read.
+      const std::shared_ptr<Field> f = std::const_pointer_cast<Field>(spare);
+      write_patch(*f->snapshot, *patch, cut);
+      f->field->update();
+      return finish(std::move(f->snapshot), std::move(f->field), f->box, f->offset);
+    });
+  }
+  return worker_->submit([base = std::move(base), patch = std::move(patch),
+                          cut]() mutable -> std::shared_ptr<const Field> {
+    const VolumeData& from = *base->snapshot;
+    auto snapshot = std::make_unique<VolumeData>(from.shape(), from.dimensions(), LabelType::kUInt8,
+                                                 from.label_table());
+    const std::size_t count = static_cast<std::size_t>(from.voxel_count());
+    std::copy_n(static_cast<const std::uint8_t*>(from.label_data()), count,
+                static_cast<std::uint8_t*>(snapshot->label_data()));
+    auto field = std::make_unique<DistanceField>(*base->field, *snapshot);
+    write_patch(*snapshot, *patch, cut);
+    field->update();
+    return finish(std::move(snapshot), std::move(field), base->box, base->offset);
+  });
 }
 
 std::future<std::shared_ptr<const StructureDistances::Field>> StructureDistances::rebuild(
@@ -186,9 +265,8 @@ std::future<std::shared_ptr<const StructureDistances::Field>> StructureDistances
   const Eigen::Vector3d offset =
       data_.voxel_center(box.lo[0], box.lo[1], box.lo[2]) - snapshot->voxel_center(0, 0, 0);
   const double band = e.band;
-  return std::async(std::launch::async, [snapshot = std::move(snapshot), box, offset,
-                                         band]() mutable {
-    run_at_normal_priority();
+  return worker_->submit([snapshot = std::move(snapshot), box, offset,
+                          band]() mutable -> std::shared_ptr<const Field> {
     auto field = std::make_unique<DistanceField>(*snapshot, std::vector<std::uint16_t>{1}, band);
     return finish(std::move(snapshot), std::move(field), box, offset);
   });
@@ -252,6 +330,9 @@ void StructureDistances::track(int label, double band) {
       }
     }
   }
+  e->spare = nullptr;
+  e->spare_lag = VoxelBox{};
+  e->next_patch = VoxelBox{};
   e->current = rebuild(*e, any ? bounds : VoxelBox{}).get();
   e->next = {};
   e->changed = false;
@@ -324,6 +405,12 @@ void StructureDistances::start(Entry& e) {
   // Local while the structure stays inside the snapshot's box and the cut is not most of it.
   const bool local = !e.whole && e.grown.empty() && !f.bounds.empty() && !e.cut.empty() &&
                      within(e.cut, f.box) && 4 * e.cut.count() < f.box.count();
+  if (!local) {
+    e.next_patch = VoxelBox{};
+    if (e.spare != nullptr) worker_->submit([old = std::move(e.spare)]() mutable { old.reset(); });
+    e.spare = nullptr;
+    e.spare_lag = VoxelBox{};
+  }
   e.next = local ? follow(e) : rebuild(e, f.bounds.united(e.grown).united(e.cut));
   local_updates_ += local ? 1 : 0;
   e.due = tick_ + kFollowTicks;
@@ -343,11 +430,13 @@ void StructureDistances::tick(bool wait) {
       std::shared_ptr<const Field> old = std::move(e.current);
       e.current = e.next.get();  // waits only if the machine is slower than kFollowTicks
       ++rebuilds_;
-      if (retiring_.valid()) retiring_.wait();
-      retiring_ = std::async(std::launch::async, [old = std::move(old)]() mutable {
-        run_at_normal_priority();
-        old.reset();
-      });
+      if (!e.next_patch.empty() && e.spare == nullptr) {
+        e.spare = std::move(old);  // behind current over the patch just applied
+        e.spare_lag = e.next_patch;
+      } else {
+        worker_->submit([old = std::move(old)]() mutable { old.reset(); });
+      }
+      e.next_patch = VoxelBox{};
     }
     if (!e.next.valid() && e.changed) start(e);
   }

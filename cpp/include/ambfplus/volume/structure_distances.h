@@ -34,7 +34,7 @@ namespace ambfplus {
 /// only removes voxels, so its distances are then a lower bound, on the safe side for fixtures.
 class AMBFPLUS_API StructureDistances {
  public:
-  explicit StructureDistances(const VolumeData& data) : data_(data) {}
+  explicit StructureDistances(const VolumeData& data);
   ~StructureDistances();
   StructureDistances(const StructureDistances&) = delete;
   StructureDistances& operator=(const StructureDistances&) = delete;
@@ -101,6 +101,11 @@ class AMBFPLUS_API StructureDistances {
     // current->box) holding every changed voxel; `whole` when only a new build will do.
     VoxelBox cut;
     bool whole = false;
+    // The field replaced last, kept to be brought up to date in place next time (no megabytes
+    // allocated or freed per update), and where it differs from `current`.
+    std::shared_ptr<const Field> spare;
+    VoxelBox spare_lag;
+    VoxelBox next_patch;  // what `next` applies to its base; empty for a new build
   };
   Entry* find(int label);
   const Entry* find(int label) const;
@@ -113,7 +118,7 @@ class AMBFPLUS_API StructureDistances {
                                              Eigen::Vector3d offset);
   /// The successor of e.current with the structure's voxels over e.cut as they are now: a copy
   /// brought up to date locally, on another thread.
-  std::future<std::shared_ptr<const Field>> follow(const Entry& e) const;
+  std::future<std::shared_ptr<const Field>> follow(Entry& e);
   /// Starts e's successor (a local update or a new build) and clears e's record of changes.
   void start(Entry& e);
   std::unique_ptr<VolumeData> copy(int label, const VoxelBox& box) const;
@@ -140,7 +145,11 @@ class AMBFPLUS_API StructureDistances {
   std::shared_ptr<const std::vector<std::uint8_t>> plan_;
   std::vector<std::vector<bool>> sets_;  // by key kPlanTarget - 1 - n: membership by label id
   std::vector<std::vector<std::uint16_t>> set_labels_;
-  std::future<void> retiring_;  // frees a replaced field (megabytes: munmap takes milliseconds)
+  // One background thread at normal priority runs the builds, the local updates and the freeing
+  // of replaced fields (megabytes: munmap takes milliseconds), in order. A tick only hands it
+  // work: it never creates a thread (which maps a stack) nor frees a field itself.
+  class Worker;
+  std::unique_ptr<Worker> worker_;
 };
 
 }  // namespace ambfplus

@@ -54,7 +54,9 @@ def launcher_image(work: Path) -> None:
         volumes: [VOLUME ear]
         VOLUME ear:
           name: ear
-          location: {{position: {{x: 0.0, y: 0.0, z: 0.0}}, orientation: {{r: 0.0, p: 0.0, y: 0.0}}}}
+          location:
+            position: {{x: 0.0, y: 0.0, z: 0.0}}
+            orientation: {{r: 0.0, p: 0.0, y: 0.0}}
           dimensions: {{x: {size[0]}, y: {size[1]}, z: {size[2]}}}
           images: {{path: ear/, prefix: plane, format: png, count: {data.shape[2]}}}
           labels: ear/labels.csv
@@ -63,7 +65,9 @@ def launcher_image(work: Path) -> None:
           name: burr
           volume: VOLUME ear
           burr: 2
-          location: {{position: {{x: 0.0, y: 0.0, z: 0.03}}, orientation: {{r: 0.0, p: -1.5708, y: 0.0}}}}
+          location:
+            position: {{x: 0.0, y: 0.0, z: 0.03}}
+            orientation: {{r: 0.0, p: -1.5708, y: 0.0}}
         """)
     )
     (work / "world.yaml").write_text(

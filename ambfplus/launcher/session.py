@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Any
 
 from .._core import KeyboardDevice, RealTimeLoop, Simulator, __version__
 from .inputs import make_device
-from .status import WARN_DISTANCE, Status
+from .status import WARN_DISTANCE, Status, level_of
 
 if TYPE_CHECKING:
     from ..export.live import FoxgloveServer
@@ -287,7 +287,19 @@ class LaunchSession:
         status.task = self.task.name
         status.elapsed_s = summary["total_time"]
         status.force_n = float(np.linalg.norm(self.drill.force))
-        near = [c for c in self.metrics.clearances() if c["distance"] is not None]
+        clearances = self.metrics.clearances()
+        status.structures = [
+            {
+                "name": c["name"],
+                "mm": None if c["distance"] is None else round(c["distance"] * 1000, 2),
+                "margin_mm": c["margin"] * 1000,
+                "level": "clear"
+                if c["distance"] is None
+                else level_of(c["distance"] * 1000, c["margin"] * 1000),
+            }
+            for c in clearances
+        ]
+        near = [c for c in clearances if c["distance"] is not None]
         if near:
             c = min(near, key=lambda c: c["distance"] - c["margin"])
             status.nearest, status.nearest_mm = c["name"], c["distance"] * 1000

@@ -11,6 +11,14 @@ import numpy as np
 WARN_DISTANCE = 0.002
 
 
+def level_of(distance_mm: float, margin_mm: float) -> str:
+    """A protected structure's warning level: "clear", "near" (within twice its margin) or
+    "inside" its margin."""
+    if not math.isfinite(distance_mm) or distance_mm > 2 * margin_mm:
+        return "clear"
+    return "inside" if distance_mm <= margin_mm else "near"
+
+
 @dataclass
 class Status:
     """What the status line shows, kept up to date by the session."""
@@ -36,16 +44,15 @@ class Status:
     nearest_mm: float = math.inf
     nearest_margin_mm: float = 0.0
     violations: int = 0
+    # Every protected structure: {"name", "mm" (None when gone), "margin_mm", "level"}.
+    structures: list = field(default_factory=list)
     fixtures: str = ""  # "on", "off" (Ctrl+G) or "" (none)
     sound: str = ""  # "on", "muted" (Ctrl+M) or "" (no sound)
 
     @property
     def level(self) -> str:
-        """The nearest protected structure: "clear", "near" (within twice its margin) or
-        "inside" its margin."""
-        if not math.isfinite(self.nearest_mm) or self.nearest_mm > 2 * self.nearest_margin_mm:
-            return "clear"
-        return "inside" if self.nearest_mm <= self.nearest_margin_mm else "near"
+        """The nearest protected structure's level (level_of)."""
+        return level_of(self.nearest_mm, self.nearest_margin_mm)
 
     def task_line(self) -> str:
         if not self.task:
@@ -96,6 +103,18 @@ def draw_overlay(status: Status, width: int, height: int) -> np.ndarray:
             filled = min(status.force_n, 10.0) * width_n
             draw.rectangle((10, y, 10 + filled, y + 8), fill=colour)
             y += 16
+            # Each protected structure in its own level's colour.
+            x: float = 10
+            for s in status.structures:
+                mm = "gone" if s["mm"] is None else f"{s['mm']:.1f} mm"
+                text = f"{s['name']} {mm}"
+                box = draw.textbbox((x, y), text, font=font)
+                draw.rectangle((box[0] - 4, box[1] - 3, box[2] + 4, box[3] + 3),
+                               fill=(0, 0, 0, 140))  # fmt: skip
+                draw.text((x, y), text, font=font, fill=colours[s["level"]])
+                x = box[2] + 16
+            if status.structures:
+                y = box[3] + 8
     if status.warning:
         big = _font(28)
         box = draw.textbbox((0, 0), status.warning, font=big)

@@ -154,6 +154,11 @@ def test_a_task_session_shows_its_metrics_and_they_equal_the_offline_assessment(
     assert status["task"] == "Ear drilling" and status["elapsed_s"] > 1, output
     assert status["nearest"] in ("Facial_Nerve", "Sinus_+_Dura")
     assert status["fixtures"] == "on" and status["sound"] == "on", output
+    # Every protected structure, each with its own level.
+    assert [s["name"] for s in status["structures"]] == ["Facial_Nerve", "Sinus_+_Dura"]
+    for s in status["structures"]:
+        assert s["level"] == ("clear" if s["mm"] > 2 * s["margin_mm"] else
+                              "inside" if s["mm"] <= s["margin_mm"] else "near"), s  # fmt: skip
     # The task line is drawn in its level's colour (green, amber or red) over the view.
     # (The screenshot comes before the status file's last write: the level may have changed.)
     band = shot[top : top + 80, left : left + WIDTH].astype(int)
@@ -184,3 +189,29 @@ def assert_same(live, offline, path="metrics"):
         assert live == pytest.approx(offline, rel=1e-9, abs=1e-12), path
     else:
         assert live == offline, path
+
+
+def test_the_overlay_shows_each_protected_structure_in_its_own_level():
+    """The task's overlay draws every protected structure in its level's colour (green, amber,
+    red): three structures clear, near and inside their margins give all three colours."""
+    from ambfplus.launcher.status import Status, draw_overlay, level_of
+
+    assert [level_of(5.0, 1.0), level_of(1.5, 1.0), level_of(0.5, 1.0)] == [
+        "clear", "near", "inside"
+    ]  # fmt: skip
+    levels = {"clear": (120, 230, 120), "near": (255, 200, 60), "inside": (255, 90, 90)}
+
+    def counts(structures):
+        status = Status(task="T", nearest="a", nearest_mm=9.0, nearest_margin_mm=1.0,
+                        structures=structures)  # fmt: skip
+        image = draw_overlay(status, 640, 200)[..., :3].astype(int)
+        return {k: int((np.abs(image - c).max(axis=2) < 30).sum()) for k, c in levels.items()}
+
+    one = [{"name": "a", "mm": 9.0, "margin_mm": 1.0, "level": "clear"}]
+    three = one + [
+        {"name": "b", "mm": 1.5, "margin_mm": 1.0, "level": "near"},
+        {"name": "c", "mm": 0.5, "margin_mm": 1.0, "level": "inside"},
+    ]
+    before, after = counts(one), counts(three)
+    assert before["near"] == 0 and before["inside"] == 0, before
+    assert after["near"] > 30 and after["inside"] > 30, after

@@ -21,6 +21,7 @@ import numpy as np
 
 from .._core import render_drill_sound
 from ..fileio import write_bytes
+from ..recording.ticks import drill_columns, removed_ticks, tick_seconds
 
 __all__ = ["drill_ticks", "render_session", "render_wav", "write_wav"]
 
@@ -36,30 +37,19 @@ def drill_ticks(
     ``removal_rate`` (m^3/s), ``hardness`` and ``tick_seconds``, from a step log and its removed
     voxels. `voxel_size` (metres, 3 values) sizes a voxel; `hardness` maps label ids to the
     tissue's hardness relative to bone (1 for labels it leaves out)."""
-    try:
-        on = np.asarray(steps[f"{drill}.on"], dtype=float).reshape(-1) > 0.5
-        force = np.asarray(steps[f"{drill}.force"], dtype=float).reshape(-1, 3)
-    except KeyError as missing:
-        raise ValueError(
-            f"the step log has no column {missing} of drill '{drill}' (columns: "
-            f"{', '.join(sorted(steps))})"
-        ) from None
+    c = drill_columns(steps, drill, ["on", "force"])
+    on: np.ndarray = c["on"].astype(float).reshape(-1) > 0.5
+    force: np.ndarray = c["force"].astype(float).reshape(-1, 3)
     n = len(on)
     speed_column = steps.get(f"{drill}.speed")
     speed = np.ones(n) if speed_column is None else np.asarray(speed_column, float).reshape(-1)
     step = np.asarray(steps["step"], dtype=np.int64).reshape(-1)
-    times = np.asarray(steps["time"], dtype=float).reshape(-1)
-    dt = float(np.median(np.diff(times))) if n > 1 else 0.001
+    dt = tick_seconds(steps["time"])
     size = np.asarray(voxel_size, dtype=float).reshape(3)
     voxel_volume = float(size[0] * size[1] * size[2])
 
-    removed_step = np.asarray(removed["step"], dtype=np.int64).reshape(-1)
     labels = np.asarray(removed["label"], dtype=np.int64).reshape(-1)
-    index = np.searchsorted(step, removed_step)
-    if len(removed_step) and (
-        index.max() >= n or not np.array_equal(step[np.minimum(index, n - 1)], removed_step)
-    ):
-        raise ValueError("removed voxels name steps that the step log does not hold")
+    index = removed_ticks(step, removed["step"])
     count = np.bincount(index, minlength=n).astype(float)
     table = np.ones(int(labels.max(initial=0)) + 1)
     for label, value in (hardness or {}).items():

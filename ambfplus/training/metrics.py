@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._core import SkillMetrics, VolumeData
+from ..recording.ticks import drill_columns, removed_ticks, tick_seconds
 
 
 @dataclass(frozen=True)
@@ -39,16 +40,11 @@ def drill_ticks(
     """The arguments of ``SkillMetrics.add_ticks`` for drill `drill` from a step log and its
     removed voxels, with the burr centre in the frame of the volume at `volume_pose` (4x4
     world-from-volume)."""
-    try:
-        pose = np.asarray(steps[f"{drill}.pose"], dtype=float).reshape(-1, 4, 4)
-        force = np.asarray(steps[f"{drill}.force"], dtype=float).reshape(-1, 3)
-        on = np.asarray(steps[f"{drill}.on"]).reshape(-1) > 0.5
-        burr = np.asarray(steps[f"{drill}.burr"]).reshape(-1).astype(np.int64)
-    except KeyError as missing:
-        raise ValueError(
-            f"the step log has no column {missing} of drill '{drill}' (columns: "
-            f"{', '.join(sorted(steps))})"
-        ) from None
+    c = drill_columns(steps, drill, ["pose", "force", "on", "burr"])
+    pose: np.ndarray = c["pose"].astype(float).reshape(-1, 4, 4)
+    force: np.ndarray = c["force"].astype(float).reshape(-1, 3)
+    on: np.ndarray = c["on"].reshape(-1) > 0.5
+    burr: np.ndarray = c["burr"].reshape(-1).astype(np.int64)
     diameters = np.asarray(burr_diameters, dtype=float)
     if len(burr) and (burr.min() < 0 or burr.max() >= len(diameters)):
         raise ValueError(
@@ -59,13 +55,8 @@ def drill_ticks(
     tips = pose[:, :3, 3] @ volume_from_world[:3, :3].T + volume_from_world[:3, 3]
     step = np.asarray(steps["step"], dtype=np.int64)
     times = np.asarray(steps["time"], dtype=float)
-    dt = float(np.median(np.diff(times))) if len(times) > 1 else 0.001
-    removed_step = np.asarray(removed["step"], dtype=np.int64)
-    index = np.searchsorted(step, removed_step)
-    if len(removed_step) and (
-        index.max() >= len(step) or not np.array_equal(step[index], removed_step)
-    ):
-        raise ValueError("removed voxels name steps that the step log does not hold")
+    dt = tick_seconds(times)
+    index = removed_ticks(step, removed["step"])
     return {
         "steps": step,
         "times": times,

@@ -19,6 +19,9 @@ def legend(world: World) -> dict[int, dict]:
         color = getattr(o, "color", None)
         if color is not None:
             entry["color"] = tuple(int(round(255 * c)) for c in list(color)[:3])
+        if o.kind == "drill":
+            # The structures of the step log's `critical_distance` column, in its order.
+            entry["critical"] = list(o.critical_distances)
         if o.kind == "volume":
             entry["labels"] = {
                 label.id: {"name": label.name, "color": tuple(label.color)}

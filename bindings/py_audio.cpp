@@ -360,6 +360,7 @@ void define_audio(py::module_& m) {
         return false;
       });
 
+  m.attr("DRILL_SOUND_MAX_WARNINGS") = audio::kMaxWarnings;
   m.def("render_drill_sound", &render, py::arg("on"), py::arg("load") = py::none(),
         py::arg("removal_rate") = py::none(), py::kw_only(), py::arg("speed") = py::none(),
         py::arg("hardness") = py::none(), py::arg("distances") = py::none(),

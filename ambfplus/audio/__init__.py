@@ -19,11 +19,15 @@ from pathlib import Path
 
 import numpy as np
 
-from .._core import render_drill_sound
+from .._core import DRILL_SOUND_MAX_WARNINGS, render_drill_sound
 from ..fileio import write_bytes
 from ..recording.ticks import drill_columns, removed_ticks, tick_seconds
 
 __all__ = ["drill_ticks", "render_session", "render_wav", "write_wav"]
+
+
+# Where a DrillSound's default proximity beep starts (metres from a critical structure).
+DEFAULT_WARNING_START = 0.001
 
 
 def drill_ticks(
@@ -124,7 +128,10 @@ def render_wav(
 ) -> Path:
     """Renders the drill sound of a recording (a path or an open ``Recording``) to a WAV file.
     `drill` names the drill (default: the recording's only drill); its volume's voxel size
-    comes from the legend (the volume its removed voxels belong to)."""
+    comes from the legend (the volume its removed voxels belong to). Without `warnings` and
+    `distances`, the proximity beeps are those a ``DrillSound`` plays by default (each critical
+    structure from 1 mm), from the step log's ``<drill>.critical_distance`` column where the
+    recording has it."""
     from ..recording import open_recording
 
     rec = recording if hasattr(recording, "steps") else open_recording(recording)
@@ -139,6 +146,18 @@ def render_wav(
     )
     if volume is None or "voxel_size" not in legend.get(volume, {}):
         raise ValueError(f"{rec.path}: no volume with a voxel size in the legend")
+    if warnings is None and distances is None:
+        column = rec.steps.get(f"{drill}.critical_distance")
+        names = legend.get(drill, {}).get("critical")
+        if (
+            column is not None
+            and names
+            and np.asarray(column).reshape(len(column), -1).shape[1] == len(names)
+        ):
+            # As a DrillSound's default: the first DRILL_SOUND_MAX_WARNINGS critical labels.
+            kept = names[:DRILL_SOUND_MAX_WARNINGS]
+            warnings = {name: DEFAULT_WARNING_START for name in kept}
+            distances = np.asarray(column, dtype=float).reshape(len(column), -1)[:, : len(kept)]
     samples = render_session(
         rec.steps,
         rec.removed,

@@ -337,3 +337,47 @@ def test_no_device_says_so_once_and_carries_on_silent(caplog):
     second.close()
     with pytest.raises(ambfplus.ResourceError, match="no audio output device"):
         DrillSound(drill, require_device=True)
+
+
+def test_a_recording_replays_the_proximity_warnings(tmp_path):
+    """The step log's <drill>.critical_distance column and the legend's list of the drill's
+    critical structures let render_wav play the beeps a DrillSound plays by default (each
+    critical structure from 1 mm): a plunge toward a nerve beeps in the replay."""
+    grid = np.zeros((100, 100, 100), np.uint8)
+    grid[:, :, :50] = 1
+    grid[45:55, 45:55, 30:40] = 2
+    table = [ambfplus.Label(1, "Bone"), ambfplus.Label(2, "Nerve", critical=True)]
+    world = ambfplus.World()
+    volume = world.add_volume("slab", ambfplus.VolumeData(grid, voxel_size=(0.0002,) * 3,
+                                                          label_table=table))  # fmt: skip
+    up = ambfplus.rotation_between((1, 0, 0), (0, 0, 1))
+    drill = world.add_drill("drill", volume, burr=1, cutting_rate=2e-6, stiffness=2000.0,
+                            pose=ambfplus.make_pose((0, 0, 0.008), rotation=up))  # fmt: skip
+    r = drill.burr_radius
+    drill.set_waypoints([
+        {"time": 0.0, "pose": ambfplus.make_pose((0, 0, 0.008), rotation=up), "on": True},
+        {"time": 1.0, "pose": ambfplus.make_pose((0, 0, r - 0.0035), rotation=up), "on": True},
+    ])  # fmt: skip
+    world.start_step_log([drill])
+    world.step(1200)
+    steps, removed = world.take_step_log(), drill.take_removed()
+    column = np.asarray(steps["drill.critical_distance"]).reshape(len(steps["step"]), -1)
+    assert column.shape[1] == 1
+    assert column[-1, 0] == pytest.approx(drill.critical_distances["Nerve"], abs=1e-12)
+    assert column[:, 0].min() < 0.0005, "the burr came within the beep's range"
+    legend = {str(k): v for k, v in ambfplus.labels.legend(world).items()}
+    assert legend[str(drill.id)]["critical"] == ["Nerve"]
+    legend[str(volume.id)]["voxel_size"] = [0.0002] * 3
+    path = tmp_path / "plunge.h5"
+    with Recorder(path) as recorder:
+        recorder.set_legend(legend)
+        recorder.add_steps(steps)
+        recorder.add_removed(removed, volume=volume.name)
+    with wave.open(str(render_wav(path, tmp_path / "plunge.wav"))) as w:
+        pcm = np.frombuffer(w.readframes(w.getnframes()), "<i2") / 32767
+    size = (0.0002,) * 3
+    beeping = render_session(steps, removed, "drill", size, warnings={"Nerve": 0.001},
+                             distances=column)  # fmt: skip
+    silent = render_session(steps, removed, "drill", size, warnings={})
+    assert np.abs(pcm - beeping).max() < 1 / 32767
+    assert np.abs(pcm - silent).max() > 0.05, "the replay beeps"

@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <limits>
 #include <vector>
 
 #include "ambfplus/haptics/drill.h"
@@ -126,6 +127,19 @@ class DrillSystem : public System {
     columns.add("leading", 1, [](const Object& o, std::vector<double>& out) {
       out.push_back(as_drill(o).leading_cursor());
     });
+    // Metres from the burr's surface to each critical structure (critical_labels() order), so
+    // that a recording replays the proximity warnings.
+    const std::size_t critical = as_drill(object).critical_labels().size();
+    if (critical > 0) {
+      columns.add(
+          "critical_distance", static_cast<int>(critical),
+          [critical](const Object& o, std::vector<double>& out) {
+            const auto& d = as_drill(o).critical_distances();
+            for (std::size_t i = 0; i < critical; ++i) {
+              out.push_back(i < d.size() ? d[i].second : std::numeric_limits<double>::infinity());
+            }
+          });
+    }
   }
 
   void run(StepStage, const StepContext& context) override {

@@ -180,6 +180,9 @@ class AMBFPLUS_API Drill : public Object {
   /// distance to the box around the structure, at least kExactReach). A field is rebuilt on
   /// another thread after a cut into its structure and taken into use 50 ticks later (the same
   /// tick in every run); until then it answers for the structure before the cut, a lower bound.
+  /// The volume's critical labels, in the order critical_distances() and the step log's
+  /// `critical_distance` column give them (fixed when the drill is made).
+  const std::vector<std::uint16_t>& critical_labels() const { return critical_labels_; }
   const std::vector<std::pair<std::uint16_t, double>>& critical_distances() const {
     return critical_distances_;
   }

@@ -4,8 +4,12 @@ report that reads the same distance fields."""
 
 from __future__ import annotations
 
+import gc
 import math
+import os
+import signal
 import textwrap
+import time
 
 import numpy as np
 import pytest
@@ -356,3 +360,38 @@ def test_critical_distances_follow_the_drilling():
     drill.goal = ambfplus.make_pose((0, 0, 0.004), rotation=UP)  # lifted out of the hole
     world.step(5)
     assert drill.critical_distances["Nerve"] == pytest.approx(brute_force(), abs=VOXEL / 10)
+
+
+def test_a_forked_child_follows_its_cuts_and_exits():
+    """A process forked after its drill's fields were built (a DataLoader's or a pool's worker)
+    drills a structure, waits for its fields' updates and exits: the background worker of the
+    parent does not run in the child, which must neither wait for it nor join it."""
+    world, drill = nerve_world(bone=True, wide=False, cutting_rate=2e-6, stiffness=2000.0)
+    r = drill.burr_radius
+    pid = os.fork()
+    if pid == 0:  # the child: only os._exit, never pytest's teardown
+        code = 1
+        try:
+            drill.set_waypoints([
+                {"time": 0.0, "pose": ambfplus.make_pose((0, 0, 0.008), rotation=UP), "on": True},
+                {"time": 1.0, "pose": ambfplus.make_pose((0, 0, r - 0.0051), rotation=UP),
+                 "on": True},
+            ])  # fmt: skip
+            world.step(1300)
+            labels = drill.removed["label"]
+            code = 0 if (labels == 2).sum() > 0 and drill.critical_distances["Nerve"] == 0 else 2
+            del drill, world
+            gc.collect()
+        finally:
+            os._exit(code)
+    deadline = time.monotonic() + 120
+    while True:
+        done, status = os.waitpid(pid, os.WNOHANG)
+        if done:
+            break
+        if time.monotonic() > deadline:
+            os.kill(pid, signal.SIGKILL)
+            os.waitpid(pid, 0)
+            pytest.fail("the forked child hung")
+        time.sleep(0.05)
+    assert os.WIFEXITED(status) and os.WEXITSTATUS(status) == 0, status

@@ -9,6 +9,7 @@
 
 #include <pthread.h>
 #include <sched.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -47,7 +48,10 @@ bool overlap(const VoxelBox& a, const VoxelBox& b) {
 
 class StructureDistances::Worker {
  public:
-  Worker() : thread_([this] { run(); }) {}
+  Worker() : pid_(getpid()), thread_([this] { run(); }) {}
+  /// In a forked child the thread is the parent's and does not run here: the worker must then
+  /// be neither joined nor destroyed (its condition variable counts the parent's waiter).
+  bool forked() const { return getpid() != pid_; }
   ~Worker() {
     {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -61,6 +65,13 @@ class StructureDistances::Worker {
     using R = decltype(job());
     auto task = std::make_shared<std::packaged_task<R()>>(std::forward<F>(job));
     std::future<R> done = task->get_future();
+    if (forked()) {  // a forked child: a thread of its own for the job
+      std::thread([task] {
+        run_at_normal_priority();
+        (*task)();
+      }).detach();
+      return done;
+    }
     {
       std::lock_guard<std::mutex> lock(mutex_);
       jobs_.emplace_back([task] { (*task)(); });
@@ -88,6 +99,7 @@ class StructureDistances::Worker {
   std::condition_variable wake_;
   std::deque<std::function<void()>> jobs_;
   bool stop_ = false;
+  pid_t pid_;
   std::thread thread_;
 };
 
@@ -95,6 +107,10 @@ StructureDistances::StructureDistances(const VolumeData& data)
     : data_(data), worker_(std::make_unique<Worker>()) {}
 
 StructureDistances::~StructureDistances() {
+  if (worker_->forked()) {
+    worker_.release();  // NOLINT: the parent's thread and state, left alone in a forked child
+    return;
+  }
   worker_.reset();  // every job handed over has run
 }
 

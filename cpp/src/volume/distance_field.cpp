@@ -379,11 +379,36 @@ DistanceSample DistanceField::sample(const Eigen::Vector3d& p) const {
     t[a] = n[a] > 1 ? c - lo[a] : 0.0;
   }
   double v[2][2][2];
-  for (int dk = 0; dk < 2; ++dk) {
-    for (int dj = 0; dj < 2; ++dj) {
-      for (int di = 0; di < 2; ++di) {
-        v[dk][dj][di] = stored(std::min(lo[0] + di, n[0] - 1), std::min(lo[1] + dj, n[1] - 1),
-                               std::min(lo[2] + dk, n[2] - 1));
+  const int rn0 = region_.hi[0] - region_.lo[0];
+  const int rn1 = region_.hi[1] - region_.lo[1];
+  const bool inside = n[0] > 1 && n[1] > 1 && n[2] > 1 && lo[0] >= region_.lo[0] &&
+                      lo[1] >= region_.lo[1] && lo[2] >= region_.lo[2] &&
+                      lo[0] + 1 < region_.hi[0] && lo[1] + 1 < region_.hi[1] &&
+                      lo[2] + 1 < region_.hi[2];
+  if (inside) {
+    // The common case, the eight corners stored: one index, fixed strides (as stored() reads).
+    const std::size_t sj = static_cast<std::size_t>(rn0);
+    const std::size_t sk = sj * static_cast<std::size_t>(rn1);
+    const float* base = values_.data() + static_cast<std::size_t>(lo[0] - region_.lo[0]) +
+                        sj * static_cast<std::size_t>(lo[1] - region_.lo[1]) +
+                        sk * static_cast<std::size_t>(lo[2] - region_.lo[2]);
+    const float band = static_cast<float>(band_);
+    for (int dk = 0; dk < 2; ++dk) {
+      for (int dj = 0; dj < 2; ++dj) {
+        const float* row = base + dk * sk + dj * sj;
+        for (int di = 0; di < 2; ++di) {
+          const float f = row[di];
+          v[dk][dj][di] = f >= band ? band_ : f <= -band ? -band_ : f;
+        }
+      }
+    }
+  } else {
+    for (int dk = 0; dk < 2; ++dk) {
+      for (int dj = 0; dj < 2; ++dj) {
+        for (int di = 0; di < 2; ++di) {
+          v[dk][dj][di] = stored(std::min(lo[0] + di, n[0] - 1), std::min(lo[1] + dj, n[1] - 1),
+                                 std::min(lo[2] + dk, n[2] - 1));
+        }
       }
     }
   }

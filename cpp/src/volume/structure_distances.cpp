@@ -324,8 +324,10 @@ void StructureDistances::track(int label, double band) {
   Entry* e = find(label);
   if (e != nullptr && e->band >= band) return;
   if (e == nullptr) {
-    entries_.push_back(Entry{label, band, nullptr, {}, 0, false, VoxelBox{}, VoxelBox{}, false});
+    entries_.emplace_back();
     e = &entries_.back();
+    e->label = label;
+    e->band = band;
   }
   if (e->next.valid()) e->next.wait();
   e->band = band;
@@ -465,14 +467,21 @@ double StructureDistances::distance(int label, const Eigen::Vector3d& p,
     if (gradient != nullptr) gradient->setZero();
     return std::numeric_limits<double>::infinity();
   }
-  const DistanceSample s = f.field->sample(p - f.offset);
   const double band = f.field->band();
+  const Eigen::Vector3d gap = (f.lo - p).cwiseMax(p - f.hi).cwiseMax(0.0);
+  // Two voxel diagonals beyond the band from the structure's box, every corner the sample
+  // would read holds the band: the answer is the same without reading them.
+  const double far = band + 2 * data_.voxel_size().norm();
+  if (gap.squaredNorm() >= far * far) {
+    if (gradient != nullptr) gradient->setZero();
+    return gap.norm();
+  }
+  const DistanceSample s = f.field->sample(p - f.offset);
   if (s.distance < band) {
     if (gradient != nullptr) *gradient = s.gradient;
     return s.distance;
   }
   if (gradient != nullptr) gradient->setZero();
-  const Eigen::Vector3d gap = (f.lo - p).cwiseMax(p - f.hi).cwiseMax(0.0);
   return std::max(band, gap.norm());
 }
 

@@ -90,8 +90,8 @@ class AMBFPLUS_API StructureDistances {
     VoxelBox bounds;         // the structure's voxels in the volume (empty: none)
   };
   struct Entry {
-    int label;
-    double band;
+    int label = 0;
+    double band = 0;
     std::shared_ptr<const Field> current;
     std::future<std::shared_ptr<const Field>> next;
     std::int64_t due = 0;  // the tick at which `next` is taken

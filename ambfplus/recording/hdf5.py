@@ -120,10 +120,10 @@ def read_attributes(checked: CheckedFile, obj) -> dict:
     return {name: read_attribute(checked, obj, name) for name in obj.attrs.keys()}
 
 
-def check_dataset_type(checked: CheckedFile, name: str, dataset: h5py.Dataset) -> None:
-    """Refuses a variable-length or reference dataset in a format 1.1 file, before its data
-    is read."""
-    problem = heap_type(dataset.id.get_type())
+def check_dataset_type(checked: CheckedFile, name: str, type_id) -> None:
+    """Refuses a variable-length or reference dataset (its HDF5 type, ``dataset.id.get_type()``)
+    in a format 1.1 file, before its data is read."""
+    problem = heap_type(type_id)
     if problem and checked.fixed_text:
         raise RecordingError(
             f"{checked.path}: dataset {name} is {problem}; a format 1.1 recording stores text "

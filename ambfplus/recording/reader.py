@@ -172,21 +172,48 @@ class Recording:
             return {}
         return {name: column[:] for name, column in self._columns("steps").items()}
 
-    def read_columns(self, group: str, names) -> dict[str, np.ndarray]:
-        """Some whole columns of a group (``steps``, ``removed``, ...), read part by part so
-        that each part is opened once however many parts a long recording has."""
-        if group not in self._groups:
-            raise KeyError(f"{self.path}: the recording has no group {group!r}")
-        columns = self._columns(group)
-        missing = [n for n in names if n not in columns]
-        if missing:
-            raise KeyError(f"{self.path}: {group} has no column {missing[0]!r} (it has "
-                           f"{', '.join(sorted(columns))})")  # fmt: skip
-        chunks: dict[str, list] = {n: [] for n in names}
-        for piece in range(len(self._groups[group][0])):
-            for n in names:
-                chunks[n].append(columns[n].read_piece(piece))
-        return {n: np.concatenate(c) if c else columns[n][:0] for n, c in chunks.items()}
+    def read_columns(self, group: str, names=None) -> dict[str, np.ndarray]:
+        """Some whole columns of a group (``steps``, ``removed``, ...; `names` None: all of
+        them), read part by part so that each part is opened once however many parts a long
+        recording has."""
+        return self.read_groups({group: names})[group]
+
+    def read_groups(self, wanted: Mapping[str, Any]) -> dict[str, dict[str, np.ndarray]]:
+        """Whole columns of several groups at once, `wanted` mapping each group to its column
+        names (None: all), in one pass over the parts (a long recording has a thousand: each
+        opened once, not once per group). Reading every column of ``removed`` or ``events``
+        also keeps them as ``removed`` and ``events`` return them."""
+        columns: dict[str, dict[str, Column]] = {}
+        for group, names in wanted.items():
+            if group not in self._groups:
+                raise KeyError(f"{self.path}: the recording has no group {group!r}")
+            found = self._columns(group)
+            names = list(found) if names is None else list(names)
+            missing = [n for n in names if n not in found]
+            if missing:
+                raise KeyError(f"{self.path}: {group} has no column {missing[0]!r} (it has "
+                               f"{', '.join(sorted(found))})")  # fmt: skip
+            columns[group] = {n: found[n] for n in names}
+        # group -> {part index: the group's piece in that part}
+        pieces = {
+            group: {part: piece for piece, (part, _) in enumerate(self._groups[group][0])}
+            for group in columns
+        }
+        chunks: dict[str, dict[str, list]] = {g: {n: [] for n in c} for g, c in columns.items()}
+        for part in sorted({part for p in pieces.values() for part in p}):
+            for group, named in columns.items():
+                piece = pieces[group].get(part)
+                if piece is not None:
+                    for n, column in named.items():
+                        chunks[group][n].append(column.read_piece(piece))
+        out = {
+            group: {n: np.concatenate(c) if c else columns[group][n][:0] for n, c in named.items()}
+            for group, named in chunks.items()
+        }
+        for group, keep in (("removed", self._removed_from), ("events", self._events_from)):
+            if group in out and set(out[group]) == set(self._columns(group)):
+                self.__dict__[group] = keep(out[group])
+        return out
 
     @cached_property
     def removed(self) -> dict:
@@ -194,7 +221,9 @@ class Recording:
         if "removed" not in self._groups:
             out = {n: np.empty((0,) + t, d) for n, (d, t) in REMOVED_COLUMNS.items()}
             return {**out, "volume": None}
-        columns = {name: column[:] for name, column in self._columns("removed").items()}
+        return self._removed_from(self.read_columns("removed"))
+
+    def _removed_from(self, columns: dict) -> dict:
         return {**columns, "volume": self._groups["removed"][1].get("volume")}
 
     @cached_property
@@ -202,7 +231,9 @@ class Recording:
         """Events as dicts: ``step``, ``kind``, ``label``, ``voxel`` (i, j, k)."""
         if "events" not in self._groups:
             return []
-        c = {name: column[:] for name, column in self._columns("events").items()}
+        return self._events_from(self.read_columns("events"))
+
+    def _events_from(self, c: dict) -> list[dict]:
         with _damage_is_an_error(self.path, "reading events"):
             return [
                 {
@@ -283,7 +314,7 @@ class Column(Sequence):
         return index % len(self)
 
     def _dataset(self, piece: int):
-        dataset = self._files.get(self._parts[piece])[self.path]
+        dataset = self._files.dataset(self._parts[piece], self.path)
         return dataset.asstr() if self.is_text else dataset
 
     def _read_row(self, index: int):
@@ -408,6 +439,8 @@ class _PartFiles:
     def __init__(self, paths: list[Path]) -> None:
         self._paths = paths
         self._open: OrderedDict[int, CheckedFile] = OrderedDict()
+        # The datasets looked up in each open part (a lookup costs more than a small read).
+        self._datasets: dict[int, dict[str, h5py.Dataset]] = {}
 
     def path(self, index: int) -> Path:
         return self._paths[index]
@@ -416,12 +449,24 @@ class _PartFiles:
         f = self._open.get(index)
         if f is None:
             f = self._open[index] = open_checked(self._paths[index])
+            self._datasets[index] = {}
             if len(self._open) > MAX_OPEN_PARTS:
-                self._open.popitem(last=False)[1].close()
+                closed, oldest = self._open.popitem(last=False)
+                del self._datasets[closed]
+                oldest.close()
         self._open.move_to_end(index)
         return f.file
 
+    def dataset(self, index: int, path: str) -> h5py.Dataset:
+        """Dataset `path` of part `index`."""
+        file = self.get(index)
+        found = self._datasets[index].get(path)
+        if found is None:
+            found = self._datasets[index][path] = file[path]
+        return found
+
     def close(self) -> None:
+        self._datasets.clear()
         while self._open:
             self._open.popitem()[1].close()
 
@@ -500,32 +545,46 @@ def _summarise_part(path: Path, recording_id: str, number: int) -> PartSummary:
                 f"'recording_id', 'part' say {found_id}, {found_number})"
             )
         summary = PartSummary(path)
-        f.visititems(lambda name, obj: _summarise_group(checked, summary, name, obj))
+        # Through the low-level API: a long recording has a thousand parts of some fifty
+        # datasets, and each high-level object costs more than reading its header.
+        datasets: list[bytes] = []
+
+        def collect(name: bytes, info) -> None:
+            if info.type == h5py.h5o.TYPE_DATASET:
+                datasets.append(name)
+
+        h5py.h5o.visit(f.id, collect, info=True)
+        for name in datasets:
+            dataset = h5py.h5d.open(f.id, name)
+            _summarise_dataset(checked, summary, name.decode("utf-8", "replace"), dataset)
         return summary
 
 
-def _summarise_group(checked: CheckedFile, summary: PartSummary, name: str, obj) -> None:
-    if not isinstance(obj, h5py.Dataset):
-        return
+def _summarise_dataset(checked: CheckedFile, summary: PartSummary, name: str, dataset) -> None:
+    """Adds one dataset (a low-level h5py DatasetID) to its group's summary, checked: no
+    variable-length type in a format 1.1 part, as many rows as the group's other datasets."""
     path = checked.path
-    check_dataset_type(checked, name, obj)
+    check_dataset_type(checked, name, dataset.get_type())
     group, column = name.rsplit("/", 1) if "/" in name else ("", name)
+    shape = dataset.shape
     entry = summary.groups.get(group)
     if entry is None:
+        parent = checked.file[group] if group else checked.file
         attrs: dict[str, object] = {
-            k: text_value(v) for k, v in read_attributes(checked, obj.parent).items()
+            k: text_value(v) for k, v in read_attributes(checked, parent).items()
         }
-        entry = summary.groups[group] = GroupSummary(obj.shape[0] if obj.shape else 0, {}, attrs)
-    if not obj.shape or obj.shape[0] != entry.rows:
+        entry = summary.groups[group] = GroupSummary(shape[0] if shape else 0, {}, attrs)
+    if not shape or shape[0] != entry.rows:
         other = next(iter(entry.datasets), None)
         raise RecordingError(
-            f"{path}: inconsistent lengths: dataset {name} has shape {obj.shape}, but "
+            f"{path}: inconsistent lengths: dataset {name} has shape {shape}, but "
             f"{group}/{other} has {entry.rows} rows"
         )
-    string = h5py.check_string_dtype(obj.dtype)
+    dtype = dataset.dtype
+    string = h5py.check_string_dtype(dtype)
     if string:
         entry.strings[column] = (string.encoding, string.length)
-    entry.datasets[column] = (np.dtype(object) if string else obj.dtype, obj.shape[1:])
+    entry.datasets[column] = (np.dtype(object) if string else dtype, shape[1:])
 
 
 def _concatenate_groups(head: Path, parts: list[PartSummary]) -> dict:

@@ -82,20 +82,28 @@ def load_session(path) -> SessionData:
     if drill is None:
         raise ValueError(f"{path}: the recorded scene has no drill: nothing to assess")
     wanted = ["step", "time"] + [f"{drill.name}.{c}" for c in ("pose", "force", "on", "burr")]
+    rig = rec.rigs.get(meta.get("rig", "rig"))
+    stream = rig.left if rig is not None else rec.cameras.get(meta.get("camera", ""))
+    if stream is not None and not len(stream):
+        stream = None
+    # Only the columns assessment reads (a long session's step log holds many more), with the
+    # camera's and the removed voxels and events, in one pass over the recording's parts.
+    groups: dict = {"steps": wanted}
+    if stream is not None:
+        groups[f"cameras/{stream.name}"] = ["step", "intrinsics", "pose"]
+    groups.update({g: None for g in ("removed", "events") if rec.rows(g)})
     try:
-        # Only the columns assessment reads (a long session's step log holds many more).
-        steps = rec.read_columns("steps", wanted)
-    except KeyError as error:
+        read = rec.read_groups(groups)
+    except KeyError as error:  # the camera's columns are every stream's: the step log's
         raise ValueError(
             f"{path}: the step log lacks what assessment needs of drill "
             f"'{drill.name}': {error.args[0]}"
         ) from None
+    steps = read["steps"]
     camera = None
-    rig = rec.rigs.get(meta.get("rig", "rig"))
-    stream = rig.left if rig is not None else rec.cameras.get(meta.get("camera", ""))
-    if stream is not None and len(stream):
+    if stream is not None:
         columns = stream.columns
-        small = rec.read_columns(f"cameras/{stream.name}", ["step", "intrinsics", "pose"])
+        small = read[f"cameras/{stream.name}"]
         camera = {
             "name": stream.camera,
             "steps": np.asarray(small["step"], np.int64),

@@ -171,6 +171,35 @@ def test_round_trip_of_real_stereo_captures_is_exact(drilled_recording):
         assert "cameras {rig_left: 4, rig_right: 4}" in repr(rec)
 
 
+def test_read_groups_reads_several_groups_in_one_pass(drilled_recording):
+    """Recording.read_groups: whole columns of several groups in one pass over the parts, equal
+    to each column read on its own; reading all of removed and events keeps them as the
+    properties give them; a missing group or column is a KeyError naming it."""
+    path, _, _, removed = drilled_recording
+    with open_recording(path) as rec:
+        alone = {name: column[:] for name, column in rec.cameras["rig_left"].columns.items()}
+        got = rec.read_groups({"steps": ["step", "force"], "cameras/rig_left": ["step", "pose"],
+                               "removed": None, "events": None})  # fmt: skip
+        assert sorted(got) == ["cameras/rig_left", "events", "removed", "steps"]
+        assert np.array_equal(got["steps"]["step"], np.arange(1, 21))
+        assert got["steps"]["force"].shape == (20, 3) and got["steps"]["force"][7, 2] == 1.0
+        for name in ("step", "pose"):
+            assert np.array_equal(got["cameras/rig_left"][name], alone[name]), name
+        for name in ("step", "voxel", "label"):
+            assert np.array_equal(got["removed"][name], removed[name]), name
+        kept_removed, kept_events = rec.removed, rec.events  # kept by the pass, not read again
+        assert kept_removed["volume"] == "ear" and kept_removed["voxel"].dtype == np.int32
+        assert kept_events == [{"step": 10, "kind": "critical", "label": 3, "voxel": (-1, -1, -1)}]
+        with pytest.raises(KeyError, match="no group 'nothing'"):
+            rec.read_groups({"nothing": None})
+        with pytest.raises(KeyError, match="steps has no column 'nothing'"):
+            rec.read_columns("steps", ["step", "nothing"])
+    with open_recording(path) as fresh:  # the properties read alone give the same
+        assert fresh.events == kept_events
+        for name in ("step", "voxel", "label"):
+            assert np.array_equal(fresh.removed[name], kept_removed[name]), name
+
+
 def test_plain_h5py_reads_the_closed_head_as_one_file(drilled_recording, tmp_path, monkeypatch):
     path, _, snapshots, _ = drilled_recording
     monkeypatch.chdir(tmp_path.parent)  # parts are found beside the head, not in the cwd

@@ -113,8 +113,10 @@ std::vector<double> drill_hardness(const Drill& drill, const py::object& hardnes
 audio::AudioOutput parse_output(const std::string& output) {
   if (output == "device") return audio::AudioOutput::kDevice;
   if (output == "null") return audio::AudioOutput::kNull;
+  if (output == "virtual") return audio::AudioOutput::kVirtual;
   if (output == "none") return audio::AudioOutput::kNone;
-  throw ArgumentError("DrillSound: output = '" + output + "', expected device, null or none");
+  throw ArgumentError("DrillSound: output = '" + output +
+                      "', expected device, null, virtual or none");
 }
 
 py::dict stats_dict(const audio::PlayerStats& s) {
@@ -253,7 +255,9 @@ void define_audio(py::module_& m) {
            py::arg("trim_backlog") = true, py::arg("paused") = false,
            py::arg("capture_seconds") = 0.0, py::arg("seed") = 0x5eed, py::keep_alive<1, 2>(),
            "output: 'device' (the default output: PulseAudio, ALSA or JACK), 'null' "
-           "(miniaudio's null device: played at the real rate, heard by nobody) or 'none'. "
+           "(miniaudio's null device: played at the real rate, heard by nobody; it wakes every "
+           "10 ms), 'virtual' (a sound card with no hardware: asks for each period at its "
+           "deadline on its own clock, heard by nobody) or 'none'. "
            "require_device: raise ResourceError instead of carrying on silent. warnings: None "
            "(a beep per critical label of the volume, from 1 mm) or {structure: start metres, "
            "or {start, full, frequency, slow_period, fast_period}}; {} for none. hardness: "
@@ -286,7 +290,7 @@ void define_audio(py::module_& m) {
           "Mutes or unmutes (a launcher's mute key); returns whether it is now muted.")
       .def_property_readonly(
           "playing", [](const DrillSound& s) { return s.player().playing(); },
-          "whether a device (or the null device) plays")
+          "whether a device (or the null or virtual device) plays")
       .def_property_readonly(
           "device_error",
           [](const DrillSound& s) -> py::object {
@@ -296,7 +300,7 @@ void define_audio(py::module_& m) {
           "why no device plays (None when one does or none was asked for)")
       .def_property_readonly(
           "backend", [](const DrillSound& s) { return s.player().backend(); },
-          "the backend playing ('pulseaudio', 'alsa', 'jack', 'null'; '' for none)")
+          "the backend playing ('pulseaudio', 'alsa', 'jack', 'null', 'virtual'; '' for none)")
       .def_property_readonly(
           "period_frames", [](const DrillSound& s) { return s.player().period_frames(); },
           "frames per audio callback the device settled on")

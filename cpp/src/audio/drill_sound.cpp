@@ -5,8 +5,10 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <mutex>
+#include <thread>
 
 #include <dlfcn.h>
 
@@ -48,6 +50,93 @@ void add(std::atomic<std::int64_t>& counter, std::int64_t n = 1) {
   counter.fetch_add(n, std::memory_order_relaxed);
 }
 
+// The virtual output, through miniaudio's custom backend: a playback device with no hardware.
+// miniaudio's audio thread asks the player for a period and writes it here; the write returns
+// when that period starts to play on the device's own clock (its start plus the frames written
+// so far), as a card's interrupt paces its driver. So the player is called once per period on
+// absolute deadlines, one period ahead of what plays. (miniaudio's null device instead wakes
+// every 10 ms and then asks for every period that fell due at once.)
+struct VirtualClock {
+  std::chrono::steady_clock::time_point start;
+  std::uint64_t frames = 0;
+};
+
+VirtualClock& clock_of(ma_device* device) {
+  return *static_cast<VirtualClock*>(device->pContext->pUserData);
+}
+
+void describe_virtual(ma_device_info* info) {
+  *info = ma_device_info{};
+  std::snprintf(info->name, sizeof(info->name), "%s", "ambfplus virtual output");
+  info->isDefault = MA_TRUE;
+  info->nativeDataFormatCount = 1;
+  info->nativeDataFormats[0].format = ma_format_f32;  // channels and rate: any
+}
+
+ma_result virtual_enumerate(ma_context* context, ma_enum_devices_callback_proc callback,
+                            void* user) {
+  ma_device_info info;
+  describe_virtual(&info);
+  callback(context, ma_device_type_playback, &info, user);
+  return MA_SUCCESS;
+}
+
+ma_result virtual_device_info(ma_context*, ma_device_type type, const ma_device_id*,
+                              ma_device_info* info) {
+  if (type != ma_device_type_playback) return MA_DEVICE_TYPE_NOT_SUPPORTED;
+  describe_virtual(info);
+  return MA_SUCCESS;
+}
+
+ma_result virtual_device_init(ma_device*, const ma_device_config* config,
+                              ma_device_descriptor* playback, ma_device_descriptor*) {
+  if (config->deviceType != ma_device_type_playback) return MA_DEVICE_TYPE_NOT_SUPPORTED;
+  if (playback->format == ma_format_unknown) playback->format = ma_format_f32;
+  if (playback->channels == 0) playback->channels = 1;
+  if (playback->sampleRate == 0) playback->sampleRate = 48000;
+  if (playback->channelMap[0] == MA_CHANNEL_NONE) {
+    ma_channel_map_init_standard(ma_standard_channel_map_default, playback->channelMap,
+                                 MA_MAX_CHANNELS, playback->channels);
+  }
+  playback->periodSizeInFrames = ma_calculate_buffer_size_in_frames_from_descriptor(
+      playback, playback->sampleRate, config->performanceProfile);
+  playback->periodCount = 2;
+  return MA_SUCCESS;
+}
+
+ma_result virtual_start(ma_device* device) {
+  clock_of(device) = VirtualClock{std::chrono::steady_clock::now(), 0};
+  return MA_SUCCESS;
+}
+
+ma_result virtual_write(ma_device* device, const void*, ma_uint32 frames, ma_uint32* written) {
+  VirtualClock& clock = clock_of(device);
+  const double rate = device->playback.internalSampleRate;
+  std::this_thread::sleep_until(
+      clock.start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                        std::chrono::duration<double>(static_cast<double>(clock.frames) / rate)));
+  clock.frames += frames;
+  *written = frames;
+  return MA_SUCCESS;
+}
+
+ma_result virtual_nothing(ma_context*) { return MA_SUCCESS; }
+ma_result virtual_device_nothing(ma_device*) { return MA_SUCCESS; }
+
+ma_result virtual_context_init(ma_context*, const ma_context_config*,
+                               ma_backend_callbacks* callbacks) {
+  callbacks->onContextInit = virtual_context_init;
+  callbacks->onContextUninit = virtual_nothing;
+  callbacks->onContextEnumerateDevices = virtual_enumerate;
+  callbacks->onContextGetDeviceInfo = virtual_device_info;
+  callbacks->onDeviceInit = virtual_device_init;
+  callbacks->onDeviceUninit = virtual_device_nothing;
+  callbacks->onDeviceStart = virtual_start;
+  callbacks->onDeviceStop = virtual_device_nothing;
+  callbacks->onDeviceWrite = virtual_write;
+  return MA_SUCCESS;
+}
+
 }  // namespace
 
 struct DrillSoundPlayer::Impl {
@@ -86,6 +175,7 @@ struct DrillSoundPlayer::Impl {
   ma_device device{};
   bool have_context = false, have_device = false;
   std::mutex close_mutex;
+  VirtualClock virtual_clock;  // the virtual output's (the context's user data)
 
   void open_output();
   void close();
@@ -102,13 +192,22 @@ void data_callback(ma_device* device, void* output, const void*, ma_uint32 frame
 
 void DrillSoundPlayer::Impl::open_output() {
   if (options.output == AudioOutput::kNone) return;
-  const bool null = options.output == AudioOutput::kNull;
+  // The null and virtual outputs are heard by nobody: no system device is tried.
+  const bool null = options.output == AudioOutput::kNull || options.output == AudioOutput::kVirtual;
   const ma_backend real[] = {ma_backend_pulseaudio, ma_backend_alsa, ma_backend_jack};
   const ma_backend none[] = {ma_backend_null};
+  const ma_backend custom[] = {ma_backend_custom};
   std::string failure;
   ma_context_config context_config = ma_context_config_init();
-  ma_result result = null ? ma_context_init(none, 1, &context_config, &context)
-                          : ma_context_init(real, 3, &context_config, &context);
+  ma_result result;
+  if (options.output == AudioOutput::kVirtual) {
+    context_config.pUserData = &virtual_clock;
+    context_config.custom.onContextInit = virtual_context_init;
+    result = ma_context_init(custom, 1, &context_config, &context);
+  } else {
+    result = null ? ma_context_init(none, 1, &context_config, &context)
+                  : ma_context_init(real, 3, &context_config, &context);
+  }
   if (result != MA_SUCCESS) {
     failure = std::string("no audio backend opened (") + ma_result_description(result) + ")";
   } else {
@@ -165,7 +264,9 @@ DrillSoundPlayer::DrillSoundPlayer(const DrillSoundSpec& spec, const PlayerOptio
   if (impl_->have_device) {
     impl_->device.pUserData = this;
     impl_->period = static_cast<int>(impl_->device.playback.internalPeriodSizeInFrames);
-    impl_->backend = ma_get_backend_name(impl_->context.backend);
+    impl_->backend = options.output == AudioOutput::kVirtual
+                         ? "virtual"
+                         : ma_get_backend_name(impl_->context.backend);
     impl_->open = true;
     impl_->paused = options.paused;
     const ma_result result = options.paused ? MA_SUCCESS : ma_device_start(&impl_->device);

@@ -15,5 +15,6 @@
 #define MA_ENABLE_ALSA
 #define MA_ENABLE_JACK
 #define MA_ENABLE_NULL
+#define MA_ENABLE_CUSTOM  // the engine's virtual output (drill_sound.cpp)
 
 #include "miniaudio/miniaudio.h"

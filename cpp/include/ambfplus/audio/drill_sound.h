@@ -30,6 +30,9 @@ enum class AudioOutput {
   kNone,    ///< nowhere: silent, nothing opened
   kDevice,  ///< the default output device (PulseAudio, ALSA or JACK, the first that opens)
   kNull,    ///< the library's null device: consumed at the real rate, heard by nobody
+  /// A virtual sound card (miniaudio's custom backend): no hardware, a clock of its own that
+  /// asks for one period at each period's deadline, as a card's interrupt does; heard by nobody.
+  kVirtual,
 };
 
 /// How a player plays.
@@ -92,11 +95,11 @@ class AMBFPLUS_API DrillSoundPlayer {
   /// Silences the output (the synthesiser keeps running, so unmuting resumes in step).
   void set_muted(bool muted);
   bool muted() const;
-  /// Whether a device (or the null device) is playing.
+  /// Whether a device (or the null or virtual device) is playing.
   bool playing() const;
   /// Why no device plays ("" when one does, or when none was asked for).
   const std::string& device_error() const;
-  /// The backend playing ("pulseaudio", "alsa", "jack", "null"), "" for none.
+  /// The backend playing ("pulseaudio", "alsa", "jack", "null", "virtual"), "" for none.
   const std::string& backend() const;
   /// Frames per callback the device settled on (0 without a device).
   int period_frames() const;

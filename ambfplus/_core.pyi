@@ -2054,6 +2054,10 @@ class Drill(Object):
         """
         stay in the plan: a fixture on the boundary of a planned region, `target` a boolean mask of the volume's shape (nx, ny, nz) or a list of labels (names or ids); every labelled voxel outside it is the forbidden side (with a `stop`, nothing outside it is cut)
         """
+    def set_plan_enabled(self, enabled: bool) -> None:
+        """
+        turns the plan's fixture off or back on, its field kept (set_plan rebuilds it)
+        """
     def set_waypoints(self, waypoints: list) -> None:
         """
         follow dicts of time (s from now), pose (4x4) and optionally on and speed, interpolating between them
@@ -2492,7 +2496,7 @@ class DrillSound:
         ...
     def __init__(self, drill: Drill, *, output: str = 'device', muted: bool = False, require_device: bool = False, warnings: typing.Any = None, hardness: typing.Any = None, sample_rate: typing.SupportsInt | typing.SupportsIndex = 48000, period_frames: typing.SupportsInt | typing.SupportsIndex = 128, max_backlog_ticks: typing.SupportsInt | typing.SupportsIndex = 16, trim_backlog: bool = True, paused: bool = False, capture_seconds: typing.SupportsFloat | typing.SupportsIndex = 0.0, seed: typing.SupportsInt | typing.SupportsIndex = 24301) -> None:
         """
-        output: 'device' (the default output: PulseAudio, ALSA or JACK), 'null' (miniaudio's null device: played at the real rate, heard by nobody) or 'none'. require_device: raise ResourceError instead of carrying on silent. warnings: None (a beep per critical label of the volume, from 1 mm) or {structure: start metres, or {start, full, frequency, slow_period, fast_period}}; {} for none. hardness: {structure: hardness relative to bone} (1 elsewhere). max_backlog_ticks, trim_backlog: ticks beyond what the next callback needs, and a backlog that never drains, are dropped (bounded latency). paused: open the device without starting it. capture_seconds: keep that much of what is played for take_capture().
+        output: 'device' (the default output: PulseAudio, ALSA or JACK), 'null' (miniaudio's null device: played at the real rate, heard by nobody; it wakes every 10 ms), 'virtual' (a sound card with no hardware: asks for each period at its deadline on its own clock, heard by nobody) or 'none'. require_device: raise ResourceError instead of carrying on silent. warnings: None (a beep per critical label of the volume, from 1 mm) or {structure: start metres, or {start, full, frequency, slow_period, fast_period}}; {} for none. hardness: {structure: hardness relative to bone} (1 elsewhere). max_backlog_ticks, trim_backlog: ticks beyond what the next callback needs, and a backlog that never drains, are dropped (bounded latency). paused: open the device without starting it. capture_seconds: keep that much of what is played for take_capture().
         """
     def close(self) -> None:
         """
@@ -2515,7 +2519,7 @@ class DrillSound:
     @property
     def backend(self) -> str:
         """
-        the backend playing ('pulseaudio', 'alsa', 'jack', 'null'; '' for none)
+        the backend playing ('pulseaudio', 'alsa', 'jack', 'null', 'virtual'; '' for none)
         """
     @property
     def closed(self) -> bool:
@@ -2554,7 +2558,7 @@ class DrillSound:
     @property
     def playing(self) -> bool:
         """
-        whether a device (or the null device) plays
+        whether a device (or the null or virtual device) plays
         """
     @property
     def sample_rate(self) -> int:

@@ -660,6 +660,16 @@ void define_drill(py::module_& m) {
           },
           "removes the plan's fixture (and its attraction, follow_plan)")
       .def(
+          "set_plan_enabled",
+          [](Drill& d, bool enabled) {
+            without_gil([&] {
+              auto lock = d.world().lock_state_for_copy();
+              d.set_plan_enabled(enabled);
+            });
+          },
+          py::arg("enabled"),
+          "turns the plan's fixture off or back on, its field kept (set_plan rebuilds it)")
+      .def(
           "follow_plan",
           [](Drill& d, double max_force, double start, bool enabled) {
             without_gil([&] {

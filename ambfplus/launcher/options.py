@@ -97,6 +97,11 @@ def build_parser() -> argparse.ArgumentParser:
                    "max_force, stop} (metres, N; a DRILL block's fixtures), or, alone, from "
                    "--task: each protected structure pushes the burr away from its margin + 1 mm "
                    "and stops it at half its margin. Ctrl+G turns them off and on")  # fmt: skip
+    p.add_argument("--plan", choices=["stay", "follow"],
+                   help="with --task, guidance from its target region: 'stay' holds the burr "
+                   "inside it (a fixture on its boundary from 1 mm, no cutting beyond 0.3 mm), "
+                   "'follow' also draws the burr toward the nearest target bone not yet removed. "
+                   "Ctrl+G turns it off and on with the fixtures")  # fmt: skip
     p.add_argument("--audio", action="store_true", help="play the drill's sound (with --task, "
                    "proximity beeps from twice each structure's margin); a machine without an "
                    "audio device says so and carries on silent")  # fmt: skip

@@ -82,7 +82,8 @@ class LaunchSession:
         self.initial_goal = self.drill.goal.copy() if self.drill is not None else None
         self.task, self.metrics = self._task(args)
         self.fixtures: list[dict] = self._fixtures(args)
-        self.fixtures_on = bool(self.fixtures)
+        self.plan: str | None = self._plan(args)
+        self.fixtures_on = bool(self.fixtures) or self.plan is not None
         self.sound = self._sound(args)
         self.report, self.metrics_path = args.report, args.metrics
         self.record_path = args.record
@@ -168,14 +169,48 @@ class LaunchSession:
             raise SystemExit(f"ambfplus-launch: --fixtures: {error}") from None
         return list(self.drill.fixtures)
 
+    # --plan: the stay-in-the-plan fixture and the follow-the-plan attraction (as the guidance
+    # tests and benchmarks set them).
+    PLAN_FIXTURE = {"start": 0.001, "max_force": 1.0, "stop": 0.0003}
+    PLAN_FOLLOW = {"max_force": 0.6, "start": 0.002}
+
+    def _plan(self, args: argparse.Namespace) -> str | None:
+        """--plan stay / follow: guidance from --task's target region."""
+        if args.plan is None:
+            return None
+        if self.task is None or self.drill is None:
+            raise SystemExit("ambfplus-launch: --plan needs --task (its target region)")
+        from .._core import ArgumentError, ConfigError
+
+        try:
+            target = self.task.target_mask(self.drill.volume.data)
+        except (ConfigError, OSError, ValueError) as error:
+            raise SystemExit(f"ambfplus-launch: --plan: {error}") from None
+        if not target.any():
+            raise SystemExit(f"ambfplus-launch: --plan: the task {self.task.name!r} has no "
+                             "target voxel in the launched volume")  # fmt: skip
+        try:
+            self.drill.set_plan(target, **self.PLAN_FIXTURE)
+            if args.plan == "follow":
+                self.drill.follow_plan(**self.PLAN_FOLLOW)
+        except (ArgumentError, ConfigError) as error:
+            raise SystemExit(f"ambfplus-launch: --plan: {error}") from None
+        return args.plan
+
     def toggle_fixtures(self) -> bool:
-        """Ctrl+G: the fixtures off, or back on; whether they are on now."""
-        if not self.fixtures or self.drill is None:
+        """Ctrl+G: the fixtures and the plan's guidance off, or back on; whether they are on
+        now."""
+        if (not self.fixtures and self.plan is None) or self.drill is None:
             return False
         self.fixtures_on = not self.fixtures_on
         with self.world.lock():
-            self.drill.set_fixtures([{**f, "enabled": f["enabled"] and self.fixtures_on}
-                                     for f in self.fixtures])  # fmt: skip
+            if self.fixtures:
+                self.drill.set_fixtures([{**f, "enabled": f["enabled"] and self.fixtures_on}
+                                         for f in self.fixtures])  # fmt: skip
+            if self.plan is not None:
+                self.drill.set_plan_enabled(self.fixtures_on)
+                if self.plan == "follow":
+                    self.drill.follow_plan(**self.PLAN_FOLLOW, enabled=self.fixtures_on)
         return self.fixtures_on
 
     def _sound(self, args: argparse.Namespace):
@@ -344,7 +379,8 @@ class LaunchSession:
             status.critical, status.critical_mm = name, distance * 1000
         if self.metrics is not None:
             self._task_status(status)
-        status.fixtures = "on" if self.fixtures_on else ("off" if self.fixtures else "")
+        guided = self.fixtures or self.plan is not None
+        status.fixtures = "on" if self.fixtures_on else ("off" if guided else "")
         status.sound = "" if self.sound is None else ("muted" if self.sound.muted else "on")
         events = self.drill.events
         cut = [e for e in events if e["kind"] == "critical"]

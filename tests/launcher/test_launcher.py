@@ -130,15 +130,7 @@ def test_a_task_session_shows_its_metrics_and_they_equal_the_offline_assessment(
     from ambfplus.training import assess, load_task
 
     launch_file = fixtures / "volumetric_drilling" / "launch.yaml"
-    ear = fixtures / "volumetric_drilling"
-    task_file = tmp_path / "task.yaml"
-    task_file.write_text(
-        "version: 1\nname: Ear drilling\n"
-        f"anatomy: {{file: {ear / 'ADF' / 'volume_256.yaml'}, labels: {ear / 'labels.csv'}}}\n"
-        "target: {labels: [Bone]}\n"
-        "protect:\n  - {structure: Facial_Nerve, margin: 1.0}\n"
-        "  - {structure: Sinus_+_Dura, margin: 1.0}\n"
-    )
+    task_file = ear_task(fixtures, tmp_path, "{labels: [Bone]}", ["Facial_Nerve", "Sinus_+_Dura"])
     record, metrics, report = tmp_path / "s.h5", tmp_path / "live.json", tmp_path / "d.html"
     process, status_file, window = launch(display, tmp_path, launch_file, 14, "--record",
                                           str(record), "--task", str(task_file), "--metrics",
@@ -173,6 +165,20 @@ def test_a_task_session_shows_its_metrics_and_they_equal_the_offline_assessment(
     assert sum(live["removed_by_label"].values()) > 100, "the session drilled"
     assert_same(live, offline)
     assert report.is_file() and "Debrief: Ear drilling" in report.read_text()
+
+
+def ear_task(fixtures, tmp_path, target: str, protect: list[str]):
+    """A task on the original system's ear (the launch file's volume_256): its target (YAML
+    text), each protected structure with a 1 mm margin."""
+    ear = fixtures / "volumetric_drilling"
+    task_file = tmp_path / "task.yaml"
+    task_file.write_text(
+        "version: 1\nname: Ear drilling\n"
+        f"anatomy: {{file: {ear / 'ADF' / 'volume_256.yaml'}, labels: {ear / 'labels.csv'}}}\n"
+        f"target: {target}\nprotect:\n"
+        + "".join(f"  - {{structure: {name}, margin: 1.0}}\n" for name in protect)
+    )
+    return task_file
 
 
 def assert_same(live, offline, path="metrics"):
@@ -215,3 +221,38 @@ def test_the_overlay_shows_each_protected_structure_in_its_own_level():
     before, after = counts(one), counts(three)
     assert before["near"] == 0 and before["inside"] == 0, before
     assert after["near"] > 30 and after["inside"] > 30, after
+
+
+@pytest.mark.slow
+def test_plan_guidance_from_the_task_and_its_toggle(fixtures, tmp_path):
+    """--plan stay / follow: the task's target region becomes the drill's plan (a fixture on
+    its boundary, and with follow an attraction toward it); Ctrl+G turns both off and on,
+    the plan's field kept. --plan needs --task."""
+    from ambfplus.launcher.options import parse_args
+    from ambfplus.launcher.session import LaunchSession
+
+    launch_file = fixtures / "volumetric_drilling" / "launch.yaml"
+    target = "{labels: [Bone], box: {min: [-10, -10, -10], max: [10, 10, 10]}}"
+    task_file = ear_task(fixtures, tmp_path, target, ["Facial_Nerve"])
+
+    def session_of(*options):  # the launch file's volume_256 ear and drill, as in launch()
+        return LaunchSession(*parse_args([str(launch_file), "-l", "0,2", *options]))
+
+    session = session_of("--task", str(task_file), "--plan", "follow")
+    drill = session.drill
+    target = session.task.target_mask(drill.volume.data)
+    assert 0 < target.sum() < (np.asarray(drill.volume.data.labels) > 0).sum()
+    assert drill.plan["voxels"] == int(target.sum()) and drill.plan["enabled"]
+    assert drill.plan["stop"] == LaunchSession.PLAN_FIXTURE["stop"]
+    assert drill.follows_plan == LaunchSession.PLAN_FOLLOW
+    assert session.toggle_fixtures() is False
+    assert not drill.plan["enabled"] and drill.follows_plan is None
+    assert drill.plan["voxels"] == int(target.sum())
+    assert session.toggle_fixtures() is True
+    assert drill.plan["enabled"] and drill.follows_plan == LaunchSession.PLAN_FOLLOW
+    session.finish()
+    stay = session_of("--task", str(task_file), "--plan", "stay")
+    assert stay.drill.plan["enabled"] and stay.drill.follows_plan is None
+    stay.finish()
+    with pytest.raises(SystemExit, match="--plan needs --task"):
+        session_of("--plan", "stay")

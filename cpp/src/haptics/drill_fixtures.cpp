@@ -138,6 +138,13 @@ void Drill::clear_plan() {
   fixtures_changed();
 }
 
+void Drill::set_plan_enabled(bool enabled) {
+  if (!plan_)
+    throw ArgumentError(describe() + ": set_plan_enabled: there is no plan (set_plan first)");
+  plan_->spec.enabled = enabled;
+  fixtures_changed();
+}
+
 void Drill::fixtures_changed() {
   std::fill(uncuttable_.begin(), uncuttable_.end(), false);
   any_stop_ = false;

@@ -217,6 +217,9 @@ class AMBFPLUS_API Drill : public Object {
   /// The same with the plan given as the voxels of some labels (names or ids).
   void set_plan(const std::vector<std::string>& labels, const FixtureSpec& fixture);
   void clear_plan();
+  /// Turns the plan's fixture off or back on (its field kept: no rebuild). Throws ArgumentError
+  /// without a plan.
+  void set_plan_enabled(bool enabled);
   /// The plan's fixture (its structure "plan"), or nullptr without a plan.
   const FixtureSpec* plan() const { return plan_ ? &plan_->spec : nullptr; }
   /// Voxels in the plan.

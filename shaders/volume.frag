@@ -5,8 +5,9 @@
 // The surface is the iso level of the smoothed occupancy (trilinear). Rays skip bricks that
 // cannot reach the level (a distance map at brick resolution says how far), march every half
 // voxel inside the others, and refine a crossing by bisection. The label is that of the solid
-// voxel with the largest trilinear weight at the hit, the normal the field's negative gradient.
-// VolumeData::raycast on the CPU is the same algorithm without the skipping.
+// voxel with the largest trilinear weight at the hit (or, where the smoothed surface bridges a
+// concave corner over eight empty voxels, the nearest solid voxel), the normal the field's
+// negative gradient. VolumeData::raycast on the CPU is the same algorithm without the skipping.
 
 #include "lighting.glsl"
 
@@ -79,6 +80,32 @@ uint dominant_label(vec3 u, out ivec3 voxel) {
       best_w = w;
       best = l;
       voxel = base + d;
+    }
+  }
+  return best;
+}
+
+// The solid voxel whose centre is nearest u (its label; the voxel in `voxel`), among those
+// within kSmoothRadius (2) of the 8 voxels around u. The field is at or above the level at u only
+// if one of those 8 has a solid voxel within the smoothing radius, so one is always found.
+uint nearest_label(vec3 u, out ivec3 voxel) {
+  ivec3 base = ivec3(floor(u - 0.5));
+  uint best = 0u;
+  float best_d = 1e30;
+  voxel = ivec3(-1);
+  for (int k = -2; k <= 3; ++k) {
+    for (int j = -2; j <= 3; ++j) {
+      for (int i = -2; i <= 3; ++i) {
+        ivec3 v = base + ivec3(i, j, k);
+        uint l = label_at(v);
+        vec3 r = vec3(v) + 0.5 - u;
+        float d = dot(r, r);
+        if (l != 0u && d < best_d) {
+          best_d = d;
+          best = l;
+          voxel = v;
+        }
+      }
     }
   }
   return best;
@@ -178,11 +205,16 @@ void main() {
 
   // The voxel a quarter voxel in from the surface (along the gradient, so every view sees the
   // same voxel at a surface point) is solid almost always; thin features fall back to the solid
-  // neighbour with the largest trilinear weight.
+  // neighbour with the largest trilinear weight. Where the smoothing rounds a concave corner, the
+  // surface can pass over eight empty voxels: the label is then the nearest solid voxel's, the
+  // material whose occupancy raised the field there. Every pass names that one voxel, so a
+  // pixel with the volume's id always has its label and voxel.
   vec3 inward = dot(g, g) > 1e-12 ? normalize(g) : dir;
   ivec3 voxel = ivec3(floor(u + 0.25 * inward));
   uint label = label_at(voxel);
   if (label == 0u) label = dominant_label(u, voxel);
+  if (label == 0u) label = nearest_label(u, voxel);
+  if (label == 0u) discard;  // cannot happen (see nearest_label); never an unlabelled hit
   vec3 base = texelFetch(u_colors, ivec2(int(label & 255u), int(label >> 8)), 0).rgb;
 #if SHADE
   vec3 n = normalize(u_normal_from_voxel * -g);
@@ -196,6 +228,6 @@ void main() {
   o_label = label;
   o_instance = u_instance;
   ivec3 shape = ivec3(u_shape);
-  o_voxel = label == 0u ? -1 : voxel.x + shape.x * (voxel.y + shape.y * voxel.z);
+  o_voxel = voxel.x + shape.x * (voxel.y + shape.y * voxel.z);
   gl_FragDepth = clip.z / clip.w;
 }

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from helpers.drilling import plunge_and_cut
 
-import ambfplus
 from ambfplus.recording import open_recording, validate
 from ambfplus.scenes import drilling_phantom, orbit_view, record_session, replay
 from ambfplus.stereo import disparity_agreement
@@ -18,18 +18,7 @@ def session(tmp_path_factory):
     circling; a stereo frame every 100 steps."""
     path = tmp_path_factory.mktemp("session") / "s.h5"
     scene = drilling_phantom(resolution=80, width=320, height=240)
-    r = scene.drill.burr_radius
-    surface = scene.drill.volume.raycast((0.0, 0.0, 0.05), (0.0, 0.0, -1.0))["position"]
-    down = surface[2] + r - 0.002 - scene.drill.goal[2, 3]
-    device = ambfplus.ScriptedDevice()
-    device.set_waypoints(
-        [
-            {"time": 0.0, "position": (0, 0, 0)},
-            {"time": 0.2, "position": (0, 0, down + 0.004), "buttons": 1},
-            {"time": 0.8, "position": (0, 0, down), "buttons": 1},
-            {"time": 1.4, "position": (0.004, 0.003, down), "buttons": 1},
-        ]
-    )
+    device = plunge_and_cut(scene)
     summary = record_session(
         scene, path, device, seconds=1.5, capture_every=100, camera_motion=orbit_view
     )

@@ -3,6 +3,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 
 #include <Eigen/Core>
 
@@ -58,6 +59,17 @@ struct VolumeField {
   }
 };
 
+/// The label of voxel (i, j, k) and its linear index (i fastest); 0 outside the grid.
+template <typename T>
+std::uint16_t label_in_grid(const T* labels, const std::array<int, 3>& shape, int i, int j, int k,
+                            std::size_t* index) {
+  if (i < 0 || j < 0 || k < 0 || i >= shape[0] || j >= shape[1] || k >= shape[2]) return 0;
+  *index = static_cast<std::size_t>(i) +
+           static_cast<std::size_t>(shape[0]) *
+               (static_cast<std::size_t>(j) + static_cast<std::size_t>(shape[1]) * k);
+  return labels[*index];
+}
+
 /// The non-zero label with the largest trilinear weight among the 8 voxels around u (0 if none),
 /// and, if asked, that voxel's linear index (-1 if none).
 template <typename T>
@@ -73,12 +85,8 @@ std::uint16_t dominant_label(const T* labels, const std::array<int, 3>& shape,
   for (int corner = 0; corner < 8; ++corner) {
     const int di = corner & 1, dj = (corner >> 1) & 1, dk = (corner >> 2) & 1;
     const int i = i0 + di, j = j0 + dj, k = k0 + dk;
-    if (i < 0 || j < 0 || k < 0 || i >= shape[0] || j >= shape[1] || k >= shape[2]) continue;
-    const std::size_t index =
-        static_cast<std::size_t>(i) +
-        static_cast<std::size_t>(shape[0]) *
-            (static_cast<std::size_t>(j) + static_cast<std::size_t>(shape[1]) * k);
-    const std::uint16_t l = labels[index];
+    std::size_t index;
+    const std::uint16_t l = label_in_grid(labels, shape, i, j, k, &index);
     if (l == 0) continue;
     const double w = (di ? f[0] : 1 - f[0]) * (dj ? f[1] : 1 - f[1]) * (dk ? f[2] : 1 - f[2]);
     // Strictly greater: ties go to the lowest corner index, as in the shader.
@@ -86,6 +94,37 @@ std::uint16_t dominant_label(const T* labels, const std::array<int, 3>& shape,
       best_w = w;
       best = l;
       if (voxel != nullptr) *voxel = static_cast<std::int64_t>(index);
+    }
+  }
+  return best;
+}
+
+/// The non-zero label of the solid voxel whose centre is nearest u, among the 6 x 6 x 6 voxels
+/// within 2 of the 8 around u (0 if none), and, if asked, its linear index (-1 if none). Where
+/// the smoothed surface rounds a concave corner over 8 empty voxels, the material that raised
+/// the field there: as the shader's nearest_label, with ties to the first in k, j, i order.
+template <typename T>
+std::uint16_t nearest_label(const T* labels, const std::array<int, 3>& shape,
+                            const Eigen::Vector3d& u, std::int64_t* voxel = nullptr) {
+  const Eigen::Vector3d c = u - Eigen::Vector3d::Constant(0.5);
+  const int i0 = static_cast<int>(std::floor(c.x())), j0 = static_cast<int>(std::floor(c.y())),
+            k0 = static_cast<int>(std::floor(c.z()));
+  std::uint16_t best = 0;
+  double best_d = std::numeric_limits<double>::infinity();
+  if (voxel != nullptr) *voxel = -1;
+  for (int k = k0 - 2; k <= k0 + 3; ++k) {
+    for (int j = j0 - 2; j <= j0 + 3; ++j) {
+      for (int i = i0 - 2; i <= i0 + 3; ++i) {
+        std::size_t index;
+        const std::uint16_t l = label_in_grid(labels, shape, i, j, k, &index);
+        if (l == 0) continue;
+        const double d = (Eigen::Vector3d(i + 0.5, j + 0.5, k + 0.5) - u).squaredNorm();
+        if (d < best_d) {
+          best_d = d;
+          best = l;
+          if (voxel != nullptr) *voxel = static_cast<std::int64_t>(index);
+        }
+      }
     }
   }
   return best;

@@ -650,7 +650,7 @@ VolumeHit VolumeData::raycast(const Eigen::Vector3d& origin, const Eigen::Vector
     result.normal = n.norm() > 0 ? n.normalized() : Eigen::Vector3d(-d);
     result.label = visit_labels(label_type_, labels_.data(), [&](auto* p) -> std::uint16_t {
       // As the shader: the voxel a quarter voxel in from the surface along the gradient (the
-      // same for every view), else the dominant solid neighbour.
+      // same for every view), else the dominant solid neighbour, else the nearest solid voxel.
       const Eigen::Vector3d inward =
           g.norm() > 1e-12 ? Eigen::Vector3d(g.normalized()) : Eigen::Vector3d(du / du.norm());
       const Eigen::Vector3d in = u + 0.25 * inward;
@@ -663,7 +663,8 @@ VolumeHit VolumeData::raycast(const Eigen::Vector3d& origin, const Eigen::Vector
           return l;
         }
       }
-      return dominant_label(p, shape_, u, &result.voxel);
+      const std::uint16_t l = dominant_label(p, shape_, u, &result.voxel);
+      return l != 0 ? l : nearest_label(p, shape_, u, &result.voxel);
     });
     return result;
   }

@@ -35,6 +35,13 @@ def add_parser(commands) -> None:
                           help="mcap/rosbag2: compressed rgb as png or jpeg (lossy)")  # fmt: skip
     exporter.add_argument("--jpeg-quality", type=int, default=90,
                           help="mcap/rosbag2: JPEG quality 1..100 (default 90)")  # fmt: skip
+    exporter.add_argument("--depth-no-hit", default="nan", choices=("nan", "zero"),
+                          help="mcap/rosbag2: depth where nothing was hit: NaN (REP 118, the "
+                          "default) or 0 as recorded")  # fmt: skip
+    exporter.add_argument("--stamp", default="sim", choices=("sim", "wall"),
+                          help="mcap/rosbag2: stamps and log times in simulation time (the "
+                          "default) or wall-clock time (the recording's start + simulation "
+                          "time)")  # fmt: skip
     exporter.add_argument("--chunk-size", type=int, default=500,
                           help="original-h5: samples per file (the original's 500)")  # fmt: skip
     exporter.add_argument("--no-images", action="store_true",
@@ -53,6 +60,8 @@ def run(args: argparse.Namespace) -> int:
         options["image_topics"] = args.image_topics
         options["rgb_codec"] = args.rgb_codec
         options["jpeg_quality"] = args.jpeg_quality
+        options["depth_no_hit"] = args.depth_no_hit
+        options["stamp"] = args.stamp
     if args.to == "mcap":
         options["compression"] = None if args.compression == "none" else args.compression
     if args.to == "original-h5":

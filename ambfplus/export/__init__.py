@@ -6,7 +6,7 @@ Formats (``FORMATS``):
   per camera and pass (raw, or as lossless PNG/TIFF CompressedImage with ``image_topics``,
   ``ambfplus.export.images``), CameraInfo, point clouds, TF, the drill's wrench, the removal
   log and the critical-structure events (``ambfplus.export.ros`` lists the topics).
-- ``rosbag2``: the same messages as a rosbag2 folder (``metadata.yaml`` and MCAP storage).
+- ``rosbag2``: the same messages as a rosbag2 folder (``metadata.yaml`` and ``<name>_0.mcap``).
 - ``original-h5``: the original system's HDF5 layout (volumetric_drilling data_record v3,
   ``ambfplus.export.original_h5``).
 - ``coco``: COCO instance annotations (RLE masks) per camera, with the RGB frames as PNG
@@ -42,8 +42,23 @@ INDEX = "index.jsonl"
 MANIFEST_KEYS = ("episode", "file", "sha256")
 # The options each format takes (keyword arguments of export()).
 OPTIONS = {
-    "mcap": ("point_clouds", "compression", "image_topics", "rgb_codec", "jpeg_quality"),
-    "rosbag2": ("point_clouds", "image_topics", "rgb_codec", "jpeg_quality"),
+    "mcap": (
+        "point_clouds",
+        "compression",
+        "image_topics",
+        "rgb_codec",
+        "jpeg_quality",
+        "depth_no_hit",
+        "stamp",
+    ),
+    "rosbag2": (
+        "point_clouds",
+        "image_topics",
+        "rgb_codec",
+        "jpeg_quality",
+        "depth_no_hit",
+        "stamp",
+    ),
     "original-h5": ("chunk_size", "names"),
     "coco": ("images",),
 }
@@ -106,7 +121,8 @@ def export(source, out, to: str, *, force: bool = False, progress: bool | None =
     (one of FORMATS). ``force`` replaces an existing output; ``progress`` shows a bar (None:
     only on a terminal). Options go to the format (``OPTIONS``): ``point_clouds``,
     ``image_topics`` ("raw", "compressed" or "both"), ``rgb_codec`` ("png" or "jpeg"),
-    ``jpeg_quality`` (mcap, rosbag2), ``compression`` (mcap), ``chunk_size``, ``names``
+    ``jpeg_quality``, ``depth_no_hit`` ("nan" or "zero"), ``stamp`` ("sim" or "wall") (mcap,
+    rosbag2), ``compression`` (mcap), ``chunk_size``, ``names``
     (original-h5), ``images`` (coco). A source is a recording's head file (a dataset's shard)
     or a dataset folder, which gives one result per shard."""
     check_format(to, options)
@@ -125,6 +141,8 @@ def export(source, out, to: str, *, force: bool = False, progress: bool | None =
 def _export_one(recording, temporary: Path, out: Path, to: str, progress, options):
     started = time.perf_counter()
     frames = _frames_to_write(recording, to)
+    if to == "rosbag2":  # its data file is named after the folder it will have
+        options = {**options, "bag_name": out.name}
     with progress_bar(frames, f"{recording.path.name} -> {to}", progress) as bar:
         details = _writer(to)(recording, temporary, bar, **options)
     return ExportResult(recording.path, out, to, details.pop("frames", frames),

@@ -153,6 +153,37 @@ def export_conventions(recording) -> dict:
     }
 
 
-def frame_name(name: str, kind: str) -> str:
-    """The TF frame of an object: cameras are optical frames (OpenCV axes, REP 103 naming)."""
-    return f"{name}_optical_frame" if kind == "camera" else name
+# The optical frame (OpenCV axes: x right, y down, z forward) in the camera's body frame
+# (REP 103: x forward, y left, z up): its columns are the optical axes in body coordinates.
+LINK_FROM_OPTICAL = np.array(
+    [[0.0, 0.0, 1.0, 0.0], [-1.0, 0.0, 0.0, 0.0], [0.0, -1.0, 0.0, 0.0], [0.0, 0.0, 0.0, 1.0]]
+)
+
+
+def tf_frame(name: str, namespace: str = "") -> str:
+    """The TF frame id of an object: its own name, under its namespace where it has one
+    (``/ambf/env/`` + ``drill`` -> ``ambf/env/drill``), without a leading slash (tf2 refuses
+    frame ids that start with one)."""
+    space = namespace.strip("/")
+    return f"{space}/{name}" if space else name
+
+
+def camera_frames(name: str, namespace: str = "") -> tuple[str, str]:
+    """A camera's two TF frames: its body frame ``<camera>_link`` (REP 103 axes) and, its
+    child by ``LINK_FROM_OPTICAL``, the optical frame ``<camera>_optical_frame`` (OpenCV
+    axes) that images, camera_info and point clouds are stamped with."""
+    base = tf_frame(name, namespace)
+    return f"{base}_link", f"{base}_optical_frame"
+
+
+def link_pose(world_from_optical: np.ndarray) -> np.ndarray:
+    """world-from-link of a camera from its recorded world-from-optical pose."""
+    return np.asarray(world_from_optical, dtype=np.float64) @ np.linalg.inv(LINK_FROM_OPTICAL)
+
+
+def frame_name(name: str, kind: str, namespace: str = "") -> str:
+    """The TF frame that stamps an object's data: a camera's optical frame, any other object's
+    own frame (``tf_frame``). The live view and the ROS exports share this rule."""
+    if kind == "camera":
+        return camera_frames(name, namespace)[1]
+    return tf_frame(name, namespace)

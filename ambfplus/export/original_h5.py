@@ -76,6 +76,12 @@ VOXEL_README = (
     "[group, r, g, b, a] in 0-255. A group is the voxels removed in one physics step, stamped "
     "by voxel_time_stamp[group]. Groups restart at 0 in every file.\n"
 )
+# The ambfplus group's attributes that describe the layout and its camera poses.
+LAYOUT_NOTE = "volumetric_drilling data_record v3 (metadata_v3, vision_data, physics_data)"
+CAMERA_POSES_NOTE = (
+    "pose_main_camera and camera high-frequency poses are "
+    "T_world_ambf_camera = T_world_cv @ T_cv_ambf (camera_extrinsic)"
+)
 DEFAULT_NAMES = {"drill": "mastoidectomy_drill", "camera": "main_camera",
                  "volume": "mastoidectomy_volume"}  # fmt: skip
 
@@ -393,11 +399,9 @@ class OriginalLayout:
         conventions = export_conventions(self.rec)
         for key, value in conventions.items():
             group.attrs[key] = value
-        group.attrs["layout"] = "volumetric_drilling data_record v3 (metadata_v3, vision_data, "
-        "physics_data)"
+        group.attrs["layout"] = LAYOUT_NOTE
         group.attrs["names"] = json.dumps({v: k for k, v in self.names.items()}, sort_keys=True)
-        group.attrs["camera_poses"] = "pose_main_camera and camera high-frequency poses are "
-        "T_world_ambf_camera = T_world_cv @ T_cv_ambf (camera_extrinsic)"
+        group.attrs["camera_poses"] = CAMERA_POSES_NOTE
         group.attrs["warnings"] = json.dumps(self.warnings)
         if self.right is not None and len(self.right):
             self._dataset(group, "camera_intrinsic_right", np.asarray(self.right.intrinsics[0]))

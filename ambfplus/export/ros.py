@@ -8,7 +8,9 @@ topic                           type                         content
 ==============================  ===========================  ==================================
 ``/S/image_rect_color``         sensor_msgs/Image            rgb8
 ``/S/depth/image_rect``         sensor_msgs/Image            32FC1, metres along the optical
-                                                             axis, 0 where nothing was hit
+                                                             axis, NaN where nothing was hit
+                                                             (REP 118; ``depth_no_hit="zero"``
+                                                             keeps the recording's 0)
 ``/S/label/image``              sensor_msgs/Image            16UC1 anatomy label ids (0 = none)
 ``/S/instance/image``           sensor_msgs/Image            32SC1 object ids (0 = background)
 ``/S/voxel/image``              sensor_msgs/Image            32SC1 voxel index, -1 = none
@@ -19,14 +21,19 @@ topic                           type                         content
                                                              16UC1) or TIFF (32-bit) form,
                                                              lossless; JPEG for rgb as an option
                                                              (``ambfplus.export.images``)
-``/S/camera_info``              sensor_msgs/CameraInfo       K, P in ROS's pixel convention
+``/S/camera_info``,             sensor_msgs/CameraInfo       K, P in ROS's pixel convention,
+``/S/<pass>/camera_info``                                    beside every image topic (depth,
+                                                             label, instance, voxel,
+                                                             segmentation): the same message
 ``/S/points``                   sensor_msgs/PointCloud2      organised, optical frame: x y z
                                                              (float32, NaN where no hit), rgb
                                                              (packed float32), instance (int32),
                                                              label (uint16)
-``/tf``                         tf2_msgs/TFMessage           world -> cameras (at their frames),
-                                                             bodies and drills (every step)
-``/tf_static``                  tf2_msgs/TFMessage           world -> volumes
+``/tf``                         tf2_msgs/TFMessage           world -> ``<camera>_link`` (at
+                                                             their frames), bodies and drills
+                                                             (every step)
+``/tf_static``                  tf2_msgs/TFMessage           world -> volumes; ``<camera>_link``
+                                                             -> ``<camera>_optical_frame``
 ``/D/wrench``                   geometry_msgs/WrenchStamped  force fed back to the device (N),
                                                              world axes; torque 0
 ``/drilling/removed_voxels``    sensor_msgs/PointCloud2      voxels removed in a step: x y z
@@ -37,8 +44,15 @@ topic                           type                         content
 ==============================  ===========================  ==================================
 
 Conventions: header stamps and log times are simulation time (nanoseconds since the session
-started, not Unix time). Camera frames are optical frames ``<camera>_optical_frame`` (x right, y
-down, z forward). CameraInfo follows ROS: pixel centres at integer coordinates, so
+started, not Unix time) by default; ``stamp="wall"`` adds the recording's wall-clock start (its
+``created`` time), so that stamps are Unix time. A camera has a body frame ``<camera>_link``
+(REP 103: x forward, y left, z up), posed in the world, and its child the optical frame
+``<camera>_optical_frame`` (x right, y down, z forward), which stamps its images. Other frames
+are named after their objects (``tf_frame``: the legend's name under its namespace, if any).
+Every channel states its ``offered_qos_profiles`` as rosbag2 writes them: ``/tf_static``
+reliable and transient local (latched), the others reliable and volatile. Message definitions
+are ROS 2 Jazzy's (``ros_distro: jazzy``; the same for these types since Humble).
+CameraInfo follows ROS: pixel centres at integer coordinates, so
 ``cx_ros = cx - 0.5`` and ``cy_ros = cy - 0.5`` from ambfplus's intrinsics (which centre pixel
 (r, c) at (c + 0.5, r + 0.5)); R is the identity (views are rectified), no distortion; a
 stereo rig's right camera has P[0, 3] = Tx = -fx * baseline and its own, shifted principal
@@ -49,26 +63,37 @@ from __future__ import annotations
 
 import functools
 import heapq
+import io
 import json
+import posixpath
 from collections.abc import Iterator
 from dataclasses import dataclass, field
+from datetime import datetime, timezone
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
+from .. import __version__
 from ._common import (
+    LINK_FROM_OPTICAL,
     ExportError,
     StepClock,
+    camera_frames,
     export_conventions,
-    frame_name,
+    link_pose,
     nanoseconds,
     quaternion_xyzw,
     require,
+    tf_frame,
 )
 from .images import COMPRESSED_IMAGE, check_image_options, compressed_image_message
 
 WORLD = "world"
 TYPESTORE = "ROS2_JAZZY"  # the message definitions (ROS 2 Jazzy's; unchanged since Humble)
+ROS_DISTRO = "jazzy"  # what the files say they hold, as rosbag2 writes it
+DEPTH_NO_HIT = ("nan", "zero")
+STAMPS = ("sim", "wall")
 
 # pass -> (topic suffix, ROS encoding)
 IMAGE_TOPICS = {
@@ -227,13 +252,90 @@ def _rays(shape: tuple[int, int], k: tuple) -> np.ndarray:
     return rays
 
 
+def check_ros_options(depth_no_hit: str, stamp: str) -> None:
+    """Raises ExportError for a depth_no_hit or stamp that is not one of the known values."""
+    if depth_no_hit not in DEPTH_NO_HIT:
+        raise ExportError(f"depth_no_hit (--depth-no-hit) is one of {', '.join(DEPTH_NO_HIT)}, "
+                          f"not {depth_no_hit!r}")  # fmt: skip
+    if stamp not in STAMPS:
+        raise ExportError(f"stamp (--stamp) is one of {', '.join(STAMPS)}, not {stamp!r}")
+
+
+def wall_clock_start(recording) -> int:
+    """The recording's wall-clock start (its ``created`` attribute, ISO 8601; UTC where it
+    names no zone) as integer nanoseconds since the Unix epoch."""
+    created = recording.created
+    try:
+        when = datetime.fromisoformat(str(created))
+    except ValueError:
+        when = None
+    if not created or when is None:
+        raise ExportError(f"{recording.path}: stamp 'wall' (--stamp wall) needs the recording's "
+                          f"wall-clock start, an ISO 8601 'created' time; it has {created!r}: "
+                          "export with stamp 'sim'")  # fmt: skip
+    if when.tzinfo is None:
+        when = when.replace(tzinfo=timezone.utc)
+    since = when - datetime(1970, 1, 1, tzinfo=timezone.utc)
+    return (since.days * 86400 + since.seconds) * 10**9 + since.microseconds * 1000
+
+
+def info_topics(stream: str, passes) -> list[str]:
+    """The CameraInfo topics of a stream: ``/S/camera_info`` and one beside every other image
+    topic (``/S/depth/camera_info`` beside ``/S/depth/image_rect``), as image_transport pairs
+    them."""
+    topics = [f"/{stream}/camera_info"]
+    for pass_name in passes:
+        if pass_name in IMAGE_TOPICS:
+            topic = posixpath.join(posixpath.dirname(f"/{stream}/{IMAGE_TOPICS[pass_name][0]}"),
+                                   "camera_info")  # fmt: skip
+            if topic not in topics:
+                topics.append(topic)
+    return topics
+
+
+def depth_with_nan(depth: np.ndarray) -> np.ndarray:
+    """A depth image with NaN where nothing was hit (recorded as 0), as REP 118 asks."""
+    depth = np.asarray(depth, dtype=np.float32)
+    return np.where(depth > 0, depth, np.float32(np.nan))
+
+
+def qos_profiles(topic: str) -> list:
+    """The offered QoS of a topic, as rosbags' Qos: /tf_static latched (reliable, transient
+    local, keep last 1), the others reliable, volatile, keep last 10."""
+    interfaces = require("export", "rosbags.interfaces")
+    latched = topic == "/tf_static"
+    zero = interfaces.QosTime(0, 0)
+    return [interfaces.Qos(
+        interfaces.QosHistory.KEEP_LAST, 1 if latched else 10,
+        interfaces.QosReliability.RELIABLE,
+        interfaces.QosDurability.TRANSIENT_LOCAL if latched else interfaces.QosDurability.VOLATILE,
+        zero, zero, interfaces.QosLiveliness.AUTOMATIC, zero, False,
+    )]  # fmt: skip
+
+
+def qos_yaml(topic: str) -> str:
+    """The ``offered_qos_profiles`` text of a topic, as rosbag2 (format 9) and rosbags write
+    it into an MCAP channel's metadata."""
+    metadata, yaml = require("export", "rosbags.rosbag2.metadata", "ruamel.yaml")
+    stream = io.StringIO()
+    dumper = yaml.YAML(typ="safe")
+    dumper.default_flow_style = False
+    dumper.dump(metadata.dump_qos_v9(qos_profiles(topic)), stream)
+    return stream.getvalue().strip()
+
+
 class RosExport:
     """Turns a recording into time-ordered ROS 2 messages (see the module docstring)."""
 
     def __init__(self, recording, *, point_clouds: bool = True, image_topics: str = "raw",
-                 rgb_codec: str = "png", jpeg_quality: int = 90) -> None:  # fmt: skip
+                 rgb_codec: str = "png", jpeg_quality: int = 90, depth_no_hit: str = "nan",
+                 stamp: str = "sim") -> None:  # fmt: skip
         check_image_options(image_topics, rgb_codec, jpeg_quality)
+        check_ros_options(depth_no_hit, stamp)
         self.rec = recording
+        self.depth_no_hit, self.stamp = depth_no_hit, stamp
+        # ns added to simulation time: the recording's wall-clock start for stamp "wall".
+        self.offset = wall_clock_start(recording) if stamp == "wall" else 0
         self.point_clouds = point_clouds
         self.raw_images = image_topics in ("raw", "both")
         self.compressed_images = image_topics in ("compressed", "both")
@@ -280,8 +382,21 @@ class RosExport:
             return None
         return np.asarray(entry["dimensions"], float), np.asarray(entry["shape"], int)
 
+    def _frame(self, name: str) -> str:
+        """The TF frame of a legend object (its namespace from the legend, where it has one)."""
+        return tf_frame(name, (self.names.get(name) or {}).get("namespace") or "")
+
+    def _camera_frames(self, stream) -> tuple[str, str]:
+        """(body, optical) frames of a stream's camera."""
+        entry = self.names.get(stream.camera) or {}
+        return camera_frames(stream.camera, entry.get("namespace") or "")
+
     def _camera_frame(self, stream) -> str:
-        return frame_name(stream.camera, "camera")
+        return self._camera_frames(stream)[1]
+
+    def _ns(self, seconds) -> int:
+        """A stamp and log time (ns) of a simulation time (s): see ``stamp``."""
+        return nanoseconds(seconds) + self.offset
 
     def _pose_columns(self) -> dict[str, np.ndarray]:
         """Step-log pose columns of objects other than recorded cameras: name -> (N, 4, 4)."""
@@ -310,12 +425,13 @@ class RosExport:
                         out[topic] = IMAGE
                     if self.compressed_images:
                         out[f"{topic}/compressed"] = COMPRESSED_IMAGE
-            out[f"/{name}/camera_info"] = CAMERA_INFO
+            for topic in info_topics(name, stream.passes):
+                out[topic] = CAMERA_INFO
             if self.point_clouds and "depth" in stream.passes:
                 out[f"/{name}/points"] = POINT_CLOUD
         if self.rec.cameras or self._pose_columns():
             out["/tf"] = TF
-        if self._static_poses():
+        if self.rec.cameras or self._static_poses():
             out["/tf_static"] = TF
         for drill in self._drills():
             out[f"/{drill}/wrench"] = WRENCH
@@ -344,31 +460,36 @@ class RosExport:
     def describe(self) -> dict:
         """The export's own metadata: conventions, topics, frames, legend, warnings."""
         topics = self.topics()
-        frames = {
-            WORLD: "the simulation's world frame (right-handed, z up)",
-            **{
-                self._camera_frame(s): f"optical frame of camera {s.camera} (OpenCV axes: x "
-                "right, y down, z forward)"
-                for s in self.rec.cameras.values()
-            },
-            **{n: f"{self._kind(n)} {n}" for n in self._pose_columns()},
-            **{
-                n: f"volume {n} (centred on its grid; voxel (i, j, k) centre at (i + 0.5) s - "
-                "D / 2 along x, y, z)"
-                for n in self._static_poses()
-            },  # fmt: skip
-        }
+        frames = {WORLD: "the simulation's world frame (right-handed, z up)"}
+        for s in self.rec.cameras.values():
+            link, optical = self._camera_frames(s)
+            frames[link] = (f"body frame of camera {s.camera} (REP 103 axes: x forward, y "
+                            "left, z up), posed in the world")  # fmt: skip
+            frames[optical] = (f"optical frame of camera {s.camera} (OpenCV axes: x right, y "
+                               f"down, z forward), child of {link}; stamps its images")  # fmt: skip
+        frames.update({self._frame(n): f"{self._kind(n)} {n}" for n in self._pose_columns()})
+        frames.update({
+            self._frame(n): f"volume {n} (centred on its grid; voxel (i, j, k) centre at "
+            "(i + 0.5) s - D / 2 along x, y, z)"
+            for n in self._static_poses()
+        })  # fmt: skip
         return {
             **export_conventions(self.rec),
-            "message_definitions": f"ROS 2 ({TYPESTORE} type store of rosbags)",
-            "time_stamps": "header stamps and log times are simulation time in nanoseconds",
+            "message_definitions": f"ROS 2 {ROS_DISTRO} ({TYPESTORE} type store of rosbags)",
+            "ros_distro": ROS_DISTRO,
+            "time_stamps": self._stamp_description(),
+            "qos": "offered_qos_profiles on every topic: /tf_static reliable, transient local "
+            "(latched), keep last 1; the others reliable, volatile, keep last 10",
             "pixel_convention": "CameraInfo K and P centre pixels on integers (ROS, OpenCV): "
             "cx_ros = cx_ambfplus - 0.5, cy_ros = cy_ambfplus - 0.5",
             "stereo": "the right camera's P has Tx = -fx * baseline and its own principal "
             "point (shifted for an off-axis rig); P maps left-optical-frame points to right "
             "pixels",
-            "encodings": "rgb8 colour and segmentation; 32FC1 depth in metres (0 = no hit); "
-            "16UC1 label ids; 32SC1 instance ids and voxel indices (-1 = none)",
+            "encodings": "rgb8 colour and segmentation; 32FC1 depth in metres ("
+            + ("NaN = no hit, REP 118" if self.depth_no_hit == "nan" else "0 = no hit")
+            + "); 16UC1 label ids; 32SC1 instance ids and voxel indices (-1 = none)",
+            "camera_info": "sensor_msgs/CameraInfo beside every image topic of a camera (the "
+            "same K, P, frame and stamp)",
             "compressed_images": self._compressed_description(),
             "point_clouds": "organised, optical frame, NaN where nothing was hit; rgb packed "
             "0x00RRGGBB as float32",
@@ -379,6 +500,13 @@ class RosExport:
             "recording_metadata": json.dumps(self.rec.metadata, sort_keys=True, default=str),
             "warnings": json.dumps(self.warnings),
         }
+
+    def _stamp_description(self) -> str:
+        if self.stamp == "wall":
+            return (f"header stamps and log times are Unix time in nanoseconds: the recording's "
+                    f"wall-clock start ({self.rec.created}) plus simulation time")  # fmt: skip
+        return ("header stamps and log times are simulation time in nanoseconds since the "
+                "session started (not Unix time)")  # fmt: skip
 
     def _compressed_description(self) -> str:
         if not self.compressed_images:
@@ -407,14 +535,17 @@ class RosExport:
     def _camera_messages(self, stream) -> Iterator[Message]:
         frame_id = self._camera_frame(stream)
         partner = self._stereo.get(stream.name)
+        infos = info_topics(stream.name, stream.passes)
         for index in range(len(stream)):
             frame = stream[index]
-            t = nanoseconds(frame.time)
+            t = self._ns(frame.time)
             for pass_name in stream.passes:
                 if pass_name not in IMAGE_TOPICS:
                     continue
                 suffix, encoding = IMAGE_TOPICS[pass_name]
                 topic, image = f"/{stream.name}/{suffix}", getattr(frame, pass_name)
+                if pass_name == "depth" and self.depth_no_hit == "nan":
+                    image = depth_with_nan(image)
                 if self.raw_images:
                     yield Message(t, 1, topic, IMAGE, image_message(t, frame_id, image, encoding))
                 if self.compressed_images:
@@ -432,7 +563,8 @@ class RosExport:
                     )
                 tx = -frame.intrinsics[0, 0] * baseline
             body = camera_info(t, frame_id, frame.width, frame.height, frame.intrinsics, tx)
-            yield Message(t, 1, f"/{stream.name}/camera_info", CAMERA_INFO, body)
+            for topic in infos:
+                yield Message(t, 1, topic, CAMERA_INFO, body)
             if self.point_clouds and frame.depth is not None:
                 yield Message(t, 1, f"/{stream.name}/points", POINT_CLOUD,
                               self._cloud(t, frame_id, frame))  # fmt: skip
@@ -450,14 +582,14 @@ class RosExport:
         return point_cloud(t, frame_id, columns, h, w)
 
     def _camera_tf(self) -> Iterator[Message]:
-        """world -> each camera's optical frame at the times its frames were taken (one
-        message per time, holding every camera filmed then)."""
+        """world -> each camera's body frame at the times its frames were taken (one message
+        per time, holding every camera filmed then); its optical frame is on /tf_static."""
         by_time: dict[int, list] = {}
         for stream in self.rec.cameras.values():
             times, poses = stream.time[:], stream.pose[:]
+            link = self._camera_frames(stream)[0]
             for time, pose in zip(times, poses):
-                by_time.setdefault(nanoseconds(time), []).append((self._camera_frame(stream),
-                                                                  pose))  # fmt: skip
+                by_time.setdefault(self._ns(time), []).append((link, link_pose(pose)))
         for t in sorted(by_time):
             transforms = [transform(t, WORLD, child, pose) for child, pose in by_time[t]]
             yield Message(t, 0, "/tf", TF, {"transforms": transforms})
@@ -469,18 +601,25 @@ class RosExport:
         steps = self.rec.steps
         times = steps["time"]
         names = sorted(columns)
+        frames = [self._frame(n) for n in names]
         for row in range(len(times)):
-            t = nanoseconds(times[row])
+            t = self._ns(times[row])
             transforms = [
-                transform(t, WORLD, frame_name(n, self._kind(n)), columns[n][row]) for n in names
+                transform(t, WORLD, frame, columns[n][row]) for n, frame in zip(names, frames)
             ]
             yield Message(t, 0, "/tf", TF, {"transforms": transforms})
 
     def _static_tf(self) -> Iterator[Message]:
-        poses = self._static_poses()
-        if poses:
-            transforms = [transform(0, WORLD, name, pose) for name, pose in sorted(poses.items())]
-            yield Message(0, 0, "/tf_static", TF, {"transforms": transforms})
+        """One latched message at the start: world -> fixed volumes, and each camera's body
+        frame -> its optical frame."""
+        t = self._ns(0.0)
+        transforms = [transform(t, WORLD, self._frame(name), pose)
+                      for name, pose in sorted(self._static_poses().items())]  # fmt: skip
+        for stream in self.rec.cameras.values():
+            link, optical = self._camera_frames(stream)
+            transforms.append(transform(t, link, optical, LINK_FROM_OPTICAL))
+        if transforms:
+            yield Message(t, 0, "/tf_static", TF, {"transforms": transforms})
 
     def _wrenches(self) -> Iterator[Message]:
         steps = self.rec.steps
@@ -490,7 +629,7 @@ class RosExport:
         times = steps["time"]
         forces = {d: steps[f"{d}.force"] for d in drills}
         for row in range(len(times)):
-            t = nanoseconds(times[row])
+            t = self._ns(times[row])
             for drill in drills:
                 f = forces[drill][row]
                 body = {
@@ -519,9 +658,9 @@ class RosExport:
             columns = {"x": centres[:, 0], "y": centres[:, 1], "z": centres[:, 2],
                        "i": voxels[:, 0], "j": voxels[:, 1], "k": voxels[:, 2],
                        "label": removed["label"][start:stop]}  # fmt: skip
-            t = nanoseconds(time)
-            yield Message(t, 3, "/drilling/removed_voxels", POINT_CLOUD,
-                          point_cloud(t, volume, columns, 1, stop - start))  # fmt: skip
+            t = self._ns(time)
+            cloud = point_cloud(t, self._frame(volume), columns, 1, stop - start)
+            yield Message(t, 3, "/drilling/removed_voxels", POINT_CLOUD, cloud)
 
     def _events(self) -> Iterator[Message]:
         events = self.rec.events
@@ -533,7 +672,7 @@ class RosExport:
         for event in events:
             by_step.setdefault(event["step"], []).append(event)
         for step in sorted(by_step):
-            t = nanoseconds(float(self.clock([step])[0]))
+            t = self._ns(float(self.clock([step])[0]))
             statuses = []
             for event in by_step[step]:
                 name = (labels.get(event["label"]) or {}).get("name", f"label {event['label']}")
@@ -550,7 +689,8 @@ class RosExport:
                         ("voxel_k", voxel[2]))],
                 })  # fmt: skip
             yield Message(t, 4, "/drilling/events", DIAGNOSTICS,
-                          {"header": header(t, volume or WORLD), "status": statuses})  # fmt: skip
+                          {"header": header(t, self._frame(volume) if volume else WORLD),
+                           "status": statuses})  # fmt: skip
 
 
 # Writers --------------------------------------------------------------------------------------
@@ -560,20 +700,6 @@ def typestore():
     """rosbags' type store of the message definitions used here."""
     typesys = require("export", "rosbags.typesys")
     return typesys.get_typestore(getattr(typesys.Stores, TYPESTORE))
-
-
-def for_mcap_ros2(value):
-    """A message tree as mcap-ros2-support's encoder takes it: uint8 arrays as bytes, other
-    arrays as lists."""
-    if isinstance(value, dict):
-        return {k: for_mcap_ros2(v) for k, v in value.items()}
-    if isinstance(value, list):
-        return [for_mcap_ros2(v) for v in value]
-    if isinstance(value, np.ndarray):
-        return value.tobytes() if value.dtype == np.uint8 else value.tolist()
-    if isinstance(value, np.generic):
-        return value.item()
-    return value
 
 
 _NUMPY_TYPES = {"bool": np.bool_, "byte": np.uint8, "char": np.uint8, "int8": np.int8,
@@ -610,35 +736,51 @@ def _rosbags_field(store, node: str, detail, raw):
 
 
 class McapSink:
-    """Writes messages to an MCAP file with ROS 2 CDR encoding (mcap-ros2-support)."""
+    """Writes messages to an MCAP file (``mcap``) as ROS 2 CDR (serialised by rosbags), with
+    each channel's ``offered_qos_profiles`` and no empty summary group (no attachment index:
+    the file holds no attachments)."""
 
     def __init__(self, path: Path, compression: str | None = "zstd") -> None:
-        writer_module, mcap_writer = require("export", "mcap_ros2.writer", "mcap.writer")
+        mcap_writer = require("export", "mcap.writer")
         kinds = {"zstd": "ZSTD", "lz4": "LZ4", None: "NONE"}
         if compression not in kinds:
             raise ExportError(f"MCAP compression is zstd, lz4 or None, not {compression!r}")
+        indexes = mcap_writer.IndexType
         self._file = open(path, "wb")  # noqa: SIM115 (closed by close())
-        self._writer = writer_module.Writer(
+        self._writer = mcap_writer.Writer(
             self._file,
             chunk_size=4 * 1024 * 1024,
             compression=getattr(mcap_writer.CompressionType, kinds[compression]),
+            index_types=indexes.CHUNK | indexes.MESSAGE | indexes.METADATA,
         )
+        self._writer.start(profile="ros2", library=f"ambfplus {__version__} ({ROS_DISTRO})")
         self._store = typestore()
-        self._schemas: dict[str, object] = {}
+        self._schemas: dict[str, int] = {}
+        self._channels: dict[str, int] = {}
         self._sequence: dict[str, int] = {}
 
-    def write(self, message: Message) -> None:
-        schema = self._schemas.get(message.msgtype)
-        if schema is None:
-            text, _ = self._store.generate_msgdef(message.msgtype, ros_version=2)
-            schema = self._schemas[message.msgtype] = self._writer.register_msgdef(
-                message.msgtype, text
+    def _channel(self, topic: str, msgtype: str) -> int:
+        channel = self._channels.get(topic)
+        if channel is None:
+            schema = self._schemas.get(msgtype)
+            if schema is None:
+                text, _ = self._store.generate_msgdef(msgtype, ros_version=2)
+                schema = self._schemas[msgtype] = self._writer.register_schema(
+                    msgtype, "ros2msg", text.encode()
+                )
+            channel = self._channels[topic] = self._writer.register_channel(
+                topic, "cdr", schema, metadata={"offered_qos_profiles": qos_yaml(topic)}
             )
+        return channel
+
+    def write(self, message: Message) -> None:
+        channel = self._channel(message.topic, message.msgtype)
+        body = for_rosbags(self._store, message.body, message.msgtype)
+        data = self._store.serialize_cdr(body, message.msgtype)
         sequence = self._sequence.get(message.topic, 0)
         self._sequence[message.topic] = sequence + 1
-        self._writer.write_message(message.topic, schema, for_mcap_ros2(message.body),
-                                   log_time=message.time, publish_time=message.time,
-                                   sequence=sequence)  # fmt: skip
+        self._writer.add_message(channel, log_time=message.time, data=bytes(data),
+                                 publish_time=message.time, sequence=sequence)  # fmt: skip
 
     def close(self, metadata: dict[str, str]) -> None:
         try:
@@ -651,34 +793,59 @@ class McapSink:
         self._file.close()
 
 
-class Rosbag2Sink:
-    """Writes messages to a rosbag2 folder (metadata.yaml + MCAP storage, zstd chunks) with
-    rosbags, which also serialises them (CDR)."""
+def _rosbag2_writer(rosbag2, path: Path, name: str):
+    """rosbags' rosbag2 writer, naming its MCAP file ``<name>_0.mcap`` as ROS 2 does (rosbags
+    names it after the folder, which is a temporary one here) and stating ``ros_distro``."""
+    plugins = rosbag2.Writer.STORAGE_PLUGINS
+    storage: Any = plugins[rosbag2.StoragePlugin.MCAP]
 
-    def __init__(self, path: Path, topics: dict[str, str]) -> None:
-        rosbag2, interfaces = require("export", "rosbags.rosbag2", "rosbags.interfaces")
+    class NamedStorage(storage):
+        def __init__(self, folder: Path, compression) -> None:
+            super().__init__(folder, compression)
+            target: Path = folder / f"{name}_0.mcap"
+            # Open for writing: the name changes, the file and its handle stay.
+            Path(folder / f"{folder.name}.mcap").rename(target)
+            self.path = target
+
+        def close(self, version: int, metadata: str) -> None:
+            super().close(version, with_ros_distro(metadata))
+
+    class Writer(rosbag2.Writer):
+        STORAGE_PLUGINS = {**plugins, rosbag2.StoragePlugin.MCAP: NamedStorage}
+
+    return Writer(path, version=9, storage_plugin=rosbag2.StoragePlugin.MCAP)
+
+
+def with_ros_distro(text: str, key: str | None = None) -> str:
+    """rosbag2 metadata (YAML) with ``ros_distro`` set to ROS_DISTRO (under ``key`` where
+    given); rosbags writes its own name there."""
+    yaml = require("export", "ruamel.yaml")
+    loader = yaml.YAML(typ="safe")
+    loader.default_flow_style = False
+    data = loader.load(text)
+    (data[key] if key else data)["ros_distro"] = ROS_DISTRO
+    stream = io.StringIO()
+    loader.dump(data, stream)
+    return stream.getvalue() if key else stream.getvalue().strip()
+
+
+class Rosbag2Sink:
+    """Writes messages to a rosbag2 folder as ROS 2 names its files (``metadata.yaml`` and
+    ``<name>_0.mcap``, zstd chunks) with rosbags, which also serialises them (CDR)."""
+
+    def __init__(self, path: Path, topics: dict[str, str], name: str | None = None) -> None:
+        rosbag2 = require("export", "rosbags.rosbag2")
         self._store = typestore()
-        self._writer = rosbag2.Writer(path, version=9,
-                                      storage_plugin=rosbag2.StoragePlugin.MCAP)  # fmt: skip
+        self._path = path
+        self._writer = _rosbag2_writer(rosbag2, path, name or path.name)
         self._writer.set_compression(rosbag2.CompressionMode.STORAGE,
                                      rosbag2.CompressionFormat.ZSTD)  # fmt: skip
         self._writer.open()
-        # /tf_static is latched in ROS 2 (transient local): players must republish it.
-        latched = interfaces.Qos(
-            interfaces.QosHistory.KEEP_LAST, 1, interfaces.QosReliability.RELIABLE,
-            interfaces.QosDurability.TRANSIENT_LOCAL, interfaces.QosTime(0, 0),
-            interfaces.QosTime(0, 0), interfaces.QosLiveliness.AUTOMATIC,
-            interfaces.QosTime(0, 0), False,
-        )  # fmt: skip
         self._connections = {
-            topic: self._writer.add_connection(
-                topic,
-                msgtype,
-                typestore=self._store,
-                offered_qos_profiles=[latched] if topic == "/tf_static" else [],
-            )  # fmt: skip
+            topic: self._writer.add_connection(topic, msgtype, typestore=self._store,
+                                               offered_qos_profiles=qos_profiles(topic))
             for topic, msgtype in topics.items()
-        }
+        }  # fmt: skip
 
     def write(self, message: Message) -> None:
         body = for_rosbags(self._store, message.body, message.msgtype)
@@ -689,6 +856,8 @@ class Rosbag2Sink:
         for key, value in metadata.items():
             self._writer.set_custom_data(f"ambfplus.{key}", value)
         self._writer.close()
+        yaml_path = self._path / "metadata.yaml"
+        yaml_path.write_text(with_ros_distro(yaml_path.read_text(), "rosbag2_bagfile_information"))
 
     def abort(self) -> None:
         self._writer.abort()
@@ -696,19 +865,24 @@ class Rosbag2Sink:
 
 def write_ros(recording, out: Path, kind: str, bar, *, point_clouds: bool = True,
               compression: str | None = "zstd", image_topics: str = "raw",
-              rgb_codec: str = "png", jpeg_quality: int = 90) -> dict:  # fmt: skip
+              rgb_codec: str = "png", jpeg_quality: int = 90, depth_no_hit: str = "nan",
+              stamp: str = "sim", bag_name: str | None = None) -> dict:  # fmt: skip
     """Writes a recording as an MCAP file (kind "mcap") or a rosbag2 folder ("rosbag2") at
     ``out`` (a path that does not exist yet); returns counts per topic. ``image_topics``:
     "raw" (sensor_msgs/Image), "compressed" (sensor_msgs/CompressedImage; ``rgb_codec`` "png"
-    or "jpeg" at ``jpeg_quality``) or "both"."""
+    or "jpeg" at ``jpeg_quality``) or "both". ``depth_no_hit``: "nan" (REP 118) or "zero"
+    where depth saw nothing; ``stamp``: "sim" (simulation time) or "wall" (the recording's
+    wall-clock start + simulation time). ``bag_name`` names a rosbag2 folder's data file
+    (``<bag_name>_0.mcap``; the folder's name by default)."""
     export = RosExport(recording, point_clouds=point_clouds, image_topics=image_topics,
-                       rgb_codec=rgb_codec, jpeg_quality=jpeg_quality)  # fmt: skip
+                       rgb_codec=rgb_codec, jpeg_quality=jpeg_quality,
+                       depth_no_hit=depth_no_hit, stamp=stamp)  # fmt: skip
     topics = export.topics()
     sink: McapSink | Rosbag2Sink
     if kind == "mcap":
         sink = McapSink(out, compression)
     else:
-        sink = Rosbag2Sink(out, topics)
+        sink = Rosbag2Sink(out, topics, bag_name)
     counts = {topic: 0 for topic in topics}
     frame_topics = {f"/{name}/camera_info" for name in recording.cameras}
     try:

@@ -172,6 +172,20 @@ def read_with_rosbags(path: Path) -> list[tuple[str, str, int, object]]:
     return sorted(out, key=lambda m: m[2])
 
 
+def exported_image(stream, pass_name: str, index: int) -> np.ndarray:
+    """A recorded pass as the ROS exports write it by default: depth NaN where nothing was
+    hit (REP 118; recorded as 0), the other passes unchanged."""
+    image = getattr(stream, pass_name)[index]
+    return np.where(image > 0, image, np.float32(np.nan)) if pass_name == "depth" else image
+
+
+def same_image(got: np.ndarray, expected: np.ndarray) -> bool:
+    """Equal arrays, NaN equal to NaN (depth), dtypes too."""
+    return got.dtype == expected.dtype and np.array_equal(
+        got, expected, equal_nan=expected.dtype.kind == "f"
+    )
+
+
 def stamp_ns(message) -> int:
     return message.header.stamp.sec * 10**9 + message.header.stamp.nanosec
 
@@ -242,8 +256,8 @@ def test_ros_exports_read_back_equal_to_the_recording(session, exported, reader,
                 for index, (msgtype, _, message) in enumerate(got):
                     assert msgtype == "sensor_msgs/msg/Image"
                     assert message.header.frame_id == f"{stream.camera}_optical_frame"
-                    expected = getattr(stream, pass_name)[index]
-                    assert np.array_equal(image_array(message), expected), (name, pass_name)
+                    expected = exported_image(stream, pass_name, index)
+                    assert same_image(image_array(message), expected), (name, pass_name)
             assert len(by_topic[f"/{name}/camera_info"]) == len(by_topic[f"/{name}/points"]) \
                 == len(stream)  # fmt: skip
         # Counts: TF at every step and at every frame time, a wrench every step, removal
@@ -388,7 +402,202 @@ def test_ros_exports_state_their_conventions(exported):
     text = (bag / "metadata.yaml").read_text()
     assert "ambfplus.ambfplus_version" in text and "storage_identifier: mcap" in text
     # /tf_static is latched, as ROS 2 players expect.
-    assert "durability: 1" in text or "transient_local" in text
+    assert "durability: transient_local" in text
+
+
+IMAGE_NAMESPACES = ("", "/depth", "/label", "/instance", "/voxel", "/segmentation")
+
+
+@pytest.mark.parametrize("which", ["mcap", "rosbag2"])
+def test_ros_exports_follow_ros_conventions(session, exported, which):
+    """Depth is NaN where nothing was hit (REP 118); a camera_info sits beside every image
+    topic with the camera's K and P; each camera has a <camera>_link body frame (REP 103) in
+    /tf whose latched child is the optical frame the images are stamped with."""
+    messages = read_with_rosbags(exported[0] if which == "mcap" else exported[1])
+    by_topic: dict[str, list] = {}
+    for topic, _, _, message in messages:
+        by_topic.setdefault(topic, []).append(message)
+    with open_recording(session) as rec:
+        for name, stream in rec.cameras.items():
+            optical, link = f"{stream.camera}_optical_frame", f"{stream.camera}_link"
+            depth = np.stack([image_array(m) for m in by_topic[f"/{name}/depth/image_rect"]])
+            recorded = stream.depth[:]
+            assert (recorded == 0).any() and (recorded > 0).any()  # both kinds of pixel
+            assert np.array_equal(np.isnan(depth), recorded == 0)
+            assert np.array_equal(depth[recorded > 0], recorded[recorded > 0])
+            infos = {ns: by_topic[f"/{name}{ns}/camera_info"] for ns in IMAGE_NAMESPACES}
+            for ns, got in infos.items():
+                assert len(got) == len(stream), (name, ns)
+                for index, (info, first) in enumerate(zip(got, infos[""])):
+                    assert info.header.frame_id == optical
+                    assert stamp_ns(info) == int(round(stream.time[index] * 1e9))
+                    assert np.array_equal(info.k, first.k) and np.array_equal(info.p, first.p)
+                    k = np.reshape(info.k, (3, 3))
+                    assert k[0, 0] == pytest.approx(stream.intrinsics[index][0, 0])
+            # TF: world -> link at every frame, link -> optical latched, no world -> optical.
+            dynamic = [t for m in by_topic["/tf"] for t in m.transforms]
+            assert not [t for t in dynamic if t.child_frame_id == optical]
+            links = [t for t in dynamic if t.child_frame_id == link]
+            assert [stamp_ns(t) for t in links] == [int(round(x * 1e9)) for x in stream.time]
+            assert {t.header.frame_id for t in links} == {"world"}
+            static = [
+                t for t in by_topic["/tf_static"][0].transforms if t.child_frame_id == optical
+            ]
+            assert len(static) == 1 and static[0].header.frame_id == link
+            q = static[0].transform.rotation
+            assert (q.x, q.y, q.z, q.w) == pytest.approx((-0.5, 0.5, -0.5, 0.5))
+            for t, pose in zip(links, stream.pose[:]):
+                world_link = transform_matrix(t)
+                # REP 103 body axes: x forward (the optical z), y left (-x), z up (-y).
+                assert world_link[:3, 0] == pytest.approx(pose[:3, 2], abs=1e-9)
+                assert world_link[:3, 1] == pytest.approx(-pose[:3, 0], abs=1e-9)
+                assert world_link[:3, 2] == pytest.approx(-pose[:3, 1], abs=1e-9)
+                assert world_link[:3, 3] == pytest.approx(pose[:3, 3], abs=1e-12)
+        # The drill and the volume are frames named after their objects.
+        volume = next(e["name"] for e in rec.legend.values() if e["kind"] == "volume")
+        assert {t.child_frame_id for t in by_topic["/tf_static"][0].transforms} >= {volume}
+        assert "drill" in {t.child_frame_id for t in by_topic["/tf"][-1].transforms}
+        assert {m.header.frame_id for m in by_topic["/drilling/removed_voxels"]} == {volume}
+
+
+def qos_of(text: str) -> list[dict]:
+    import yaml
+
+    profiles = yaml.safe_load(text)
+    assert isinstance(profiles, list) and len(profiles) == 1, text
+    return profiles
+
+
+def test_ros_exports_state_qos_distro_and_rosbag2_names(exported):
+    """Every MCAP channel offers its QoS as rosbag2 writes it (/tf_static transient local,
+    the others volatile, all reliable), the same in the rosbag2 folder; both files say
+    ros_distro jazzy; the folder holds <name>_0.mcap and metadata.yaml, which points to it."""
+    import yaml
+
+    mcap_path, bag = exported
+    assert sorted(p.name for p in bag.iterdir()) == ["bag_0.mcap", "metadata.yaml"]
+    info = yaml.safe_load((bag / "metadata.yaml").read_text())["rosbag2_bagfile_information"]
+    assert info["ros_distro"] == "jazzy" and info["version"] == 9
+    assert info["relative_file_paths"] == ["bag_0.mcap"]
+    assert [f["path"] for f in info["files"]] == ["bag_0.mcap"]
+    in_yaml = {t["topic_metadata"]["name"]: t["topic_metadata"]["offered_qos_profiles"]
+               for t in info["topics_with_message_count"]}  # fmt: skip
+    for path in (mcap_path, bag / "bag_0.mcap"):
+        with open(path, "rb") as f:
+            reader = make_reader(f)
+            channels = reader.get_summary().channels.values()
+            metadata = {m.name: m.metadata for m in reader.iter_metadata()}
+        assert {c.topic for c in channels} == set(in_yaml)
+        for channel in channels:
+            (profile,) = qos_of(channel.metadata["offered_qos_profiles"])
+            latched = channel.topic == "/tf_static"
+            assert profile["reliability"] == "reliable", channel.topic
+            assert profile["durability"] == ("transient_local" if latched else "volatile")
+            assert profile["history"] == "keep_last" and profile["depth"] == (1 if latched else 10)
+            assert in_yaml[channel.topic] == [profile], channel.topic  # MCAP and rosbag2 agree
+        if path == mcap_path:
+            assert metadata["ambfplus"]["ros_distro"] == "jazzy"
+        else:
+            embedded = yaml.safe_load(metadata["rosbag2"]["serialized_metadata"])
+            assert embedded["ros_distro"] == "jazzy"
+            assert embedded["relative_file_paths"] == ["bag_0.mcap"]
+
+
+def test_mcap_summary_passes_the_specs_checks(exported):
+    """The MCAP summary as the specification (and `mcap doctor`) checks it: every summary
+    offset names a non-empty group holding only records of its opcode, the statistics count
+    the channels, schemas, chunks and messages that are there, and no attachment index is
+    written for a file without attachments."""
+    from mcap.records import Attachment, AttachmentIndex, SummaryOffset
+    from mcap.stream_reader import StreamReader
+
+    for path in (exported[0], exported[1] / "bag_0.mcap"):
+        data = path.read_bytes()
+        with open(path, "rb") as f:
+            records = list(StreamReader(f, skip_magic=False).records)
+        offsets = [r for r in records if isinstance(r, SummaryOffset)]
+        assert offsets and all(o.group_length > 0 for o in offsets), offsets
+        for offset in offsets:
+            group = data[offset.group_start : offset.group_start + offset.group_length]
+            position = 0
+            while position < len(group):
+                assert group[position] == offset.group_opcode, (path.name, offset)
+                length = int.from_bytes(group[position + 1 : position + 9], "little")
+                position += 9 + length
+            assert position == len(group)
+        assert not [r for r in records if isinstance(r, (Attachment, AttachmentIndex))]
+        with open(path, "rb") as f:
+            reader = make_reader(f)
+            summary = reader.get_summary()
+            messages = sum(1 for _ in reader.iter_messages())
+        stats = summary.statistics
+        assert stats.message_count == messages == sum(stats.channel_message_counts.values())
+        assert stats.channel_count == len(summary.channels) > 0
+        assert stats.schema_count == len(summary.schemas) > 0
+        assert stats.chunk_count == len(summary.chunk_indexes) > 0
+        assert stats.attachment_count == 0
+
+
+def test_ros_exports_take_wall_stamps_and_zero_depth(session, tmp_path):
+    """--stamp wall: every stamp and log time is the recording's wall-clock start (its
+    created time) plus the simulation time; --depth-no-hit zero keeps the recorded 0."""
+    from datetime import datetime
+
+    with open_recording(session) as rec:
+        start = int(round(datetime.fromisoformat(rec.created).timestamp() * 1e6)) * 1000
+        frame_times = [int(round(t * 1e9)) for t in rec.cameras["rig_left"].time[:]]
+        depth = rec.cameras["rig_left"].depth[:]
+        step_times = [int(round(t * 1e9)) for t in rec.steps["time"]]
+    assert start > 1.7e18  # after 2023: Unix time
+    completed = run_cli(tmp_path, str(session), "--to", "rosbag2", str(tmp_path / "wall"),
+                        "--stamp", "wall", "--depth-no-hit", "zero", "--no-points",
+                        "--quiet")  # fmt: skip
+    assert completed.returncode == 0, completed.stderr
+    export(session, tmp_path / "wall.mcap", "mcap", stamp="wall", depth_no_hit="zero",
+           point_clouds=False, progress=False)  # fmt: skip
+    for path in (tmp_path / "wall", tmp_path / "wall.mcap"):
+        for reader in (read_with_rosbags, read_with_mcap):
+            by_topic: dict[str, list] = {}
+            for topic, _, log_time, message in reader(path):
+                by_topic.setdefault(topic, []).append((log_time, message))
+                if hasattr(message, "header"):
+                    assert stamp_ns(message) == log_time
+            images = by_topic["/rig_left/depth/image_rect"]
+            assert [t for t, _ in images] == [start + t for t in frame_times]
+            assert [t for t, _ in by_topic["/drill/wrench"]] == [start + t for t in step_times]
+            static = by_topic["/tf_static"][0][1].transforms
+            assert {stamp_ns(t) for t in static} == {start}
+            got = np.stack([image_array(m) for _, m in images])
+            assert np.array_equal(got, depth) and not np.isnan(got).any()
+    info = (tmp_path / "wall" / "metadata.yaml").read_text()
+    assert f"nanoseconds_since_epoch: {start}" in info
+    assert sorted(p.name for p in (tmp_path / "wall").iterdir()) == ["metadata.yaml",
+                                                                      "wall_0.mcap"]  # fmt: skip
+
+
+def test_ros_options_are_checked(session, tmp_path):
+    cases = [
+        ({"depth_no_hit": "inf"}, "depth_no_hit (--depth-no-hit) is one of nan, zero, not 'inf'"),
+        ({"stamp": "utc"}, "stamp (--stamp) is one of sim, wall, not 'utc'"),
+    ]
+    for options, message in cases:
+        for to in ("mcap", "rosbag2"):
+            with pytest.raises(ExportError, match=re.escape(message)):
+                export(session, tmp_path / "x", to, progress=False, **options)
+            assert list(tmp_path.iterdir()) == []
+    completed = run_cli(tmp_path, str(session), "--to", "mcap", str(tmp_path / "x.mcap"),
+                        "--stamp", "utc")  # fmt: skip
+    assert completed.returncode != 0 and "--stamp" in completed.stderr
+    assert "'utc'" in completed.stderr and "sim" in completed.stderr
+    # A recording whose created time is no date cannot be stamped with wall-clock time.
+    path = tmp_path / "undated.h5"
+    with Recorder(path, created="yesterday") as recorder:
+        recorder.set_legend(TINY_LEGEND)
+        recorder.add_frame("cam", tiny_frame("cam", 10))
+    with pytest.raises(ExportError, match=r"stamp 'wall' \(--stamp wall\) needs .*'yesterday'"):
+        export(path, tmp_path / "u.mcap", "mcap", stamp="wall", progress=False)
+    assert not (tmp_path / "u.mcap").exists()
+    assert export(path, tmp_path / "u.mcap", "mcap", progress=False).frames == 1
 
 
 def test_events_become_diagnostics(tmp_path):
@@ -650,11 +859,14 @@ def test_coco_masks_decode_to_the_instance_images(session, tmp_path):
         legend = rec.legend
         label_names = {label["name"] for e in legend.values() if e["kind"] == "volume"
                        for label in e["labels"].values()}  # fmt: skip
-        object_names = {e["name"] for e in legend.values() if e["kind"] in ("body", "volume")}
+        object_names = {e["name"] for e in legend.values() if e["kind"] == "body"}
         for name, stream in rec.cameras.items():
             coco = COCO(str(out / f"{name}.json"))
             categories = {c["id"]: c for c in coco.loadCats(coco.getCatIds())}
-            assert {c["name"] for c in categories.values()} == label_names | object_names
+            # Objects, and the anatomy labels the frames show (no catch-all volume category).
+            anatomy = {c["name"] for c in categories.values() if c["supercategory"] == "anatomy"}
+            assert {c["name"] for c in categories.values()} - anatomy == object_names
+            assert anatomy and anatomy <= label_names
             for index in range(len(stream)):
                 frame = stream[index]
                 image = coco.loadImgs(index + 1)[0]
@@ -955,11 +1167,11 @@ def test_compressed_image_topics_round_trip(session, tmp_path, which):
                         assert message.format == formats[pass_name]
                         assert stamp_ns(message) == log_time
                         assert message.header.frame_id == f"{stream.camera}_optical_frame"
-                        expected = getattr(stream, pass_name)[index]
+                        expected = exported_image(stream, pass_name, index)
                         for decoded in (decode_with_opencv(message),
                                         decode_image(message.format, message.data)):  # fmt: skip
                             assert decoded.dtype == expected.dtype, (name, pass_name)
-                            assert np.array_equal(decoded, expected), (name, pass_name)
+                            assert same_image(decoded, expected), (name, pass_name)
     # JPEG for rgb, compressed topics only; the rest stays lossless.
     jpeg = tmp_path / ("jpeg.mcap" if which == "mcap" else "jpeg")
     export(session, jpeg, which, image_topics="compressed", rgb_codec="jpeg", jpeg_quality=95,
@@ -1047,8 +1259,8 @@ def check_export_reads_back(to: str, output: Path, recording) -> None:
                     got = by_topic[f"/{name}/{PASS_TOPICS[pass_name]}"]
                     assert [t for t, _ in got] == times, (name, pass_name)
                     for index, (_, message) in enumerate(got):
-                        expected = getattr(stream, pass_name)[index]
-                        assert np.array_equal(image_array(message), expected), (name, pass_name)
+                        expected = exported_image(stream, pass_name, index)
+                        assert same_image(image_array(message), expected), (name, pass_name)
                 assert len(by_topic[f"/{name}/camera_info"]) == len(stream)
             assert len(by_topic["/drill/wrench"]) == len(recording.steps["step"])
     elif to == "original-h5":

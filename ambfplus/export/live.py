@@ -10,8 +10,10 @@ It publishes, as ROS 2 messages (CDR, ``ros2msg`` schemas: the same types and co
 the ``mcap`` export), only on channels a client subscribed to, from two threads of its own:
 
 - at ``rate`` Hz of wall time (10 by default; ticks it misses are skipped, never caught up in a
-  burst): ``/tf`` (tf2_msgs/TFMessage: world -> each camera's optical frame, the drill, its
-  bodies and the volumes), ``/<camera>/camera_info`` (K and P in ROS's pixel convention),
+  burst): ``/tf`` (tf2_msgs/TFMessage: world -> each camera's ``<camera>_link`` -> its
+  ``<camera>_optical_frame``, and world -> the drill, its bodies and the volumes, each frame
+  named after its object, as the ``mcap`` export names them), ``/<camera>/camera_info`` (K
+  and P in ROS's pixel convention),
   ``/<drill>/wrench`` (geometry_msgs/WrenchStamped: the force fed back to the device, world
   axes) and ``/<drill>/critical`` (diagnostic_msgs/DiagnosticArray: every critical structure's
   distance from the burr, nearest first, level WARN under 2 mm, ERROR at 0). These are a few
@@ -32,10 +34,21 @@ lock for one batch of reads per tick, and encoding and sending happen off the lo
 client loses its oldest messages (the SDK's per-client backlog), it never stalls the publisher.
 It listens on 127.0.0.1 unless ``host`` says otherwise. Needs ``pip install
 "ambfplus[foxglove]"``.
+
+Clients name the protocol in the WebSocket handshake: ``foxglove.sdk.v1`` (Foxglove, the SDK's
+clients) or ``foxglove.websocket.v1`` (Lichtblick, older tools), the same protocol under its
+first name. The SDK's server accepts only the new name, so it listens on a loopback port of its
+own and a small relay holds the public one: it passes each connection through unchanged, except
+that a handshake offering only the old name reaches the SDK offering the new one and is
+answered with the name the client offered. The relay runs on a thread of its own and copies
+bytes as they come; the physics loop never waits for it.
 """
 
 from __future__ import annotations
 
+import asyncio
+import contextlib
+import socket
 import threading
 import time
 from collections import deque
@@ -44,7 +57,7 @@ from typing import Any
 
 import numpy as np
 
-from ._common import frame_name, nanoseconds, require
+from ._common import LINK_FROM_OPTICAL, camera_frames, link_pose, nanoseconds, require, tf_frame
 from .ros import (
     CAMERA_INFO,
     DIAGNOSTICS,
@@ -65,6 +78,14 @@ WARN_DISTANCE = 0.002  # m; as the launcher's status line
 DIAGNOSTIC_OK, DIAGNOSTIC_WARN, DIAGNOSTIC_ERROR = 0, 1, 2
 TIMINGS_KEPT = 1000  # the last tick and capture durations the statistics cover
 IDLE_POLL_S = 0.05  # how often the image thread looks for a subscriber while there is none
+# The protocol's names in the WebSocket handshake: the SDK's, then the one it had first.
+SUBPROTOCOL = "foxglove.sdk.v1"
+LEGACY_SUBPROTOCOL = "foxglove.websocket.v1"
+SUBPROTOCOLS = (SUBPROTOCOL, LEGACY_SUBPROTOCOL)
+HANDSHAKE_LIMIT = 64 * 1024  # bytes; a longer HTTP head is refused
+HANDSHAKE_TIMEOUT_S = 10.0  # a client that sends no complete head in this time is dropped
+RELAY_CHUNK = 256 * 1024  # bytes copied per read
+CLOSE_GRACE_S = 1.0  # on stop, how long relays may finish the SDK's closing handshakes
 
 
 def _durations() -> deque:
@@ -123,12 +144,14 @@ class FoxgloveServer:
         self.stats = LiveStats()
         self._store = typestore()
         self._server = None
+        self._relay: _SubprotocolRelay | None = None
         self._threads: list[threading.Thread] = []
         self._stop = threading.Event()
         self._errors: list[BaseException] = []
         # Objects whose pose /tf carries, chosen once.
         self._posed_objects = [o for o in world.objects if o.kind in ("body", "volume", "drill")]
-        self._posed = [o.name for o in self._posed_objects]
+        # (object name, its TF frame: the rule the ROS exports follow)
+        self._posed = [(o.name, tf_frame(o.name)) for o in self._posed_objects]
         # What each tick reads: the posed objects, the cameras, then the drill.
         self._read_objects = self._posed_objects + list(self.cameras)
         if self.drill is not None:
@@ -150,14 +173,26 @@ class FoxgloveServer:
         if self.drill is not None:
             self._channel(f"/{self.drill.name}/wrench", WRENCH)
             self._channel(f"/{self.drill.name}/critical", DIAGNOSTICS)
+        # The public port first, so that a port in use fails before anything starts.
         try:
-            self._server = fox.start_server(name=self.name, host=self.host,
-                                            port=self.requested_port, context=self._context,
-                                            message_backlog_size=64)  # fmt: skip
-        except Exception as error:  # the SDK raises RuntimeError for a port in use
+            listener = _listen(self.host, self.requested_port)
+        except OSError as error:
             raise RuntimeError(
                 f"the Foxglove server cannot listen on {self.host}:{self.requested_port}: {error}"
             ) from None
+        try:
+            server = fox.start_server(name=self.name, host="127.0.0.1", port=0,
+                                      context=self._context,
+                                      message_backlog_size=64)  # fmt: skip
+        except Exception as error:
+            listener.close()
+            raise RuntimeError(f"the Foxglove SDK's server did not start: {error}") from None
+        try:
+            self._relay = _SubprotocolRelay(listener, server.port)
+        except BaseException:
+            server.stop()
+            raise
+        self._server = server
         self._stop.clear()
         self._threads = [
             threading.Thread(target=self._guard, args=(self._run_state,), daemon=True,
@@ -174,9 +209,13 @@ class FoxgloveServer:
         for thread in self._threads:
             thread.join()
         self._threads = []
+        # The SDK's server first: it closes its connections, which the relay passes on.
         if self._server is not None:
             self._server.stop()
             self._server = None
+        if self._relay is not None:
+            self._errors += self._relay.stop()
+            self._relay = None
         for channel in getattr(self, "_channels", {}).values():
             channel.close()
         if self._errors:
@@ -192,7 +231,7 @@ class FoxgloveServer:
     @property
     def port(self) -> int:
         """The port it listens on (the one chosen when asked for port 0)."""
-        return self._server.port if self._server is not None else self.requested_port
+        return self._relay.port if self._relay is not None else self.requested_port
 
     @property
     def url(self) -> str:
@@ -278,11 +317,12 @@ class FoxgloveServer:
                 continue
             frame = camera.capture(passes=passes, poses=True)
             t = nanoseconds(frame.time)
-            frame_id = frame_name(camera.name, "camera")
+            link, frame_id = camera_frames(camera.name)
             if self._wanted("/tf"):  # first, so a client has the pose when the image comes
                 poses = frame.poses
-                transforms = [transform(t, WORLD, n, poses[n]) for n in self._posed if n in poses]
-                transforms.append(transform(t, WORLD, frame_id, frame.pose))
+                transforms = [transform(t, WORLD, child, poses[name])
+                              for name, child in self._posed if name in poses]  # fmt: skip
+                transforms += self._camera_transforms(t, link, frame_id, frame.pose)
                 self._send("/tf", t, {"transforms": transforms})
             for pass_name, encoding in (("rgb", "rgb8"), ("depth", "32FC1")):
                 image = getattr(frame, pass_name, None)
@@ -306,9 +346,9 @@ class FoxgloveServer:
         t = nanoseconds(state["time"])
         transforms = [transform(t, WORLD, child, pose) for child, pose in state["poses"]]
         for camera in self.cameras:
-            frame_id = frame_name(camera.name, "camera")
+            link, frame_id = camera_frames(camera.name)
             pose, intrinsics = state["cameras"][camera.name]
-            transforms.append(transform(t, WORLD, frame_id, pose))
+            transforms += self._camera_transforms(t, link, frame_id, pose)
             info_topic = f"/{camera.name}/camera_info"
             if self._wanted(info_topic):
                 self._send(info_topic, t, camera_info(t, frame_id, camera.width, camera.height,
@@ -329,6 +369,13 @@ class FoxgloveServer:
         if self._wanted(critical_topic):
             self._send(critical_topic, t, self._critical(t, state))
 
+    @staticmethod
+    def _camera_transforms(t: int, link: str, optical: str, pose) -> list[dict]:
+        """A camera's body frame in the world and its optical frame under it (REP 103; the
+        exports put the second on /tf_static, the live view sends both with each pose)."""
+        return [transform(t, WORLD, link, link_pose(pose)),
+                transform(t, link, optical, LINK_FROM_OPTICAL)]  # fmt: skip
+
     def publish(self) -> None:
         """One tick of everything: the state channels, then a round of images."""
         self.publish_state()
@@ -344,7 +391,7 @@ class FoxgloveServer:
         cameras = states[n : n + len(self.cameras)]
         state = {
             "time": read["time"],
-            "poses": [(name, s["pose"]) for name, s in zip(self._posed, states)],
+            "poses": [(frame, s["pose"]) for (_, frame), s in zip(self._posed, states)],
             "cameras": {
                 c.name: (s["pose"], s["intrinsics"]) for c, s in zip(self.cameras, cameras)
             },
@@ -368,7 +415,184 @@ class FoxgloveServer:
                 "hardware_id": self.drill.name,
                 "values": [{"key": "distance_m", "value": repr(float(distance))}],
             })  # fmt: skip
-        return {"header": header(t, self.drill.name), "status": statuses}
+        return {"header": header(t, tf_frame(self.drill.name)), "status": statuses}
+
+
+# The relay on the public port -----------------------------------------------------------------
+
+
+def _listen(host: str, port: int) -> socket.socket:
+    """A listening TCP socket on host:port (the first address the host resolves to)."""
+    family, _, _, _, address = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM,
+                                                  flags=socket.AI_PASSIVE)[0]  # fmt: skip
+    return socket.create_server(address[:2], family=family)
+
+
+def _header_lines(head: bytes) -> list[bytes]:
+    return head.split(b"\r\n")
+
+
+def _is_subprotocol_header(line: bytes) -> bool:
+    name, colon, _ = line.partition(b":")
+    return bool(colon) and name.strip().lower() == b"sec-websocket-protocol"
+
+
+def _offer_sdk_name(request: bytes) -> tuple[bytes, bool]:
+    """A client's HTTP upgrade request as the SDK accepts it: where the client offers the
+    protocol only under its old name, that name becomes the SDK's (other offers are kept).
+    Returns the request and whether it was renamed."""
+    lines = _header_lines(request)
+    offered = [token.strip() for line in lines[1:] if _is_subprotocol_header(line)
+               for token in line.partition(b":")[2].split(b",")]  # fmt: skip
+    if SUBPROTOCOL.encode() in offered or LEGACY_SUBPROTOCOL.encode() not in offered:
+        return request, False
+    renamed = []
+    for line in lines:
+        if line is not lines[0] and _is_subprotocol_header(line):
+            tokens = [t.strip() for t in line.partition(b":")[2].split(b",")]
+            tokens = [SUBPROTOCOL.encode() if t == LEGACY_SUBPROTOCOL.encode() else t
+                      for t in tokens]  # fmt: skip
+            line = b"Sec-WebSocket-Protocol: " + b", ".join(tokens)
+        renamed.append(line)
+    return b"\r\n".join(renamed), True
+
+
+def _answer_legacy_name(response: bytes) -> bytes:
+    """The SDK's handshake response as a client that offered the old name expects it: the
+    protocol it chose named as the client named it."""
+    lines = [b"Sec-WebSocket-Protocol: " + LEGACY_SUBPROTOCOL.encode()
+             if _is_subprotocol_header(line)
+             and line.partition(b":")[2].strip() == SUBPROTOCOL.encode() else line
+             for line in _header_lines(response)]  # fmt: skip
+    return b"\r\n".join(lines)
+
+
+class _SubprotocolRelay:
+    """Accepts connections on `listener` and relays each to the SDK's server on the loopback
+    `backend_port`, renaming the subprotocol in the handshake of a client that offers only
+    the old name (_offer_sdk_name, _answer_legacy_name); everything after the handshake is
+    copied unchanged both ways. An asyncio loop on a thread of its own."""
+
+    def __init__(self, listener: socket.socket, backend_port: int) -> None:
+        self.port: int = listener.getsockname()[1]
+        self.backend_port = backend_port
+        self.errors: list[BaseException] = []  # unexpected ones, reported by stop()
+        self._listener = listener
+        self._loop = asyncio.new_event_loop()
+        self._closing: asyncio.Event | None = None
+        self._connections: dict[asyncio.Task, list[asyncio.StreamWriter]] = {}
+        started = threading.Event()
+        self._thread = threading.Thread(target=self._run, args=(started,), daemon=True,
+                                        name="foxglove-relay")  # fmt: skip
+        self._thread.start()
+        started.wait()
+        if self.errors:
+            self._thread.join()
+            raise RuntimeError(f"the live view's relay did not start: {self.errors[0]!r}")
+
+    def stop(self) -> list[BaseException]:
+        """Stops accepting, lets open connections finish closing for up to CLOSE_GRACE_S,
+        cuts the rest and returns the unexpected errors met."""
+        if self._thread.is_alive():
+            self._loop.call_soon_threadsafe(self._close)
+            self._thread.join()
+        errors, self.errors = self.errors, []
+        return errors
+
+    def _close(self) -> None:
+        assert self._closing is not None, "set before the thread says it started"
+        self._closing.set()
+
+    def _run(self, started: threading.Event) -> None:
+        asyncio.set_event_loop(self._loop)
+        try:
+            self._loop.run_until_complete(self._main(started))
+        except BaseException as error:  # reported by stop()
+            self.errors.append(error)
+        finally:
+            started.set()
+            self._listener.close()
+            self._loop.close()
+
+    async def _main(self, started: threading.Event) -> None:
+        self._closing = asyncio.Event()
+        server = await asyncio.start_server(self._serve, sock=self._listener,
+                                            limit=HANDSHAKE_LIMIT)  # fmt: skip
+        started.set()
+        await self._closing.wait()
+        server.close()
+        # Cut the connections still in their handshake at once; the others pass on the SDK's
+        # closing (it stopped first) for up to CLOSE_GRACE_S, then are cut. Cut transports
+        # end their tasks (cancelling a connection's task makes asyncio log it on 3.11).
+        for writers in self._connections.values():
+            if len(writers) == 1:
+                writers[0].transport.abort()
+        if self._connections:
+            _, late = await asyncio.wait(list(self._connections), timeout=CLOSE_GRACE_S)
+            for task in late:
+                for writer in self._connections.get(task, []):
+                    writer.transport.abort()
+            if late:
+                await asyncio.wait(late, timeout=CLOSE_GRACE_S)
+        with contextlib.suppress(asyncio.TimeoutError):  # 3.12 waits for the connections too
+            await asyncio.wait_for(server.wait_closed(), CLOSE_GRACE_S)
+
+    async def _serve(self, client_reader: asyncio.StreamReader,
+                     client_writer: asyncio.StreamWriter) -> None:  # fmt: skip
+        task = asyncio.current_task()
+        assert task is not None, "a connection is served by a task"
+        writers = self._connections[task] = [client_writer]
+        try:
+            request = await asyncio.wait_for(client_reader.readuntil(b"\r\n\r\n"),
+                                             HANDSHAKE_TIMEOUT_S)  # fmt: skip
+            request, renamed = _offer_sdk_name(request)
+            backend_reader, backend_writer = await asyncio.open_connection(
+                "127.0.0.1", self.backend_port, limit=HANDSHAKE_LIMIT
+            )
+            writers.append(backend_writer)
+            backend_writer.write(request)
+            response = await asyncio.wait_for(backend_reader.readuntil(b"\r\n\r\n"),
+                                              HANDSHAKE_TIMEOUT_S)  # fmt: skip
+            client_writer.write(_answer_legacy_name(response) if renamed else response)
+            upstream = asyncio.ensure_future(_pump(client_reader, backend_writer))
+            downstream = asyncio.ensure_future(_pump(backend_reader, client_writer))
+            pumps = [upstream, downstream]
+            try:
+                # A connection ends with the SDK's side; where the client ends first, the SDK
+                # is told (a half close) and its end awaited.
+                done, _ = await asyncio.wait(pumps, return_when=asyncio.FIRST_COMPLETED)
+                if downstream not in done and upstream.exception() is None:
+                    await downstream
+            finally:
+                for pump in pumps:
+                    pump.cancel()
+                for result in await asyncio.gather(*pumps, return_exceptions=True):
+                    if isinstance(result, Exception):
+                        raise result
+        except (OSError, EOFError, asyncio.TimeoutError, asyncio.LimitOverrunError):
+            pass  # a peer that left, reset or never completed its HTTP head: dropped
+        except Exception as error:  # reported by stop()
+            self.errors.append(error)
+        finally:
+            for writer in writers:
+                writer.close()  # sends what is buffered first (the SDK's closing frame)
+            for writer in writers:
+                with contextlib.suppress(Exception):
+                    await writer.wait_closed()
+            del self._connections[task]
+
+
+async def _pump(reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
+    """Copies reader to writer as bytes come; at the reader's end, half-closes the writer so
+    that the other direction can finish its closing handshake."""
+    while True:
+        data = await reader.read(RELAY_CHUNK)
+        if not data:
+            break
+        writer.write(data)
+        await writer.drain()
+    if writer.can_write_eof():
+        writer.write_eof()
 
 
 def serve(world, cameras=None, **options) -> FoxgloveServer:

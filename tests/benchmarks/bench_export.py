@@ -3,7 +3,10 @@
 ``export``: a 640x480 stereo drilling session (rgb, depth, label, instance, voxel,
 segmentation every 50 ms) exported to each format, in MB/s of recorded image data and frames/s,
 against reading the same recording alone (every frame's passes and the step log) in the same
-run: ratio = export rate / read rate. Median and worst of the repetitions.
+run: ratio = export rate / read rate. Median and worst of the repetitions. Each line also gives
+the output's size per second of the session (``output_mb_per_session_s``), so the MCAP variants
+compare the image settings: raw (the default), compressed (PNG; TIFF for 32-bit passes) and
+JPEG rgb.
 
 ``foxglove_live``: the 1 kHz physics loop drilling the 128^3 phantom headless, without and with
 the Foxglove live view (its defaults: TF, calibration, force and critical structures at 10 Hz,
@@ -13,6 +16,11 @@ and the longest wait for the world's lock, each period over 2 ms and that wait a
 the host or to us by the realtime benchmark's witness (rt_witness.realtime_attribution:
 over_2ms_host, over_2ms_ours, over_2ms_unknown); the images and state messages the client
 received per second, and the image rate the server reports. Median and worst of the rounds.
+
+``foxglove_subprotocols``: two clients watching one live session (a 640x480 camera, the
+defaults) at once, one offering only ``foxglove.websocket.v1`` and one only ``foxglove.sdk.v1``,
+for 10 s: what each received per second (images, camera_info, TF, force, MB), each image rate
+against the rate the server reports, and the loop's p99 period.
 """
 
 from __future__ import annotations
@@ -118,17 +126,21 @@ def export_benchmark(args):
             "worst_mb_per_s": round(source_mb / worst, 1),
             "cpu_s_per_frame": round(statistics.median(c for _, c in runs[to]) / frames, 4),
             "output_mb": round(out_bytes[to] / 1e6, 2),
+            "output_mb_per_session_s": round(out_bytes[to] / 1e6 / seconds, 2),
             "what": f"export to {to} {options or ''}against reading the recording alone",
             **common,
         }
 
 
-def _live_client(url: str, stop: threading.Event, counts: dict) -> None:
-    """A Foxglove WebSocket client subscribed to every channel, counting what it receives
-    by topic (and bytes) from its subscription on."""
+def _live_client(url: str, stop: threading.Event, counts: dict,
+                 subprotocol: str = "foxglove.sdk.v1") -> None:  # fmt: skip
+    """A Foxglove WebSocket client offering only `subprotocol`, subscribed to every channel,
+    counting what it receives by topic (and bytes) from its subscription on."""
     from websockets.sync.client import connect
 
-    with connect(url, subprotocols=["foxglove.sdk.v1"], max_size=None) as connection:
+    with connect(url, subprotocols=[subprotocol], max_size=None) as connection:
+        if connection.subprotocol != subprotocol:
+            raise RuntimeError(f"offered {subprotocol}, answered {connection.subprotocol}")
         channels = []
         while len(channels) < 5:
             message = connection.recv(timeout=10)
@@ -150,10 +162,12 @@ def _live_client(url: str, stop: threading.Event, counts: dict) -> None:
         counts["until"] = time.perf_counter()
 
 
-def _live_round(seconds: float, size: tuple[int, int] | None, image_rate: float = 10.0) -> dict:
-    """One round of the 1 kHz loop drilling; `size`: the served camera's, None: no server. The
-    realtime benchmark's witness runs around the loop, so that each period over 2 ms is
-    attributed to the host or to us (rt_witness.realtime_attribution)."""
+def _live_round(seconds: float, size: tuple[int, int] | None, image_rate: float = 10.0,
+                subprotocols: tuple[str, ...] = ("foxglove.sdk.v1",)) -> dict:  # fmt: skip
+    """One round of the 1 kHz loop drilling; `size`: the served camera's, None: no server,
+    watched by one client per name in `subprotocols` at once (the first one's rates are the
+    round's). The realtime benchmark's witness runs around the loop, so that each period over
+    2 ms is attributed to the host or to us (rt_witness.realtime_attribution)."""
     from rt_witness import Witness, anchored, realtime_attribution
 
     from ambfplus.export.live import FoxgloveServer
@@ -174,36 +188,44 @@ def _live_round(seconds: float, size: tuple[int, int] | None, image_rate: float 
     world.add_input_device("hand", hand, drill)
     camera.capture()
     stop = threading.Event()
-    counts = {"bytes": 0}
+    counts: dict[str, dict] = {name: {"bytes": 0} for name in subprotocols}
     loop = ambfplus.RealTimeLoop(world)
     server = FoxgloveServer(world, [camera], image_rate=image_rate, port=0) if size else None
     first_index = world.step_index
     with Witness() as witness, loop, anchored(world, first_index, witness) as anchors:
-        client = None
+        clients = []
         if server is not None:
             server.start()
-            client = threading.Thread(target=_live_client, args=(server.url, stop, counts))
-            client.start()
+            clients = [threading.Thread(target=_live_client,
+                                        args=(server.url, stop, counts[name], name))
+                       for name in subprotocols]  # fmt: skip
+            for client in clients:
+                client.start()
         hand.set_target(into * 0.005, buttons=1)
         time.sleep(seconds)
         stop.set()
-        if client is not None:
+        for client in clients:
             client.join()
+        if server is not None:
             server.stop()
     s = loop.stats
     out = {"p99": s["p99"], "max": s["max"], "rate": s["mean_rate"], "over_2ms": s["over_2ms"],
            "lock_wait_max": s["lock_wait_max"], "lock_wait_p99": s["lock_wait_p99"],
            "attribution": realtime_attribution(s, anchors, witness, loop.scheduling)}  # fmt: skip
     if server is not None:
-        window = counts["until"] - counts["since"]
-        out.update(
-            images_per_s=counts.get("/cam/image_rect_color", 0) / window,
-            wrench_per_s=counts.get("/drill/wrench", 0) / window,
-            tf_per_s=counts.get("/tf", 0) / window,
-            mb_per_s=counts["bytes"] / 1e6 / window,
-            server=server.stats.summary(),
-        )
+        rates = {name: _client_rates(c) for name, c in counts.items()}
+        out.update(rates[subprotocols[0]], clients=rates, server=server.stats.summary())
     return out
+
+
+def _client_rates(counts: dict) -> dict:
+    """Messages (by topic) and MB a client received per second of its subscription."""
+    window = counts["until"] - counts["since"]
+    return {"images_per_s": counts.get("/cam/image_rect_color", 0) / window,
+            "camera_info_per_s": counts.get("/cam/camera_info", 0) / window,
+            "wrench_per_s": counts.get("/drill/wrench", 0) / window,
+            "tf_per_s": counts.get("/tf", 0) / window,
+            "mb_per_s": counts["bytes"] / 1e6 / window}  # fmt: skip
 
 
 def _ms(values) -> list[float]:
@@ -278,4 +300,30 @@ def foxglove_live(args):
         }
 
 
-BENCHMARKS = {"export": export_benchmark, "foxglove_live": foxglove_live}
+def foxglove_subprotocols(args):
+    """Two clients watching one live session at once, one offering only foxglove.websocket.v1
+    (Lichtblick's name for the protocol, relayed under the SDK's name), one only
+    foxglove.sdk.v1: the rates each received against the server's, and the loop's p99."""
+    seconds = 3.0 if args.quick else 10.0
+    names = ("foxglove.websocket.v1", "foxglove.sdk.v1")
+    run = _live_round(seconds, (640, 480), 10.0, subprotocols=names)
+    server = run["server"]
+    for name in names:
+        rates = run["clients"][name]
+        yield {
+            "bench": "foxglove_subprotocols_" + name.replace(".", "_"),
+            "value": round(rates["images_per_s"], 2),
+            "unit": "images/s received",
+            "baseline": server["image_rate_hz"],
+            "ratio": round(rates["images_per_s"] / max(server["image_rate_hz"], 1e-9), 3),
+            **{key: round(value, 2) for key, value in rates.items() if key != "images_per_s"},
+            "loop_p99_ms": round(run["p99"] * 1e3, 4),
+            "seconds": seconds,
+            "what": f"a client offering only {name}, beside one offering the other name, "
+            "watching a 640x480 camera of the 128^3 phantom (images up to 10 Hz, state 10 Hz): "
+            "what it received per second against the image rate the server reports",
+        }
+
+
+BENCHMARKS = {"export": export_benchmark, "foxglove_live": foxglove_live,
+              "foxglove_subprotocols": foxglove_subprotocols}  # fmt: skip

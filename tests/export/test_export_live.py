@@ -25,6 +25,8 @@ from mcap_ros2.decoder import DecoderFactory  # noqa: E402
 from ambfplus.export.live import FoxgloveServer  # noqa: E402
 
 SUBPROTOCOL = "foxglove.sdk.v1"
+# The protocol's first name, which Lichtblick and older clients offer: the same protocol.
+LEGACY_SUBPROTOCOL = "foxglove.websocket.v1"
 MESSAGE_DATA = 0x01  # binary opcode: subscription id (u32), log time (u64), payload
 
 
@@ -42,11 +44,12 @@ WANTED = ["/tf", "/rig_left/image_rect_color", "/rig_left/camera_info", "/drill/
           "/drill/critical"]  # fmt: skip
 
 
-def watch(server, seconds: float) -> dict[str, list]:
-    """Subscribes a WebSocket client to WANTED and decodes what it receives for `seconds`:
-    topic -> [(log time, message)]."""
-    with websockets_client.connect(server.url, subprotocols=[SUBPROTOCOL],
+def watch(server, seconds: float, subprotocol: str = SUBPROTOCOL) -> dict[str, list]:
+    """Subscribes a WebSocket client offering only `subprotocol` to WANTED and decodes what it
+    receives for `seconds`: topic -> [(log time, message)]."""
+    with websockets_client.connect(server.url, subprotocols=[subprotocol],
                                    max_size=None) as connection:  # fmt: skip
+        assert connection.subprotocol == subprotocol  # answered in the client's own words
         info = receive_json(connection, "serverInfo")
         assert info["name"] == "ambfplus"
         channels = {}
@@ -109,6 +112,7 @@ def test_a_client_watches_a_drilling_session_live():
         pixels = np.frombuffer(image.data, np.uint8).reshape(120, 160, 3)
         assert pixels.std() > 5  # the phantom, not an empty frame
         assert image.header.stamp.sec * 10**9 + image.header.stamp.nanosec == log_time
+        assert image.header.frame_id == "rig_left_optical_frame"
     stamps = [t for t, _ in images]
     assert stamps == sorted(stamps) and stamps[-1] > stamps[0]  # simulation time advances
     info = received["/rig_left/camera_info"][-1][1]
@@ -125,8 +129,11 @@ def test_a_client_watches_a_drilling_session_live():
     # /tf: the state's ticks and one per image, placing the camera at each image's stamp.
     tf = received["/tf"]
     frames = {t.child_frame_id for _, m in tf for t in m.transforms}
-    assert {"rig_left_optical_frame", "drill", "anatomy", "burr"} <= frames
+    assert {"rig_left_link", "rig_left_optical_frame", "drill", "anatomy", "burr"} <= frames
     optical = "rig_left_optical_frame"
+    # The optical frame under the camera's body frame (REP 103), the image's frame id.
+    parents = {x.child_frame_id: x.header.frame_id for _, m in tf for x in m.transforms}
+    assert parents[optical] == "rig_left_link" and parents["rig_left_link"] == "world"
     camera_stamps = {t for t, m in tf if any(x.child_frame_id == optical for x in m.transforms)}
     assert set(stamps) <= camera_stamps
     assert len(tf) >= len(received["/drill/wrench"])
@@ -157,6 +164,84 @@ def test_slow_images_do_not_slow_the_state_channels():
     assert len(images) / seconds == pytest.approx(stats["image_rate_hz"], rel=0.35, abs=1.0)
     for topic in ("/drill/wrench", "/drill/critical", "/rig_left/camera_info"):
         assert 0.7 * rate * seconds <= len(received[topic]) <= rate * seconds + 2, topic
+
+
+def test_the_live_view_answers_each_name_of_the_protocol_in_kind():
+    """A client offering foxglove.sdk.v1 or foxglove.websocket.v1 (alone, or beside names the
+    server does not speak) is answered with the name it offered and served; one offering
+    neither, or no subprotocol at all, is refused with HTTP 400."""
+    from websockets.exceptions import ConnectionClosed, InvalidStatus
+
+    world = ambfplus.World()
+    offers = {(SUBPROTOCOL,): SUBPROTOCOL, (LEGACY_SUBPROTOCOL,): LEGACY_SUBPROTOCOL,
+              ("example.v2", LEGACY_SUBPROTOCOL): LEGACY_SUBPROTOCOL,
+              (LEGACY_SUBPROTOCOL, SUBPROTOCOL): SUBPROTOCOL}  # fmt: skip
+    with FoxgloveServer(world, [], port=0) as server:
+        for offered, answer in offers.items():
+            with websockets_client.connect(server.url, subprotocols=list(offered)) as connection:
+                assert connection.subprotocol == answer, offered
+                assert receive_json(connection, "serverInfo")["name"] == "ambfplus"
+                topics = {c["topic"] for c in receive_json(connection, "advertise")["channels"]}
+                assert topics == {"/tf"}
+        for offered in (["example.v2"], None):
+            with pytest.raises(InvalidStatus) as refused:
+                websockets_client.connect(server.url, subprotocols=offered)
+            assert refused.value.response.status_code == 400, offered
+    # A client still connected when the server stops is closed, not left hanging.
+    server = FoxgloveServer(world, [], port=0).start()
+    with websockets_client.connect(server.url, subprotocols=[LEGACY_SUBPROTOCOL]) as connection:
+        receive_json(connection, "serverInfo")
+        server.stop()
+        with pytest.raises(ConnectionClosed):
+            while True:
+                connection.recv(timeout=10)
+
+
+@pytest.mark.slow
+def test_clients_of_either_protocol_name_watch_one_session():
+    """Two clients at once, one offering only foxglove.websocket.v1 (as Lichtblick does), one
+    only foxglove.sdk.v1: each receives the images, calibration and TF, decodable, at the rates
+    the server keeps (printed)."""
+    import threading
+
+    scene, hand = drilling_world(64, 160, 120)
+    world, rig = scene.world, scene.rig
+    rate, image_rate, seconds = 10.0, 10.0, 3.0
+    received: dict[str, dict] = {}
+    errors: list[BaseException] = []
+
+    def client(subprotocol: str) -> None:
+        try:
+            received[subprotocol] = watch(server, seconds, subprotocol)
+        except BaseException as error:  # raised below, in the test's thread
+            errors.append(error)
+
+    with ambfplus.RealTimeLoop(world), FoxgloveServer(world, [rig.left], rate=rate,
+                                                      image_rate=image_rate,
+                                                      port=0) as server:  # fmt: skip
+        hand.set_target((0.0, 0.0, -0.008), buttons=1)
+        threads = [threading.Thread(target=client, args=(name,))
+                   for name in (LEGACY_SUBPROTOCOL, SUBPROTOCOL)]  # fmt: skip
+        for thread in threads:
+            thread.start()
+        for thread in threads:
+            thread.join()
+        stats = server.stats.summary()
+    if errors:
+        raise errors[0]
+    for subprotocol, topics in received.items():
+        rates = {topic: round(len(messages) / seconds, 2) for topic, messages in topics.items()}
+        print(f"{subprotocol}: messages/s {rates}")
+        images = topics["/rig_left/image_rect_color"]
+        assert images, subprotocol
+        for _, image in images:
+            assert (image.encoding, image.width, image.height) == ("rgb8", 160, 120)
+            assert np.frombuffer(image.data, np.uint8).std() > 5  # the phantom
+        info = topics["/rig_left/camera_info"]
+        assert info and (info[-1][1].width, info[-1][1].height) == (160, 120), subprotocol
+        frames = {t.child_frame_id for _, m in topics["/tf"] for t in m.transforms}
+        assert {"rig_left_optical_frame", "drill"} <= frames, subprotocol
+    print(f"live view: {stats}")
 
 
 def test_the_live_view_says_when_its_port_is_taken():

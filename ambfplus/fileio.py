@@ -11,7 +11,7 @@ from __future__ import annotations
 import contextlib
 import os
 import shutil
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 
 
@@ -60,3 +60,28 @@ def write_bytes(path: Path, data: bytes) -> None:
     """Writes bytes to ``path`` whole (see the module)."""
     with written_whole(path) as temporary:
         temporary.write_bytes(data)
+
+
+class OwnInputError(ValueError):
+    """An output that would write over the command's own input."""
+
+
+def refuse_writing_over(out, inputs: Iterable, command: str, error: type = OwnInputError) -> None:
+    """Raises `error` if the output `out` is one of `inputs`, lies inside one (an input folder)
+    or holds one (an output folder that would be replaced or filled): a command never writes
+    over its own input, with --force or without. Paths are compared resolved (links followed),
+    and by identity where both exist (hard links); checked before anything is written."""
+    out = Path(out)
+    target = out.resolve()
+    for source in inputs:
+        source = Path(source)
+        found = source.resolve()
+        same = target == found or (
+            out.exists() and source.exists() and os.path.samefile(out, source)
+        )
+        if same or found in target.parents or target in found.parents:
+            relation = "is" if same else "lies inside" if found in target.parents else "holds"
+            raise error(
+                f"{out}: the output {relation} the input {source}; {command} never writes over "
+                "its own input (with --force or without): choose another output"
+            )

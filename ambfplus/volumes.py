@@ -7,6 +7,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from ._core import VolumeData, World, load_nrrd, load_slice_stack, write_label_table
+from .fileio import refuse_writing_over
 
 
 def load_volume(
@@ -61,6 +62,25 @@ def write_volume_adf(
     )
 
 
+def volume_sources(source: str | os.PathLike) -> list[Path]:
+    """The files and folders a volume is read from: the source, and for a volume ADF the slice
+    folders its volumes' ``images`` name (relative to the ADF)."""
+    path = Path(source)
+    found = [path]
+    if path.suffix.lower() in (".yaml", ".yml") and path.is_file():
+        import yaml
+
+        try:
+            blocks = yaml.safe_load(path.read_text())
+        except (OSError, UnicodeDecodeError, yaml.YAMLError):
+            return found  # the loader names what is wrong with it
+        for value in blocks.values() if isinstance(blocks, dict) else ():
+            images = value.get("images") if isinstance(value, dict) else None
+            if isinstance(images, dict) and isinstance(images.get("path"), str):
+                found.append(path.parent / images["path"])
+    return found
+
+
 def convert_volume(
     source: str | os.PathLike,
     output: str | os.PathLike,
@@ -74,7 +94,9 @@ def convert_volume(
 ) -> str:
     """Converts a volume (see load_volume for sources) to a slice stack with its ADF and label
     table (output is a folder), an NRRD label map (.nrrd) or a surface mesh (.stl, .ply).
-    Returns a one-line summary."""
+    Returns a one-line summary. An output that is the source, lies inside it or holds it (or
+    the slice folder a volume ADF names) is refused before anything is read or written."""
+    refuse_writing_over(output, volume_sources(source), "convert")
     data = load_volume(
         source,
         prefix=prefix,

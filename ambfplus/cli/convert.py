@@ -4,8 +4,10 @@ meshes."""
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
+from ..fileio import OwnInputError
 from ..volumes import convert_volume
 
 
@@ -48,8 +50,8 @@ def add_parser(commands) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Converts an anatomy volume and prints what it wrote."""
-    print(
-        convert_volume(
+    try:
+        summary = convert_volume(
             args.input,
             args.output,
             prefix=args.prefix,
@@ -59,5 +61,8 @@ def run(args: argparse.Namespace) -> int:
             threshold=args.threshold,
             label=args.label,
         )
-    )
+    except OwnInputError as error:
+        print(f"ambfplus convert: {error}", file=sys.stderr)
+        return 2
+    print(summary)
     return 0

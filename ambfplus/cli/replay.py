@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from pathlib import Path
 
 
@@ -25,16 +26,21 @@ def add_parser(commands) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Re-simulates a recording from its device readings, optionally re-rendering it."""
+    from ..fileio import OwnInputError
     from ..scenes import replay
 
-    report = replay(
-        args.recording,
-        out=args.out,
-        baseline=args.baseline,
-        width=args.width,
-        height=args.height,
-        progress=lambda line: print("  " + line, flush=True),
-    )
+    try:
+        report = replay(
+            args.recording,
+            out=args.out,
+            baseline=args.baseline,
+            width=args.width,
+            height=args.height,
+            progress=lambda line: print("  " + line, flush=True),
+        )
+    except OwnInputError as error:
+        print(f"ambfplus replay: {error}", file=sys.stderr)
+        return 2
     print(
         json.dumps(
             {

@@ -30,8 +30,9 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..fileio import written_whole
+from ..fileio import refuse_writing_over, written_whole
 from ..recording import RecordingError, open_recording
+from ..recording.schema import recording_files
 from ._common import ExportError, MissingExtra, check_output, progress_bar
 
 FORMATS = ("mcap", "rosbag2", "original-h5", "coco")
@@ -132,6 +133,7 @@ def export(source, out, to: str, *, force: bool = False, progress: bool | None =
     if source.name == MANIFEST:
         raise ExportError(f"{source} is a dataset's manifest: export its folder "
                           f"{source.parent} (every shard) or one shard's head file")  # fmt: skip
+    refuse_writing_over(out, recording_files(source), "export", ExportError)
     check_output(out, force)
     _writer(to)  # the extra's modules are imported before anything is opened
     with open_recording(source) as recording, written_whole(out) as temporary:
@@ -228,6 +230,7 @@ def export_dataset(folder: Path, out: Path, to: str, *, force: bool = False,
     names, with ``index.jsonl`` (one line per shard: its manifest fields, the output and
     counts). Checksums are verified first; a mismatch exports nothing."""
     check_format(to, options)
+    refuse_writing_over(out, [folder], "export", ExportError)
     check_output(out, force)
     entries = read_manifest(folder)
     verify_shards(folder, entries)

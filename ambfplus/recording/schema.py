@@ -135,6 +135,11 @@ def part_number(head: Path, candidate: Path) -> int | None:
     return int(match.group(1)) if match else None
 
 
+def recording_files(head: Path) -> list[Path]:
+    """A recording's files on disk: its head and its closed parts."""
+    return [Path(head)] + [path for _, path in find_parts(Path(head))]
+
+
 def find_parts(head: Path) -> list[tuple[int, Path]]:
     """Closed segments on disk, sorted by number (temporary files excluded)."""
     found = []

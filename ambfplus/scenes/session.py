@@ -29,7 +29,9 @@ from pathlib import Path
 import numpy as np
 
 from .._core import Device, ReplayDevice
+from ..fileio import refuse_writing_over
 from ..recording import Recorder, open_recording
+from ..recording.schema import recording_files
 from ..transforms import make_pose
 from .builders import Scene, build_scene
 
@@ -177,6 +179,8 @@ def replay(
 ) -> ReplayReport:
     """Re-simulates a recording from its device readings and re-renders its frames (see the
     module). With `out`, writes the re-rendered session as a new recording."""
+    if out is not None:
+        refuse_writing_over(out, recording_files(Path(path)), "replay")
     with open_recording(path) as rec:
         meta = rec.metadata
         steps = rec.steps

@@ -35,15 +35,32 @@ class Where:
         return self.error_type(f"{self.source}: {path or 'the file'}: {message}")
 
 
+# The largest phantom a spec or task may ask for, and what it costs: its label grid and the
+# drill's distance fields grow with the cube of the resolution.
+MAX_PHANTOM_RESOLUTION = 512
+PHANTOM_LIMIT = "a 512^3 phantom takes about 1 GB with its drill's distance fields"
+
+
 def load_yaml(path: Path, error: type = ConfigError, what: str = "YAML"):
-    """A YAML file's content; a missing file or bad YAML raises `error` naming the file (and the
-    line and column)."""
+    """A YAML file's content; a missing file, one that is not a regular file, bad YAML or an
+    alias (``*name``: a few lines of aliases can expand to billions of nodes) raises `error`
+    naming the file (and the line and column)."""
     import yaml
 
     if not path.is_file():
+        if path.exists():
+            raise error(f"{path}: not a regular file (a {what} file is read whole)")
         raise error(f"{path}: no such {what} file")
     text = path.read_text()
     try:
+        for event in yaml.parse(text, Loader=yaml.SafeLoader):
+            if isinstance(event, yaml.AliasEvent):
+                mark = event.start_mark
+                at = f"line {mark.line + 1}, column {mark.column + 1}: " if mark else ""
+                raise error(
+                    f"{path}: {at}YAML aliases (*{event.anchor}) are not allowed in a {what} "
+                    "file: write the value out"
+                )
         return yaml.safe_load(text), text
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
@@ -73,8 +90,10 @@ def keys(value: dict, where: Where, required=(), optional=()) -> None:
         raise where.error(missing[0], "missing (required)")
 
 
-def number(value, where: Where, minimum=None, maximum=None, integer=False, strict=False):
-    """A number (bool refused) within bounds; `strict`: strictly above `minimum`."""
+def number(value, where: Where, minimum=None, maximum=None, integer=False, strict=False,
+           limit: str = ""):  # fmt: skip
+    """A number (bool refused) within bounds; `strict`: strictly above `minimum`; `limit`: why
+    the maximum is what it is (what a larger value would cost), for the error."""
     ok = isinstance(value, int) if integer else isinstance(value, (int, float))
     if isinstance(value, bool) or not ok or (not integer and not math.isfinite(value)):
         raise where.error(
@@ -85,12 +104,13 @@ def number(value, where: Where, minimum=None, maximum=None, integer=False, stric
             None, f"expected a value {'>' if strict else '>='} {minimum}, got {value}"
         )
     if maximum is not None and value > maximum:
-        raise where.error(None, f"expected a value <= {maximum}, got {value}")
+        why = f" ({limit})" if limit else ""
+        raise where.error(None, f"expected a value <= {maximum}, got {value}{why}")
     return value if integer else float(value)
 
 
-def integer(value, where: Where, minimum=None, maximum=None) -> int:
-    return number(value, where, minimum, maximum, integer=True)
+def integer(value, where: Where, minimum=None, maximum=None, limit: str = "") -> int:
+    return number(value, where, minimum, maximum, integer=True, limit=limit)
 
 
 def positive(value, where: Where) -> float:
@@ -152,7 +172,9 @@ def anatomy(entry, where: Where, base: Path, parameter: Callable = _fixed_parame
                 "resolution": parameter(
                     params.get("resolution", 128),
                     where.at("phantom").at("resolution"),
-                    lambda v, w: integer(v, w, minimum=8, maximum=1024),
+                    lambda v, w: integer(
+                        v, w, minimum=8, maximum=MAX_PHANTOM_RESOLUTION, limit=PHANTOM_LIMIT
+                    ),
                     integer=True,
                 ),
                 "seed": parameter(

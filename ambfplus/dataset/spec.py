@@ -37,20 +37,28 @@ SCHEMA_VERSION = 1
 SCENARIO_KINDS = ("camera", "drilling", "mixed")
 LIGHT_TYPES = ("directional", "point", "spot")
 PASS_NAMES = ("rgb", "depth", "label", "instance", "voxel", "segmentation", "points")
+# Limits a 2-core, 24 GB machine honours, each with what a larger value would cost.
+MAX_EPISODES = 1_000_000
+EPISODES_LIMIT = "a dataset's manifest and plan hold a line per episode"
+MAX_EVERY = 60_000
+EVERY_LIMIT = "one minute of 1 ms steps between stereo pairs; an episode steps every frame"
+MAX_SIDE = 4096
+SIDE_LIMIT = "a 4096x4096 stereo pair of every pass takes about 0.6 GB"
+
 # The paper's camera: f = 1135 px at 480 rows.
 PAPER_FOV_Y = 2.0 * math.atan(240.0 / 1135.0)
 
 SCHEMA_TEXT = """\
 version: 1                      # required: the spec's schema version
 name: text                      # optional
-episodes: 12                    # required, >= 1
+episodes: 12                    # required, 1..1000000
 seed: 0                         # base seed (default 0)
 capture:
-  every: 40                     # 1 ms steps between stereo pairs (default 40)
+  every: 40                     # 1 ms steps between stereo pairs (default 40; 1..60000)
   frames: 25                    # stereo pairs per episode (default 25; a scenario may say)
   passes: [rgb, depth, label, instance, voxel]   # (the default)
 anatomies:                      # required, one drawn per episode by weight
-  - phantom: {resolution: 128, seed: 0}          # values may vary
+  - phantom: {resolution: 128, seed: 0}          # values may vary; resolution 8..512
     weight: 1
   - file: ear.seg.nrrd          # NRRD, Slicer .seg.nrrd, slice folder or volume ADF,
     weight: 1                   # relative to the spec's folder; prefix, labels, dimensions,
@@ -63,7 +71,7 @@ scenarios:                      # default [{kind: camera}]
 rigs:                           # default [the paper's rig]
   - baseline: 0.065             # metres, may vary
     working_distance: 0.25      # off-axis, zero disparity at this depth; null: parallel
-    resolution: [640, 480]      # may vary ({choice: [[640, 480], [320, 240]]})
+    resolution: [640, 480]      # may vary ({choice: [[640, 480], [320, 240]]}); 8..4096
     fov_y: 0.4169               # radians (default: f = 1135 px at 480 rows)
     weight: 1
 appearance:                     # optional; every entry may vary
@@ -140,7 +148,8 @@ def parse_spec(data, base: Path, source: str, text: str) -> DatasetSpec:
             f"version {SCHEMA_VERSION}",
         )
     out = {"version": SCHEMA_VERSION, "name": str(data.get("name", ""))}
-    out["episodes"] = integer(data["episodes"], where.at("episodes"), minimum=1)
+    out["episodes"] = integer(data["episodes"], where.at("episodes"), minimum=1,
+                              maximum=MAX_EPISODES, limit=EPISODES_LIMIT)  # fmt: skip
     out["seed"] = integer(data.get("seed", 0), where.at("seed"), minimum=0)
     out["capture"] = _capture(data.get("capture", {}), where.at("capture"))
     out["anatomies"] = _weighted_list(
@@ -234,7 +243,13 @@ def _capture(value, where: Where) -> dict:
     if len(set(passes)) != len(passes):
         raise where.error("passes", f"a pass is listed twice: {passes}")
     return {
-        "every": integer(value.get("every", 40), where.at("every"), minimum=1),
+        "every": integer(
+            value.get("every", 40),
+            where.at("every"),
+            minimum=1,
+            maximum=MAX_EVERY,
+            limit=EVERY_LIMIT,
+        ),  # fmt: skip
         "frames": _varying(value.get("frames", 25), where.at("frames"), _frames, integer=True),
         "passes": list(passes),
     }
@@ -271,7 +286,7 @@ def _rig(entry: dict, where: Where) -> dict:
         "resolution": _varying(
             entry.get("resolution", [640, 480]),
             where.at("resolution"),
-            lambda v, w: integer(v, w, minimum=8, maximum=16384),
+            lambda v, w: integer(v, w, minimum=8, maximum=MAX_SIDE, limit=SIDE_LIMIT),
             size=2,
             integer=True,
         ),

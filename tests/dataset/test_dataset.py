@@ -83,6 +83,16 @@ def run_cli(*args) -> subprocess.CompletedProcess:
     [
         ({"colour": 1}, "colour: unknown key"),
         ({"episodes": 0}, "episodes: expected a value >= 1"),
+        ({"episodes": 10**12}, "episodes: expected a value <= 1000000, got 1000000000000 (a "),
+        ({"capture": {"every": 10**12}}, "capture.every: expected a value <= 60000"),
+        (
+            {"rigs": [{"resolution": [16384, 16384]}]},
+            "rigs[0].resolution[0]: expected a value <= 4096, got 16384 (a 4096x4096",
+        ),
+        (
+            {"anatomies": [{"phantom": {"resolution": 1024}}]},
+            "anatomies[0].phantom.resolution: expected a value <= 512",
+        ),
         ({"episodes": "12"}, "episodes: expected an integer, got str"),
         ({"version": 2}, "version: spec schema version 2 is not supported"),
         (
@@ -122,6 +132,26 @@ def test_bad_specs_name_the_key(change, where, tmp_path):
     with pytest.raises(SpecError):
         generate({**BASE_SPEC, **change}, out, progress=False)
     assert not out.exists()
+
+
+def test_hostile_yaml_fails_fast_and_small(tmp_path):
+    """An alias bomb (nine lines expanding to 10^9 nodes) is refused before anything expands:
+    quickly and in little memory (the test would not end otherwise); a FIFO is not read."""
+    import resource
+
+    lines = ["a0: &a0 [x, x, x, x, x, x, x, x, x, x]"]
+    lines += [f"a{i}: &a{i} [{', '.join([f'*a{i - 1}'] * 10)}]" for i in range(1, 9)]
+    bomb = tmp_path / "bomb.yaml"
+    bomb.write_text("\n".join(lines) + "\nversion: 1\nepisodes: 1\nname: *a8\n")
+    before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    with pytest.raises(SpecError, match=r"bomb\.yaml: line 2, column 10: YAML aliases \(\*a0\)"):
+        load_spec(bomb)
+    grown_mb = (resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before) / 1024
+    assert grown_mb < 100
+    fifo = tmp_path / "spec.fifo"
+    os.mkfifo(fifo)
+    with pytest.raises(SpecError, match=r"spec\.fifo: not a regular file"):
+        load_spec(fifo)
 
 
 def test_bad_yaml_and_unreadable_volume_name_the_file(tmp_path):

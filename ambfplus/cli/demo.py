@@ -3,6 +3,7 @@ and previewed as PNG files."""
 
 from __future__ import annotations
 
+import argparse
 import json
 import sys
 from pathlib import Path
@@ -10,6 +11,8 @@ from pathlib import Path
 import numpy as np
 
 from .._core import ScriptedDevice, __version__, gl_info, write_image
+from ..config import MAX_PHANTOM_RESOLUTION
+from ..dataset.spec import MAX_SIDE
 
 
 def add_parser(commands) -> None:
@@ -20,11 +23,28 @@ def add_parser(commands) -> None:
         "write preview PNGs",
     )
     demo.add_argument("--out", type=Path, default=Path("demo_out"), help="output folder")
-    demo.add_argument("--width", type=int, default=640)
-    demo.add_argument("--height", type=int, default=480)
-    demo.add_argument("--resolution", type=int, default=128, help="phantom voxels per side")
-    demo.add_argument("--every", type=int, default=50, help="steps (ms) between stereo frames")
+    demo.add_argument("--width", type=within(8, MAX_SIDE), default=640)
+    demo.add_argument("--height", type=within(8, MAX_SIDE), default=480)
+    demo.add_argument("--resolution", type=within(8, MAX_PHANTOM_RESOLUTION), default=128,
+                      help="phantom voxels per side")  # fmt: skip
+    demo.add_argument("--every", type=within(1, 1000), default=50,
+                      help="steps (ms) between stereo frames")  # fmt: skip
     demo.set_defaults(func=run)
+
+
+def within(low: int, high: int):
+    """An argparse type: an integer in [low, high], else a one-line usage error saying so."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
+        if not low <= value <= high:
+            raise argparse.ArgumentTypeError(f"expected {low}..{high}, got {value}")
+        return value
+
+    return parse
 
 
 def run(args) -> int:

@@ -136,3 +136,22 @@ def test_info_prints_version_and_renderer(capsys):
     assert main(["info"]) == 0
     info = json.loads(capsys.readouterr().out)
     assert info["gl"]["renderer"] and info["version"]
+
+
+@pytest.mark.parametrize(
+    "option, value, message",
+    [
+        ("--every", "0", "argument --every: expected 1..1000, got 0"),
+        ("--resolution", "1024", "argument --resolution: expected 8..512, got 1024"),
+        ("--width", "-5", "argument --width: expected 8..4096, got -5"),
+        ("--height", "tall", "argument --height: expected an integer, got 'tall'"),
+    ],
+)
+def test_demo_refuses_values_it_cannot_honour(option, value, message, capsys, tmp_path):
+    """--every 0 never reached a frame (the demo stepped forever at step 0); each bad value is
+    now a one-line usage error (exit 2) before anything runs."""
+    with pytest.raises(SystemExit) as exit_:
+        main(["demo", "--out", str(tmp_path / "demo"), option, value])
+    assert exit_.value.code == 2
+    assert message in capsys.readouterr().err
+    assert not (tmp_path / "demo").exists()

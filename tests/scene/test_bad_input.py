@@ -6,11 +6,15 @@ Meshes that crash or hang Debian's assimp are loaded in their own process, with 
 
 from __future__ import annotations
 
+import contextlib
 import gzip
+import os
 import struct
 import subprocess
 import sys
 import textwrap
+import threading
+import time
 from pathlib import Path
 
 import numpy as np
@@ -165,7 +169,7 @@ def test_nrrd_non_utf8_segment_name_is_a_config_error(tmp_path):
 def test_nrrd_folder_says_it_is_a_folder(tmp_path):
     folder = tmp_path / "volume.nrrd"
     folder.mkdir()
-    expect_config_error(folder, "is a folder")
+    expect_config_error(folder, "not a regular file but a folder")
 
 
 def test_nrrd_detached_data_file_missing_is_asset_not_found(tmp_path):
@@ -619,3 +623,67 @@ def test_adf_of_a_lone_comma_is_a_config_error_not_endless_memory(tmp_path):
     # A fuzzer's finding: yaml-cpp's LoadAll allocates without end on this input.
     with pytest.raises(ambfplus.ConfigError):
         ambfplus.World().load_adf(adf_file(tmp_path, b","))
+
+
+# Files that are not regular files -----------------------------------------------------------
+
+
+@contextlib.contextmanager
+def fifo(path: Path):
+    """A FIFO at `path`, checked never to have been opened for reading. Should a reader block
+    on it (the defect these tests guard against), a writer opens and closes it after 5 s, which
+    releases the reader and marks the FIFO opened: the test fails instead of hanging."""
+    os.mkfifo(path)
+    done, opened = threading.Event(), threading.Event()
+
+    def release() -> None:
+        if done.wait(5.0):
+            return
+        while not done.is_set():
+            try:
+                os.close(os.open(path, os.O_WRONLY | os.O_NONBLOCK))
+                opened.set()
+            except OSError:  # no reader
+                time.sleep(0.05)
+
+    thread = threading.Thread(target=release, daemon=True)
+    thread.start()
+    try:
+        yield path
+    finally:
+        done.set()
+        thread.join()
+    assert not opened.is_set(), f"{path} was opened for reading"
+
+
+TRIANGLE_UV = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl red\nf 1/1 2/2 3/3\n"
+
+
+def test_a_fifo_is_refused_as_what_it_is_and_never_read(tmp_path):
+    """A FIFO given as a mesh, NRRD, label table, model file or slice is a ConfigError saying it
+    is a FIFO (not "file not found"); one named by an OBJ's mtllib or an MTL's map_Kd is
+    skipped as a missing one is (the mesh loads, as in AMBF). None is ever opened."""
+    world = ambfplus.World()
+    checks = [
+        ("mesh.obj", lambda p: world.add_body("fifo", mesh=str(p))),
+        ("ear.nrrd", ambfplus.load_nrrd),
+        ("labels.csv", ambfplus.read_label_table),
+        ("model.yaml", lambda p: ambfplus.World().load_adf(p)),
+    ]
+    for name, load in checks:
+        with fifo(tmp_path / name) as path:
+            with pytest.raises(ambfplus.ConfigError, match="not a regular file but a FIFO"):
+                load(path)
+    rgba = np.full((4, 4, 3, 4), 255, dtype=np.uint8)
+    write_slices(tmp_path / "slices", rgba)
+    slice_file = sorted((tmp_path / "slices").glob("*.png"))[1]
+    slice_file.unlink()
+    with fifo(slice_file), pytest.raises(ambfplus.ConfigError, match="a FIFO") as info:
+        ambfplus.load_slice_stack(tmp_path / "slices", dimensions=(0.01, 0.01, 0.01))
+    assert slice_file.name in str(info.value)
+    (tmp_path / "a.obj").write_text("mtllib fifo.mtl\n" + TRIANGLE_UV)
+    (tmp_path / "b.mtl").write_text("newmtl red\nKd 1 0 0\nmap_Kd fifo.png\n")
+    (tmp_path / "b.obj").write_text("mtllib b.mtl\n" + TRIANGLE_UV)
+    with fifo(tmp_path / "fifo.mtl"), fifo(tmp_path / "fifo.png"):
+        assert world.add_body("a", mesh=str(tmp_path / "a.obj")).name == "a"
+        assert world.add_body("b", mesh=str(tmp_path / "b.obj")).name == "b"

@@ -92,7 +92,7 @@ def test_unreadable_mesh_is_config_error_naming_the_file(tmp_path, name, content
 
 
 def test_directory_instead_of_mesh(tmp_path):
-    with pytest.raises(ambfplus.ConfigError, match="directory"):
+    with pytest.raises(ambfplus.ConfigError, match="not a regular file but a folder"):
         ambfplus.World().add_body("part", mesh=str(tmp_path))
 
 

@@ -13,13 +13,13 @@
 #include <Eigen/Geometry>
 
 #include "ambfplus/log.h"
+#include "util/files.h"
 #include "util/strings.h"
 
 namespace ambfplus::adf {
 
 Doc load(const std::string& path, const std::string& what) {
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec)) throw AssetNotFound(path, what);
+  require_regular_file(path, what);
   Doc doc{path, fs::absolute(fs::path(path)).parent_path().lexically_normal(), {}};
   std::ifstream file(path, std::ios::binary);
   std::stringstream text;

@@ -8,6 +8,7 @@
 #include "ambfplus/errors.h"
 #include "ambfplus/io/image.h"
 #include "io/image_codecs.h"
+#include "util/files.h"
 #include "util/strings.h"
 
 namespace fs = std::filesystem;
@@ -67,9 +68,7 @@ Format format_of_name(const std::string& path) {
 }  // namespace
 
 Image read_image(const std::string& path) {
-  std::error_code ec;
-  if (!fs::exists(path, ec)) throw AssetNotFound(path, "image");
-  if (fs::is_directory(path, ec)) throw ConfigError(path, "expected an image file, found a folder");
+  require_regular_file(path, "image");
   FilePtr file(std::fopen(path.c_str(), "rb"), std::fclose);
   if (!file) throw ConfigError(path, std::string("cannot open the image: ") + std::strerror(errno));
   // The first bytes say what the file is, whatever its name.

@@ -1,3 +1,4 @@
+#include <assimp/DefaultIOSystem.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <assimp/Importer.hpp>
@@ -19,6 +20,7 @@
 #include "io/off_check.h"
 #include "io/ply_check.h"
 #include "io/stl_check.h"
+#include "util/files.h"
 #include "util/strings.h"
 
 namespace ambfplus {
@@ -142,16 +144,22 @@ void append_mesh(const std::string& path, const aiMesh& in, double scale, bool t
   }
 }
 
+// The files assimp opens for a mesh (an OBJ's mtllib, ...) as the default system opens them,
+// but regular files only: a FIFO named by a mesh would block its read forever. What is not one
+// is as good as missing (assimp goes on without a material library, as AMBF does).
+class RegularFilesOnly : public Assimp::DefaultIOSystem {
+ public:
+  bool Exists(const char* file) const override { return is_regular_file(file); }
+  Assimp::IOStream* Open(const char* file, const char* mode = "rb") override {
+    if (!is_regular_file(file)) return nullptr;
+    return DefaultIOSystem::Open(file, mode);
+  }
+};
+
 }  // namespace
 
 MeshData load_mesh(const std::string& path, double scale) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) {
-    if (std::filesystem::is_directory(path, ec)) {
-      throw ConfigError(path, "is a directory, expected a mesh file");
-    }
-    throw AssetNotFound(path, "mesh");
-  }
+  require_regular_file(path, "mesh");
   if (!std::isfinite(scale) || !(scale > 0)) {
     throw ArgumentError("mesh " + path + ": scale must be a positive finite number, got " +
                         std::to_string(scale));
@@ -164,6 +172,7 @@ MeshData load_mesh(const std::string& path, double scale) {
   // assimp allocates what an OFF header's counts ask for before reading a row.
   if (has_extension(path, ".off")) io::check_off(path, read_bytes(path));
   Assimp::Importer importer;
+  importer.SetIOHandler(new RegularFilesOnly);  // the importer owns and deletes it
   // Points and lines carry no surface; drop them so a file of only those reads as empty.
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
                               aiPrimitiveType_POINT | aiPrimitiveType_LINE);

@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "ambfplus/errors.h"
+#include "util/files.h"
 #include "util/strings.h"
 
 namespace ambfplus {
@@ -228,8 +229,7 @@ LabelTable read_yaml(const std::string& path) {
 }  // namespace
 
 LabelTable read_label_table(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) throw AssetNotFound(path, "label table");
+  require_regular_file(path, "label table");
   const std::string ext = to_lower(std::filesystem::path(path).extension().string());
   if (ext == ".csv") return read_csv(path);
   if (ext == ".yaml" || ext == ".yml") return read_yaml(path);

@@ -21,6 +21,7 @@
 #include "ambfplus/errors.h"
 #include "ambfplus/log.h"
 #include "ambfplus/volume/volume_io.h"
+#include "util/files.h"
 #include "util/strings.h"
 #include "volume/grid_access.h"
 
@@ -249,11 +250,7 @@ std::vector<Eigen::Vector3d> parse_vectors(const std::string& path, const std::s
 }
 
 std::string read_file(const std::string& path, const char* what) {
-  std::error_code ec;
-  if (fs::is_directory(path, ec)) {
-    throw ConfigError(path, std::string("is a folder, expected ") + what);
-  }
-  if (!fs::is_regular_file(path, ec)) throw AssetNotFound(path, "NRRD");
+  require_regular_file(path, what);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw ConfigError(path, std::string("cannot open: ") + std::strerror(errno));
   std::ostringstream s;

@@ -545,18 +545,15 @@ def _summarise_part(path: Path, recording_id: str, number: int) -> PartSummary:
                 f"'recording_id', 'part' say {found_id}, {found_number})"
             )
         summary = PartSummary(path)
-        # Through the low-level API: a long recording has a thousand parts of some fifty
-        # datasets, and each high-level object costs more than reading its header.
-        datasets: list[bytes] = []
-
-        def collect(name: bytes, info) -> None:
-            if info.type == h5py.h5o.TYPE_DATASET:
-                datasets.append(name)
-
-        h5py.h5o.visit(f.id, collect, info=True)
-        for name in datasets:
-            dataset = h5py.h5d.open(f.id, name)
-            _summarise_dataset(checked, summary, name.decode("utf-8", "replace"), dataset)
+        # Through the low-level API (the same library calls as h5py's visititems: a visit of
+        # the names, then each object opened): a long recording has a thousand parts of some
+        # fifty datasets, and each high-level object costs more than reading its header.
+        names: list[bytes] = []
+        h5py.h5o.visit(f.id, names.append)
+        for name in names:
+            found = h5py.h5o.open(f.id, name)
+            if isinstance(found, h5py.h5d.DatasetID):
+                _summarise_dataset(checked, summary, name.decode("utf-8", "replace"), found)
         return summary
 
 

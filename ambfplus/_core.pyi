@@ -2482,6 +2482,11 @@ class LiveMetrics:
         Whether the metrics are still fed (their drill is in the world).
         """
     @property
+    def field_waits(self) -> dict:
+        """
+        How often a tick waited for a structure's field brought up to date after a breach (due kFollowTicks ticks after it, as offline, so that the live metrics equal the offline assessment), and the seconds waited: {'count', 'seconds'}; zero on a machine that keeps up.
+        """
+    @property
     def tick_cpu_seconds(self) -> numpy.typing.NDArray[numpy.float64]:
         """
         CPU seconds the metrics added to each of the last ticks (up to 16384).

@@ -334,6 +334,23 @@ void define_training(py::module_& m) {
           },
           "Each protected structure's distance (metres; None once it is gone) from the burr "
           "where it is now, with its margin: [{'name', 'margin', 'distance'}].")
+      .def_property_readonly(
+          "field_waits",
+          [](const LiveMetrics& l) {
+            const std::pair<std::int64_t, double> w = [&] {
+              py::gil_scoped_release release;
+              auto lock = l.drill().world().lock_state_for_copy();
+              return std::make_pair(l.metrics().field_waits(), l.metrics().field_wait_seconds());
+            }();
+            py::dict d;
+            d["count"] = w.first;
+            d["seconds"] = w.second;
+            return d;
+          },
+          "How often a tick waited for a structure's field brought up to date after a breach "
+          "(due kFollowTicks ticks after it, as offline, so that the live metrics equal the "
+          "offline assessment), and the seconds waited: {'count', 'seconds'}; zero on a machine "
+          "that keeps up.")
       .def_property_readonly("active", &LiveMetrics::active,
                              "Whether the metrics are still fed (their drill is in the world).");
 

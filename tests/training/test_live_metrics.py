@@ -58,6 +58,9 @@ def test_live_metrics_equal_the_offline_assessment(tmp_path):
     offline = assess(path, task).data["metrics"]
     offline.pop("removed_by_name")
     same(summary, offline)
+    # The fields followed the drilling on the offline schedule, waited for when late.
+    waits = live.field_waits
+    assert waits["count"] >= 0 and (waits["seconds"] > 0) == (waits["count"] > 0), waits
     costs = live.tick_cpu_seconds
     assert len(costs) == 6000 and np.all(costs >= 0)
 

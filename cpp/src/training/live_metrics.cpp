@@ -46,7 +46,6 @@ void LiveMetrics::tick(const StepContext& context) {
     tick_.removed.push_back(it->voxel);
     tick_.removed_labels.push_back(it->label);
   }
-  metrics_.set_realtime(d.realtime());
   metrics_.add(tick_);
   tick_cpu_seconds_.push_back(thread_cpu_seconds() - started);
   if (tick_cpu_seconds_.size() > kTickHistory) tick_cpu_seconds_.pop_front();

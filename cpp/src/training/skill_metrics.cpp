@@ -67,6 +67,14 @@ SkillMetrics::SkillMetrics(VolumeData& volume, MetricsConfig config)
   sum_.voxel_volume = v.x() * v.y() * v.z();
 }
 
+std::int64_t SkillMetrics::field_waits() const {
+  return distances_ == nullptr ? 0 : distances_->waits();
+}
+
+double SkillMetrics::field_wait_seconds() const {
+  return distances_ == nullptr ? 0.0 : distances_->wait_seconds();
+}
+
 double SkillMetrics::clearance(std::size_t s, const Eigen::Vector3d& p, double r) const {
   const Watch& w = watches_.at(s);
   return std::min(distances_->distance(w.key, p), w.band) - r;
@@ -130,7 +138,7 @@ void SkillMetrics::add(const ToolTick& tick) {
   // the volume since the last tick), they start local updates, taken kFollowTicks later.
   if (!watches_.empty()) {
     distances_->removed(-1, tick.removed, tick.removed_labels);
-    distances_->tick(!realtime_);
+    distances_->tick();
   }
   for (std::size_t s = 0; s < watches_.size(); ++s) {
     Watch& w = watches_[s];

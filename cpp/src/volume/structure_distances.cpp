@@ -446,7 +446,15 @@ void StructureDistances::tick(bool wait) {
                                                       std::future_status::ready);
     if (ready && tick_ >= e.due) {
       std::shared_ptr<const Field> old = std::move(e.current);
-      e.current = e.next.get();  // waits only if the machine is slower than kFollowTicks
+      // Waits only if the machine is slower than kFollowTicks.
+      if (e.next.wait_for(std::chrono::seconds(0)) != std::future_status::ready) {
+        const auto began = std::chrono::steady_clock::now();
+        e.next.wait();
+        ++waits_;
+        wait_seconds_ +=
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
+      }
+      e.current = e.next.get();
       ++rebuilds_;
       if (!e.next_patch.empty() && e.spare == nullptr) {
         e.spare = std::move(old);  // behind current over the patch just applied

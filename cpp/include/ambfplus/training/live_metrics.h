@@ -22,7 +22,9 @@ class World;
 /// burr's centre in its volume's frame, the force fed back, the burr, whether it spins and the
 /// voxels it removed in the step (which the drill has already taken from the volume, so the
 /// structures' distance fields follow the drilling). Read it under the world's lock while a
-/// real-time loop steps.
+/// real-time loop steps. Its fields follow the drilling on the offline schedule, so that the
+/// live metrics equal the offline assessment exactly; a machine too slow for that schedule makes
+/// a tick wait (SkillMetrics::field_waits counts it).
 class AMBFPLUS_API LiveMetrics {
  public:
   LiveMetrics(Drill& drill, MetricsConfig config);

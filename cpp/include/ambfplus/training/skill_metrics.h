@@ -138,10 +138,14 @@ class AMBFPLUS_API SkillMetrics {
   /// surface, from its field as of the last tick: what the contacts are measured with. Beyond
   /// the field's band (margin + field_band) it reads as the band.
   double clearance(std::size_t s, const Eigen::Vector3d& p, double r) const;
-  /// In a real-time loop (set by LiveMetrics from its drill) a structure's field brought up to
-  /// date after a breach is taken once ready, never waited for; otherwise (offline, scripted)
-  /// it is taken StructureDistances::kFollowTicks ticks after the breach, deterministically.
-  void set_realtime(bool on) { realtime_ = on; }
+  /// A structure's field brought up to date after a breach is taken
+  /// StructureDistances::kFollowTicks ticks after the breach, waited for when not yet built:
+  /// live (LiveMetrics, in a real-time loop) as offline, so the live metrics equal the offline
+  /// assessment of the session's recording on any machine. On a machine slower than that the
+  /// tick waits (the drill's own fields, which the fixtures push with, never do): how often and
+  /// for how long.
+  std::int64_t field_waits() const;
+  double field_wait_seconds() const;
 
  private:
   struct Watch {
@@ -169,7 +173,6 @@ class AMBFPLUS_API SkillMetrics {
   // costs a local update of tens of milliseconds, too long for a haptic tick).
   std::unique_ptr<StructureDistances> distances_;
   std::vector<Watch> watches_;
-  bool realtime_ = false;
   MetricsSummary sum_;
   std::vector<float> cutting_forces_;
   double cutting_force_sum_ = 0.0;

@@ -78,6 +78,10 @@ class AMBFPLUS_API StructureDistances {
   std::int64_t rebuilds() const { return rebuilds_; }
   /// Of the successors started so far, those made by a local update (for tests).
   std::int64_t local_updates() const { return local_updates_; }
+  /// Due fields that were not built yet when taken with `wait`, and the seconds (wall clock)
+  /// waited for them: how far the machine fell behind kFollowTicks.
+  std::int64_t waits() const { return waits_; }
+  double wait_seconds() const { return wait_seconds_; }
 
  private:
   /// A field on a snapshot of the structure's neighbourhood; immutable once built.
@@ -142,6 +146,8 @@ class AMBFPLUS_API StructureDistances {
   std::int64_t seen_ = -1;  // the volume revision whose edits are accounted for
   std::int64_t rebuilds_ = 0;
   std::int64_t local_updates_ = 0;
+  std::int64_t waits_ = 0;
+  double wait_seconds_ = 0.0;
   std::shared_ptr<const std::vector<std::uint8_t>> plan_;
   std::vector<std::vector<bool>> sets_;  // by key kPlanTarget - 1 - n: membership by label id
   std::vector<std::vector<std::uint16_t>> set_labels_;

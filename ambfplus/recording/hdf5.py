@@ -15,7 +15,10 @@ by each object's size, and a free-space object of size 0 never moves it on. So:
   after every global heap collection in it has been walked the way libhdf5 walks it: a walk that
   would not end exactly at the collection's end is a ``RecordingError`` naming the file and the
   collection's byte offset. This reads the whole file once (then not again while its size and
-  modification time stay the same).
+  modification time stay the same). libhdf5 also allocates, and fills, the length each
+  variable-length value claims before it looks for the value, so the lengths are read from the
+  file's bytes first (an attribute's from its attribute message, a dataset's from its storage):
+  one claiming more than the file holds is a ``RecordingError``.
 - Heads of either format are checked that way too (they are small, and their virtual datasets'
   mappings live in a global heap), before any attribute is read.
 
@@ -43,6 +46,8 @@ GLOBAL_HEAP_START = b"GCOL\x01"
 # Files whose global heaps passed the check, by (device, inode, size, mtime): collections found.
 _HEAPS_CHECKED: OrderedDict[tuple, int] = OrderedDict()
 _HEAPS_CHECKED_LIMIT = 4096
+# What attribute messages of a name claim, by file (as above) and name: _attribute_claims.
+_CLAIMS: OrderedDict[tuple, list] = OrderedDict()
 
 
 @dataclass
@@ -112,7 +117,167 @@ def read_attribute(checked: CheckedFile, obj, name: str, expect: str | None = No
             f"{checked.path}: attribute '{where}' claims {points} values of "
             f"{type_id.get_size()} bytes, more than the file holds"
         )
+    if problem:
+        _check_variable_attribute(checked, where, name, problem)
     return obj.attrs[name]
+
+
+# A variable-length value on disk (HDF5 file format, "Variable-length" data and "Global Heap
+# ID"): its length (4 bytes), then where its data is, the heap collection's address and the
+# object's index (4 bytes). libhdf5 allocates, and fills, the length a value claims before it
+# finds the heap object holding it, so a damaged length (4 GB in 16 bytes) is read here first.
+
+
+def _check_variable_attribute(checked: CheckedFile, where: str, name: str, problem: str) -> None:
+    """Refuses a format 1.0 attribute of variable length whose stored value claims more than
+    the file holds, or whose stored form cannot be found to check it."""
+    if problem not in ("a variable-length string", "a variable-length sequence"):
+        raise RecordingError(
+            f"{checked.path}: attribute '{where}' is {problem}; format 1.0 keeps only text on "
+            "the global heap, so the file is damaged"
+        )
+    claims = _attribute_claims(checked, name)
+    if not claims:
+        raise RecordingError(
+            f"{checked.path}: attribute '{where}' is {problem}, but no attribute message named "
+            f"'{name}' holding one is in the file to check its length: the file is damaged"
+        )
+    for lengths in claims:
+        _check_lengths(checked, f"attribute '{where}'", lengths)
+
+
+def check_variable_dataset(checked: CheckedFile, name: str, dataset) -> None:
+    """Refuses a format 1.0 dataset of variable length (a low-level h5py DatasetID) whose
+    stored values claim more than the file holds, before any is read: its raw values are
+    read from its contiguous storage or unfiltered chunks (what the format 1.0 writer made)."""
+    plist = dataset.get_create_plist()
+    layout = plist.get_layout()
+    element = 8 + checked.file.id.get_create_plist().get_sizes()[0]
+    spans: list[tuple[int, int]] = []
+    if layout == h5py.h5d.CONTIGUOUS:
+        if dataset.get_storage_size():
+            spans.append((dataset.get_offset(), dataset.get_storage_size()))
+    elif layout == h5py.h5d.CHUNKED:
+        if plist.get_nfilters():
+            raise RecordingError(
+                f"{checked.path}: dataset {name} holds variable-length values through filters, "
+                "which format 1.0 never wrote: the file is damaged"
+            )
+        for i in range(dataset.get_num_chunks()):
+            info = dataset.get_chunk_info(i)
+            spans.append((info.byte_offset, info.size))
+    else:
+        return  # compact values fit the object's header; a virtual dataset's are in its sources
+    size = checked.path.stat().st_size
+    with open(checked.path, "rb") as raw:
+        for offset, length in spans:
+            if offset is None or offset + length > size:
+                raise RecordingError(
+                    f"{checked.path}: dataset {name} keeps its values past the end of the file"
+                )
+            raw.seek(offset)
+            data = raw.read(length)
+            lengths = [_unsigned(data, at, 4) for at in range(0, len(data) - element + 1, element)]
+            _check_lengths(checked, f"dataset {name}", lengths)
+
+
+def _check_lengths(checked: CheckedFile, what: str, lengths: list[int] | None) -> None:
+    size = checked.file.id.get_filesize()
+    if lengths is None:
+        raise RecordingError(f"{checked.path}: {what} keeps its values past the end of the file")
+    for length in lengths:
+        if length > size:
+            raise RecordingError(
+                f"{checked.path}: {what} holds a variable-length value claiming {length} bytes, "
+                f"more than the file's {size}: the file is damaged"
+            )
+
+
+def _attribute_claims(checked: CheckedFile, name: str) -> list[list[int] | None]:
+    """The lengths each attribute message named `name` in the file claims for its variable-
+    length values (None for one whose values run past the file), found in the file's bytes:
+    compact attributes in object headers and dense ones in fractal heaps alike. Layout (HDF5
+    file format, "Attribute Message"): version 1 (name, datatype and dataspace each padded to 8
+    bytes), 2 or 3 (unpadded; 3 adds the name's encoding), flags, the three sizes; the name with
+    its NUL; datatype; dataspace; the values."""
+    stat = checked.path.stat()
+    key = (stat.st_dev, stat.st_ino, stat.st_size, stat.st_mtime_ns, name)
+    if key in _CLAIMS:
+        return _CLAIMS[key]
+    size_addr, size_len = checked.file.id.get_create_plist().get_sizes()
+    element = 8 + size_addr
+    wanted = name.encode() + b"\0"
+    n = len(wanted)
+    found: list[list[int] | None] = []
+    with open(checked.path, "rb") as raw:
+        if not stat.st_size:
+            return found
+        with mmap.mmap(raw.fileno(), 0, access=mmap.ACCESS_READ) as data:
+            at = data.find(wanted)
+            while at >= 0:
+                for version, prefix in ((1, 8), (2, 8), (3, 9)):
+                    start = at - prefix
+                    if start < 0 or data[start] != version or _unsigned(data, start + 2, 2) != n:
+                        continue
+                    flags = data[start + 1]
+                    dt_size, ds_size = _unsigned(data, start + 4, 2), _unsigned(data, start + 6, 2)
+                    if version == 1:
+                        if flags:
+                            continue
+                        dt = at + _pad8(n)
+                        ds = dt + _pad8(dt_size)
+                        value = ds + _pad8(ds_size)
+                    else:
+                        if flags & 0x3 or (version == 3 and data[start + 8] > 1):
+                            continue  # a shared datatype or dataspace: not one written here
+                        dt, ds = at + n, at + n + dt_size
+                        value = ds + ds_size
+                    if value > len(data) or dt_size < 8 or data[dt] & 0x0F != 9:
+                        continue  # not a message of a variable-length type
+                    count = _dataspace_points(data, ds, ds_size, size_len)
+                    if count is None:
+                        continue
+                    end = value + count * element
+                    found.append(
+                        None
+                        if end > len(data)
+                        else [_unsigned(data, v, 4) for v in range(value, end, element)]
+                    )
+                    break
+                at = data.find(wanted, at + 1)
+    _CLAIMS[key] = found
+    while len(_CLAIMS) > _HEAPS_CHECKED_LIMIT:
+        _CLAIMS.popitem(last=False)
+    return found
+
+
+def _dataspace_points(data, at: int, size: int, size_len: int) -> int | None:
+    """The points of the dataspace message at `at` (version 1 or 2), or None if it is not
+    one."""
+    if size < 4 or at + size > len(data):
+        return None
+    version, rank = data[at], data[at + 1]
+    if version == 1:
+        dims = at + 8
+    elif version == 2:
+        kind = data[at + 3]
+        if kind == 2:
+            return 0
+        if kind > 2:
+            return None
+        dims = at + 4
+    else:
+        return None
+    if dims + rank * size_len > at + size:
+        return None
+    points = 1
+    for d in range(rank):
+        points *= _unsigned(data, dims + d * size_len, size_len)
+    return points
+
+
+def _pad8(n: int) -> int:
+    return (n + 7) // 8 * 8
 
 
 def read_attributes(checked: CheckedFile, obj) -> dict:

@@ -21,6 +21,8 @@ from ..stereo import StereoFrame
 from .hdf5 import (
     CheckedFile,
     check_dataset_type,
+    check_variable_dataset,
+    heap_type,
     open_checked,
     read_attribute,
     read_attributes,
@@ -561,7 +563,10 @@ def _summarise_dataset(checked: CheckedFile, summary: PartSummary, name: str, da
     """Adds one dataset (a low-level h5py DatasetID) to its group's summary, checked: no
     variable-length type in a format 1.1 part, as many rows as the group's other datasets."""
     path = checked.path
-    check_dataset_type(checked, name, dataset.get_type())
+    type_id = dataset.get_type()
+    check_dataset_type(checked, name, type_id)
+    if heap_type(type_id):
+        check_variable_dataset(checked, name, dataset)
     group, column = name.rsplit("/", 1) if "/" in name else ("", name)
     shape = dataset.shape
     entry = summary.groups.get(group)

@@ -46,6 +46,10 @@ def add_parser(commands) -> None:
                           help="original-h5: samples per file (the original's 500)")  # fmt: skip
     exporter.add_argument("--no-images", action="store_true",
                           help="coco: annotations only, no PNG frames")  # fmt: skip
+    exporter.add_argument("--skip-bad-frames", action="store_true",
+                          help="leave out (and count) frames and step rows whose values are "
+                          "not valid (NaN or negative depth, a pose that is not rigid, an id "
+                          "not in the legend, ...) instead of refusing the export")  # fmt: skip
     exporter.set_defaults(func=run)
 
 
@@ -54,7 +58,7 @@ def run(args: argparse.Namespace) -> int:
     from ..export import ExportError, MissingExtra, export
     from ..recording import RecordingError
 
-    options: dict[str, Any] = {}
+    options: dict[str, Any] = {"bad_frames": "skip" if args.skip_bad_frames else "refuse"}
     if args.to in ("mcap", "rosbag2"):
         options["point_clouds"] = not args.no_points
         options["image_topics"] = args.image_topics

@@ -11,6 +11,7 @@ from pathlib import Path
 from .driver import ENVIRONMENT
 from .episode import PARTIAL, SHARDS
 from .manifest import read_manifest, shard_checksum
+from .spec import MAX_EPISODES
 
 
 @dataclass
@@ -76,7 +77,19 @@ def validate_dataset(folder, match_images: bool = True) -> DatasetReport:
     seed), and nothing unlisted in shards/."""
     folder = Path(folder)
     environment = _environment(folder)
-    report = DatasetReport(folder, expected=int(environment["episodes"]))
+    episodes = environment.get("episodes") if isinstance(environment, dict) else None
+    if (
+        not isinstance(episodes, int)
+        or isinstance(episodes, bool)
+        or not (0 <= episodes <= MAX_EPISODES)
+    ):
+        report = DatasetReport(folder)
+        report.problems.append(
+            f"{folder / ENVIRONMENT}: episodes is {episodes!r}, not a whole number in "
+            f"0..{MAX_EPISODES} as a spec gives it: the file is damaged"
+        )
+        return report
+    report = DatasetReport(folder, expected=episodes)
     records, problems = read_manifest(folder)
     report.problems += problems
     counts = Counter(r["episode"] for r in records)

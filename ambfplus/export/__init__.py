@@ -51,6 +51,7 @@ OPTIONS = {
         "jpeg_quality",
         "depth_no_hit",
         "stamp",
+        "bad_frames",
     ),
     "rosbag2": (
         "point_clouds",
@@ -59,9 +60,10 @@ OPTIONS = {
         "jpeg_quality",
         "depth_no_hit",
         "stamp",
+        "bad_frames",
     ),
-    "original-h5": ("chunk_size", "names"),
-    "coco": ("images",),
+    "original-h5": ("chunk_size", "names", "bad_frames"),
+    "coco": ("images", "bad_frames"),
 }
 
 
@@ -124,8 +126,11 @@ def export(source, out, to: str, *, force: bool = False, progress: bool | None =
     ``image_topics`` ("raw", "compressed" or "both"), ``rgb_codec`` ("png" or "jpeg"),
     ``jpeg_quality``, ``depth_no_hit`` ("nan" or "zero"), ``stamp`` ("sim" or "wall") (mcap,
     rosbag2), ``compression`` (mcap), ``chunk_size``, ``names``
-    (original-h5), ``images`` (coco). A source is a recording's head file (a dataset's shard)
-    or a dataset folder, which gives one result per shard."""
+    (original-h5), ``images`` (coco); and ``bad_frames`` (every format): "refuse" (default: an
+    ExportError naming the first frame whose values break ``ambfplus.recording.values``' rules;
+    nothing is left) or "skip" (such frames are left out and counted in the details). A source
+    is a recording's head file (a dataset's shard) or a dataset folder, which gives one result
+    per shard."""
     check_format(to, options)
     source, out = Path(source), Path(out)
     if source.is_dir():

@@ -23,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..recording.values import FrameGate
 from ._common import ExportError, export_conventions, require
 
 SKIPPED_KINDS = {"camera", "light", "input device", "drill", "volume", "sensor", "actuator"}
@@ -158,12 +159,15 @@ class CocoExport:
         }
 
 
-def write_coco(recording, out: Path, bar, *, images: bool = True) -> dict:
+def write_coco(recording, out: Path, bar, *, images: bool = True,
+               bad_frames: str = "refuse") -> dict:  # fmt: skip
     """Writes COCO annotations (and, with images, the RGB frames as PNG) into the folder
-    ``out`` (which must not exist yet)."""
+    ``out`` (which must not exist yet). ``bad_frames``: "refuse" or "skip" frames whose values
+    break ``ambfplus.recording.values``' rules."""
     from .. import write_image
 
     export = CocoExport(recording)
+    gate = FrameGate(recording, bad_frames, ExportError)
     out.mkdir()
     files, counts = [], {}
     info = {
@@ -183,6 +187,9 @@ def write_coco(recording, out: Path, bar, *, images: bool = True) -> dict:
             (out / stream.name).mkdir()
         for index in range(len(stream)):
             frame = stream[index]
+            if not gate.frame_ok(stream.name, index, frame):
+                bar.update(1)
+                continue
             image_id = index + 1
             file_name = f"{stream.name}/{index:06d}.png"
             if images and frame.rgb is not None:
@@ -216,4 +223,5 @@ def write_coco(recording, out: Path, bar, *, images: bool = True) -> dict:
         files.append(f"{stream.name}.json")
         counts[stream.name] = len(annotations)
     return {"files": files, "annotations": counts, "warnings": export.warnings,
-            "frames": sum(len(s) for s in export.streams)}  # fmt: skip
+            "frames": sum(len(s) for s in export.streams) - gate.skipped_frames,
+            **gate.counts()}  # fmt: skip

@@ -57,6 +57,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..recording.values import FrameGate
 from ._common import ExportError, StepClock, export_conventions, pose_vector
 
 CHUNK_SIZE = 500
@@ -89,7 +90,8 @@ DEFAULT_NAMES = {"drill": "mastoidectomy_drill", "camera": "main_camera",
 class OriginalLayout:
     """Plans and writes one recording in the v3 layout (see the module docstring)."""
 
-    def __init__(self, recording, chunk_size: int = CHUNK_SIZE, names: dict | None = None):
+    def __init__(self, recording, chunk_size: int = CHUNK_SIZE, names: dict | None = None,
+                 bad_frames: str = "refuse"):  # fmt: skip
         if chunk_size < 1:
             raise ExportError(f"chunk_size must be >= 1, got {chunk_size}")
         self.rec = recording
@@ -97,9 +99,12 @@ class OriginalLayout:
         self.warnings: list[str] = []
         self.legend_names = {e.get("name"): e for e in recording.legend.values()}
         self.clock = StepClock(recording)
+        self.gate = FrameGate(recording, bad_frames, ExportError)
         self._choose_streams()
         self.names = self._names(names or {})
         self.steps = recording.steps
+        if self.gate.skip:
+            self._skip_bad()
         self._voxel_steps = None
         if len(recording.removed["step"]) and self._volume_geometry() is None:
             # v3 holds voxel indices, as the original's plugin publishes them, so they are
@@ -172,6 +177,25 @@ class OriginalLayout:
         volumes = [n for n, e in self.legend_names.items() if e.get("kind") == "volume"]
         return volumes[0] if volumes else None
 
+    def _skip_bad(self) -> None:
+        """Leaves out the samples whose views break the value rules (their time, pose or K;
+        the left view's depth, read here once more) and the step rows that do."""
+        gate, kept = self.gate, []
+        for sample in self.samples:
+            views = [(s, int(r)) for s, r in zip((self.left, self.right), sample) if r is not None]
+            if all(gate.pose_ok(s.name, r) for s, r in views) and (
+                self.left.depth is None
+                or gate.image_ok(
+                    self.left.name, int(sample[0]), "depth", self.left.depth[int(sample[0])]
+                )
+            ):
+                kept.append(sample)
+        gate.skipped_frames = len(self.samples) - len(kept)
+        self.samples = kept
+        if gate.bad_steps.any():
+            good = ~gate.bad_steps
+            self.steps = {k: (v[good] if k != "volume" else v) for k, v in self.steps.items()}
+
     def chunks(self) -> list[tuple[int, int]]:
         n = len(self.samples)
         return [(a, min(a + self.chunk_size, n)) for a in range(0, max(n, 1), self.chunk_size)]
@@ -213,7 +237,8 @@ class OriginalLayout:
                 self._vision(f, a, b, bar)
                 self._physics(f, bounds[index], bounds[index + 1])
                 self._extension(f, a, b)
-        return {"files": names, "samples": len(self.samples), "warnings": self.warnings}
+        return {"files": names, "samples": len(self.samples), "frames": len(self.samples),
+                "warnings": self.warnings, **self.gate.counts()}  # fmt: skip
 
     def _dataset(self, group, name: str, data, **attrs) -> None:
         data = np.asarray(data) if not isinstance(data, str) else data
@@ -273,7 +298,11 @@ class OriginalLayout:
                                  chunks=(1,) + column.shape[1:], compression="gzip")  # fmt: skip
         for i in range(a, b):
             for name, column, side, convert, _ in datasets:
-                group[name][i - a] = convert(np.asarray(column[int(self.samples[i][side])]))
+                row = int(self.samples[i][side])
+                image = np.asarray(column[row])
+                if name == "depth":
+                    self.gate.image_ok(left.name, row, "depth", image)  # refuses a bad one
+                group[name][i - a] = convert(image)
             bar.update(1)
         for name, poses in self._sample_poses(left_rows).items():
             self._dataset(group, f"pose_{name}", poses)
@@ -420,8 +449,9 @@ class OriginalLayout:
 
 
 def write_original(recording, out: Path, bar, *, chunk_size: int = CHUNK_SIZE,
-                   names: dict | None = None) -> dict:  # fmt: skip
+                   names: dict | None = None, bad_frames: str = "refuse") -> dict:  # fmt: skip
     """Writes a recording in the original's v3 layout into the folder ``out`` (which must not
-    exist yet); returns the files written."""
-    layout = OriginalLayout(recording, chunk_size=chunk_size, names=names)
+    exist yet); returns the files written. ``bad_frames``: "refuse" or "skip" samples whose
+    values break ``ambfplus.recording.values``' rules."""
+    layout = OriginalLayout(recording, chunk_size=chunk_size, names=names, bad_frames=bad_frames)
     return layout.write(out, bar)

@@ -75,6 +75,7 @@ from typing import Any
 import numpy as np
 
 from .. import __version__
+from ..recording.values import FrameGate
 from ._common import (
     LINK_FROM_OPTICAL,
     ExportError,
@@ -329,10 +330,11 @@ class RosExport:
 
     def __init__(self, recording, *, point_clouds: bool = True, image_topics: str = "raw",
                  rgb_codec: str = "png", jpeg_quality: int = 90, depth_no_hit: str = "nan",
-                 stamp: str = "sim") -> None:  # fmt: skip
+                 stamp: str = "sim", bad_frames: str = "refuse") -> None:  # fmt: skip
         check_image_options(image_topics, rgb_codec, jpeg_quality)
         check_ros_options(depth_no_hit, stamp)
         self.rec = recording
+        self.gate = FrameGate(recording, bad_frames, ExportError)
         self.depth_no_hit, self.stamp = depth_no_hit, stamp
         # ns added to simulation time: the recording's wall-clock start for stamp "wall".
         self.offset = wall_clock_start(recording) if stamp == "wall" else 0
@@ -521,7 +523,8 @@ class RosExport:
         )
 
     def frames(self) -> int:
-        return sum(len(s) for s in self.rec.cameras.values())
+        """Frames written (once written: those skipped for their values are not)."""
+        return sum(len(s) for s in self.rec.cameras.values()) - self.gate.skipped_frames
 
     # The messages ----------------------------------------------------------------------------
 
@@ -538,6 +541,8 @@ class RosExport:
         infos = info_topics(stream.name, stream.passes)
         for index in range(len(stream)):
             frame = stream[index]
+            if not self.gate.frame_ok(stream.name, index, frame):
+                continue
             t = self._ns(frame.time)
             for pass_name in stream.passes:
                 if pass_name not in IMAGE_TOPICS:
@@ -588,8 +593,9 @@ class RosExport:
         for stream in self.rec.cameras.values():
             times, poses = stream.time[:], stream.pose[:]
             link = self._camera_frames(stream)[0]
-            for time, pose in zip(times, poses):
-                by_time.setdefault(self._ns(time), []).append((link, link_pose(pose)))
+            for index, (time, pose) in enumerate(zip(times, poses)):
+                if self.gate.pose_ok(stream.name, index):
+                    by_time.setdefault(self._ns(time), []).append((link, link_pose(pose)))
         for t in sorted(by_time):
             transforms = [transform(t, WORLD, child, pose) for child, pose in by_time[t]]
             yield Message(t, 0, "/tf", TF, {"transforms": transforms})
@@ -603,6 +609,8 @@ class RosExport:
         names = sorted(columns)
         frames = [self._frame(n) for n in names]
         for row in range(len(times)):
+            if not self.gate.step_ok(row):
+                continue
             t = self._ns(times[row])
             transforms = [
                 transform(t, WORLD, frame, columns[n][row]) for n, frame in zip(names, frames)
@@ -629,6 +637,8 @@ class RosExport:
         times = steps["time"]
         forces = {d: steps[f"{d}.force"] for d in drills}
         for row in range(len(times)):
+            if not self.gate.step_ok(row):
+                continue
             t = self._ns(times[row])
             for drill in drills:
                 f = forces[drill][row]
@@ -866,17 +876,21 @@ class Rosbag2Sink:
 def write_ros(recording, out: Path, kind: str, bar, *, point_clouds: bool = True,
               compression: str | None = "zstd", image_topics: str = "raw",
               rgb_codec: str = "png", jpeg_quality: int = 90, depth_no_hit: str = "nan",
-              stamp: str = "sim", bag_name: str | None = None) -> dict:  # fmt: skip
+              stamp: str = "sim", bag_name: str | None = None,
+              bad_frames: str = "refuse") -> dict:  # fmt: skip
     """Writes a recording as an MCAP file (kind "mcap") or a rosbag2 folder ("rosbag2") at
     ``out`` (a path that does not exist yet); returns counts per topic. ``image_topics``:
     "raw" (sensor_msgs/Image), "compressed" (sensor_msgs/CompressedImage; ``rgb_codec`` "png"
     or "jpeg" at ``jpeg_quality``) or "both". ``depth_no_hit``: "nan" (REP 118) or "zero"
     where depth saw nothing; ``stamp``: "sim" (simulation time) or "wall" (the recording's
     wall-clock start + simulation time). ``bag_name`` names a rosbag2 folder's data file
-    (``<bag_name>_0.mcap``; the folder's name by default)."""
+    (``<bag_name>_0.mcap``; the folder's name by default). ``bad_frames``: "refuse" (an
+    ExportError at the first frame or step whose values break ``ambfplus.recording.values``'
+    rules) or "skip" (left out and counted)."""
     export = RosExport(recording, point_clouds=point_clouds, image_topics=image_topics,
                        rgb_codec=rgb_codec, jpeg_quality=jpeg_quality,
-                       depth_no_hit=depth_no_hit, stamp=stamp)  # fmt: skip
+                       depth_no_hit=depth_no_hit, stamp=stamp,
+                       bad_frames=bad_frames)  # fmt: skip
     topics = export.topics()
     sink: McapSink | Rosbag2Sink
     if kind == "mcap":
@@ -896,4 +910,4 @@ def write_ros(recording, out: Path, kind: str, bar, *, point_clouds: bool = True
         raise
     sink.close(export.describe())
     return {"topics": topics, "messages": counts, "warnings": export.warnings,
-            "frames": export.frames()}  # fmt: skip
+            "frames": export.frames(), **export.gate.counts()}  # fmt: skip

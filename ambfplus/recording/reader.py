@@ -135,6 +135,8 @@ class Recording:
         self.conventions: dict = head["conventions"]
         # The texts as stored, which repair() writes back unchanged.
         self.metadata_text: str = head["metadata_text"]
+        #: whether the head holds a metadata attribute (a recorder always writes one)
+        self.metadata_stored: bool = head["metadata_stored"]
         self.legend_text: str = head["legend_text"]
         self.part_summaries = scan_parts(self.path, self.recording_id)
         if self.complete:
@@ -507,6 +509,7 @@ def _read_head(path: Path) -> dict:
                 "complete": bool(attrs.get("complete", False)),
                 "metadata": json.loads(metadata),
                 "metadata_text": metadata,
+                "metadata_stored": "metadata" in attrs,
                 "legend": legend_from_json(legend),
                 "legend_text": legend,
                 "parts": json.loads(text_value(attrs.get("parts")) or "[]"),

@@ -12,6 +12,7 @@ from ..stereo import disparity_agreement
 from .hdf5 import check_global_heaps
 from .reader import DAMAGE, CameraStream, Recording, RigStream, open_recording
 from .schema import RecordingError, find_parts, glob_escape
+from .values import Rules, step_problems
 
 POINTS_RELATIVE_TOLERANCE = 1e-4
 BASELINE_TOLERANCE_M = 1e-6
@@ -93,9 +94,12 @@ def validate(path, match_images: bool = True) -> ValidationReport:
         return ValidationReport(path, [Check("open", "fail", str(error))])
     with recording:
         checks = [_open_check(recording), heaps, _leftover_check(path)]
+        checks.append(_metadata_check(recording))
         try:
+            rules = Rules.of(recording)
             for name, stream in recording.cameras.items():
                 checks += _stream_checks(f"cameras/{name}", stream)
+                checks.append(_values_check(f"cameras/{name}", stream, rules))
             for name, rig in recording.rigs.items():
                 checks += _rig_checks(f"rigs/{name}", rig, match_images)
             checks += _steps_checks(recording.steps)
@@ -333,11 +337,50 @@ def _tolerance_check(title: str, errors: np.ndarray, tolerance: float, unit: str
 def _steps_checks(steps: dict) -> list[Check]:
     if not steps:
         return [Check("steps", "skip", "no steps recorded")]
+    problems = step_problems(steps)
+    values = Check(
+        "steps: values finite, poses rigid",
+        "fail" if problems else "pass",
+        "; ".join(problems),
+        {"columns": len(steps)},
+    )
     return [
         _equal_lengths("steps", steps),
         _increasing("steps/step", steps["step"]),
         _increasing("steps/time", steps["time"]),
+        values,
     ]
+
+
+def _metadata_check(recording: Recording) -> Check:
+    """The head's metadata: stored (a recorder always writes it, {} when given none) and a JSON
+    object; a session's says which scene it recorded (what replay rebuilds)."""
+    title = "metadata"
+    if not recording.metadata_stored:
+        detail = "the head holds no metadata attribute, which every recorder writes: damaged"
+        return Check(title, "fail", detail)
+    if not isinstance(recording.metadata, dict):
+        detail = f"the head's metadata is {type(recording.metadata).__name__}, not a JSON object"
+        return Check(title, "fail", detail)
+    scene = "scene" in recording.metadata
+    detail = "" if scene else "no scene: a recording replay cannot rebuild (not a session's)"
+    return Check(title, "pass", detail, {"keys": len(recording.metadata)})
+
+
+def _values_check(name: str, stream: CameraStream, rules: Rules) -> Check:
+    """Every frame's values (see ``ambfplus.recording.values``); names the first bad frame."""
+    title = f"{name}: frame values"
+    bad, first = 0, ""
+    for i in range(len(stream)):
+        problems = rules.frame_problems(stream[i])
+        if problems:
+            bad += 1
+            if not first:
+                first = f"frame {i} (step {int(stream.step[i])}): {'; '.join(problems)}"
+    if bad:
+        return Check(title, "fail", first + (f"; {bad} frames in all" if bad > 1 else ""),
+                     {"frames": len(stream), "bad_frames": bad})  # fmt: skip
+    return Check(title, "pass", "depth, poses, intrinsics, ids in range", {"frames": len(stream)})
 
 
 def _log_order_checks(recording: Recording) -> list[Check]:

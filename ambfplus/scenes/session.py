@@ -31,7 +31,8 @@ import numpy as np
 from .._core import Device, ReplayDevice
 from ..fileio import refuse_writing_over
 from ..recording import Recorder, open_recording
-from ..recording.schema import recording_files
+from ..recording.schema import RecordingError, recording_files
+from ..recording.values import step_problems
 from ..transforms import make_pose
 from .builders import Scene, build_scene
 
@@ -183,7 +184,17 @@ def replay(
         refuse_writing_over(out, recording_files(Path(path)), "replay")
     with open_recording(path) as rec:
         meta = rec.metadata
+        missing = [k for k in ("scene", "device") if k not in meta]
+        if missing:
+            raise RecordingError(
+                f"{path}: its metadata has no {' or '.join(missing)}: replay rebuilds the scene "
+                "and device of a session recorded by ambfplus (record_session, the launcher)"
+            )
         steps = rec.steps
+        # A value that is not finite is never reproduced (NaN equals nothing): refused.
+        problems = step_problems(steps)
+        if problems:
+            raise RecordingError(f"{path}: cannot replay {problems[0]}")
         removed = rec.removed
         rig_frames = rec.rigs.get(meta.get("rig", RIG))
         plan = (

@@ -76,7 +76,7 @@ def tiny_frame(camera: str, step: int, focal: float = 6.0, x: float = 0.0) -> di
         "intrinsics": np.array([[focal, 0, 4.0], [0, focal, 3.0], [0, 0, 1]]),
         "rgb": rng.integers(0, 256, (6, 8, 3), dtype=np.uint8),
         "depth": rng.uniform(0.2, 0.3, (6, 8)).astype(np.float32),
-        "label": rng.integers(0, 4, (6, 8)).astype(np.uint16),
+        "label": rng.choice(np.array([0, 1, 3], np.uint16), (6, 8)),  # the legend's labels
         "instance": rng.choice(np.array([0, 1, 2], np.int32), (6, 8)),
         "segmentation": rng.integers(0, 256, (6, 8, 3), dtype=np.uint8),
     }  # fmt: skip

@@ -106,3 +106,27 @@ def test_validate_catches_images_that_disagree_with_depth_and_baseline(session, 
     report = validate(copy)
     failed = [c.name for c in report.failed]
     assert failed == ["rigs/rig: disparity from depth and baseline matches the images"], failed
+
+
+def test_replay_refuses_what_it_could_never_reproduce(session, tmp_path):
+    """A NaN in the step log equals nothing a replay computes; a recording with no scene in
+    its metadata has nothing to rebuild: both are RecordingErrors naming what is wrong."""
+    import shutil
+
+    import h5py
+
+    from ambfplus.recording import RecordingError
+
+    path, _ = session
+    for part in path.parent.glob(path.name + "*"):
+        shutil.copy(part, tmp_path / part.name)
+    copy = tmp_path / path.name
+    first = tmp_path / (path.name + ".part0001")
+    with h5py.File(first, "r+") as f:
+        f["steps/hand.position"][7, 2] = np.nan
+    with pytest.raises(RecordingError, match=r"cannot replay steps/hand.position row 7 holds"):
+        replay(copy)
+    with h5py.File(copy, "r+") as f:
+        f.attrs["metadata"] = np.array(b"{}", dtype=h5py.string_dtype("utf-8", 2))
+    with pytest.raises(RecordingError, match="its metadata has no scene or device"):
+        replay(copy)

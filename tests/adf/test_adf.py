@@ -314,7 +314,9 @@ def test_camera_rides_on_its_parent_body(fixtures, tmp_path):
     assert cam.pose[:3, 2] == pytest.approx(link.pose[:3, :3] @ [0, 0, -1.0])
 
 
-def test_unknown_keys_warn_once_and_duplicates_take_the_first(tmp_path, caplog):
+def test_unknown_keys_warn_once_and_repeated_keys_warn_or_refuse(tmp_path, caplog):
+    # yaml-cpp (and so AMBF) keeps a key written twice and reads the first: with one value it
+    # is a warning naming the key and both lines; with two, a ConfigError (see test_silent_cases).
     model = write(
         tmp_path,
         "dup.yaml",
@@ -323,21 +325,26 @@ def test_unknown_keys_warn_once_and_duplicates_take_the_first(tmp_path, caplog):
         BODY a:
           name: a
           mass: 2.0
-          mass: 7.0
+          mass: 2.0
           shape: SPHERE
           geometry: {radius: 0.1}
           detached: true
           visiblity: true
-          detached: false
+          detached: true
         """,
     )
     world = ambfplus.World()
     with caplog.at_level(logging.WARNING, logger="ambfplus"):
         world.load_adf(model)
-    assert world.get("a").mass == 2.0  # first wins, as yaml-cpp (and so AMBF) reads it
+    assert world.get("a").mass == 2.0
     messages = [r.getMessage() for r in caplog.records]
     assert sum("unknown key 'detached'" in m for m in messages) == 1
     assert sum("unknown key 'visiblity'" in m for m in messages) == 1
+    assert sum("line 6: key 'mass' is given twice" in m and "line 5" in m for m in messages) == 1
+    assert sum("key 'detached' is given twice" in m for m in messages) == 1
+    model.write_text(model.read_text().replace("mass: 2.0\n  mass: 2.0", "mass: 2.0\n  mass: 7.0"))
+    with pytest.raises(ambfplus.ConfigError, match=r"line 6: key 'mass' is given twice"):
+        ambfplus.World().load_adf(model)
 
 
 def test_bad_input_names_file_object_and_key(tmp_path):

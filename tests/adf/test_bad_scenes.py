@@ -327,8 +327,15 @@ def test_two_bodies_or_joints_of_one_name_warn_naming_both_blocks(tmp_path, capl
     assert {"a", "a1", "j", "j1"} <= {o.name for o in world.objects}
 
 
-def test_a_block_listed_twice_is_refused(tmp_path):
-    refused(tmp_path, f"bodies: [BODY a, BODY a]\n{BODY_A}\n", "'BODY a'", "twice")
+def test_a_block_listed_twice_is_made_once_with_a_warning(tmp_path, caplog):
+    # The same block named twice is one block (issue #34); test_silent_cases checks the lines.
+    path = write(tmp_path, f"bodies: [BODY a, BODY a]\n{BODY_A}\n")
+    world = ambfplus.World()
+    with caplog.at_level(logging.WARNING, logger="ambfplus"):
+        world.load_adf(path)
+    assert [o.name for o in world.objects] == ["a"]
+    warned = [r.getMessage() for r in caplog.records if "again" in r.getMessage()]
+    assert len(warned) == 1 and str(path) in warned[0] and "'BODY a'" in warned[0], warned
 
 
 def test_a_camera_cycle_is_refused_naming_the_cycle(tmp_path):

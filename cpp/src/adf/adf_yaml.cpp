@@ -18,7 +18,78 @@
 
 namespace ambfplus::adf {
 
-Doc load(const std::string& path, const std::string& what) {
+namespace {
+
+std::string line_of(const YAML::Node& node) {
+  const std::string a = at(node);
+  return a.empty() ? "an earlier line" : a.substr(0, a.size() - 2);
+}
+
+/// Whether a and b hold the same value (the same scalars, in the same order for lists, under the
+/// same keys for mappings). budget bounds the work on aliased input; once spent, "different".
+bool same_value(const YAML::Node& a, const YAML::Node& b, long& budget) {
+  if (--budget < 0) return false;
+  if (a.is(b)) return true;
+  if (a.Type() != b.Type()) return false;
+  switch (a.Type()) {
+    case YAML::NodeType::Scalar:
+      return a.Scalar() == b.Scalar();
+    case YAML::NodeType::Sequence: {
+      if (a.size() != b.size()) return false;
+      for (std::size_t i = 0; i < a.size(); ++i) {
+        if (!same_value(a[i], b[i], budget)) return false;
+      }
+      return true;
+    }
+    case YAML::NodeType::Map: {
+      if (a.size() != b.size()) return false;
+      for (const auto& entry : a) {
+        if (!entry.first.IsScalar()) return false;
+        const YAML::Node other = b[entry.first.Scalar()];
+        if (!other || !same_value(entry.second, other, budget)) return false;
+      }
+      return true;
+    }
+    default:
+      return true;  // null or undefined on both sides
+  }
+}
+
+/// Keys written twice in one mapping of node (and the mappings inside it), each mapping visited
+/// once however often aliases name it: yaml-cpp (and so AMBF) keeps both and reads the first.
+void check_repeated_keys(const Doc& doc, const YAML::Node& node, Diagnostics* diag,
+                         std::set<std::size_t>& visited, long& budget) {
+  if (!node.IsMap() && !node.IsSequence()) return;
+  if (!node.Mark().is_null() && !visited.insert(static_cast<std::size_t>(node.Mark().pos)).second) {
+    return;
+  }
+  if (node.IsSequence()) {
+    for (const YAML::Node& item : node) check_repeated_keys(doc, item, diag, visited, budget);
+    return;
+  }
+  std::map<std::string, std::pair<YAML::Node, YAML::Node>> first;  // key -> (key, value)
+  for (const auto& entry : node) {
+    check_repeated_keys(doc, entry.second, diag, visited, budget);
+    if (!entry.first.IsScalar()) continue;
+    const std::string key = entry.first.Scalar();
+    const auto [seen, fresh] = first.try_emplace(key, entry.first, entry.second);
+    if (fresh) continue;
+    const std::string earlier = line_of(seen->second.first);
+    if (!same_value(seen->second.second, entry.second, budget)) {
+      fail(doc, entry.first, "",
+           "key '" + key + "' is given twice in one mapping (first on " + earlier +
+               ") with different values; AMBF would silently use the first: keep one");
+    }
+    if (diag != nullptr) {
+      diag->warn(doc.path, at(entry.first) + "key '" + key + "' is given twice in one mapping " +
+                               "(first on " + earlier + "), with the same value; read once");
+    }
+  }
+}
+
+}  // namespace
+
+Doc load(const std::string& path, const std::string& what, Diagnostics* diag) {
   require_regular_file(path, what);
   Doc doc{path, fs::absolute(fs::path(path)).parent_path().lexically_normal(), {}};
   std::ifstream file(path, std::ios::binary);
@@ -49,6 +120,9 @@ Doc load(const std::string& path, const std::string& what) {
     throw ConfigError(path, "line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
   }
   if (!doc.root.IsMap()) throw ConfigError(path, what + ": expected a mapping of keys at the top");
+  std::set<std::size_t> visited;
+  long budget = 1000000;
+  check_repeated_keys(doc, doc.root, diag, visited, budget);
   if (const YAML::Node version = doc.root["adf version"]) {
     const std::string v = as<std::string>(doc, version, what, "adf version", "a string");
     if (v != "1.0" && v != "1") {
@@ -108,7 +182,14 @@ bool boolean(const Doc& doc, const YAML::Node& node, const std::string& where,
 std::string text(const Doc& doc, const YAML::Node& node, const std::string& where,
                  const std::string& key) {
   if (!node.IsScalar()) fail(doc, node, where, "'" + key + "' must be a string");
-  return node.as<std::string>();
+  std::string value = node.as<std::string>();
+  // A quoted "\0" would cut the name short where the file system reads it.
+  if (const std::size_t nul = value.find('\0'); nul != std::string::npos) {
+    fail(doc, node, where,
+         "'" + key + "' holds a NUL character (\\0) after '" + value.substr(0, nul) +
+             "'; names and paths cannot contain one");
+  }
+  return value;
 }
 
 double number_or(const Doc& doc, const YAML::Node& parent, const char* key,
@@ -121,6 +202,28 @@ double number_or(const Doc& doc, const YAML::Node& parent, const char* key,
   return n ? number(doc, n, where, key) : fallback;
 }
 
+double scale_of(const Doc& doc, const YAML::Node& block, const std::string& where) {
+  const double scale = number_or(doc, block, "scale", where, 1.0);
+  if (!(scale > 0) || scale > kMaxScale) {
+    fail(doc, block["scale"], where,
+         "'scale' must be > 0 and at most 1e6, got " + block["scale"].Scalar() +
+             " (a scaled mesh or shape beyond that is past Bullet's and the renderer's precision)");
+  }
+  return scale;
+}
+
+double mass_of(const Doc& doc, const YAML::Node& node, const std::string& where) {
+  const double mass = number(doc, node, where, "mass");
+  if (!(mass >= 0)) fail(doc, node, where, "'mass' must be >= 0 (0: static), got " + node.Scalar());
+  if (mass > kMaxMass) {
+    fail(doc, node, where,
+         "'mass' is " + node.Scalar() +
+             " kg; at most 1e9 kg is taken (beyond it the inertia and contact forces overflow "
+             "Bullet's solver; use mass 0 for a body that never moves)");
+  }
+  return mass;
+}
+
 Eigen::Vector3d xyz(const Doc& doc, const YAML::Node& node, const std::string& where,
                     const std::string& key, const Eigen::Vector3d& fallback) {
   if (!node) return fallback;
@@ -128,7 +231,12 @@ Eigen::Vector3d xyz(const Doc& doc, const YAML::Node& node, const std::string& w
   Eigen::Vector3d v = fallback;
   const char* axes[3] = {"x", "y", "z"};
   for (int a = 0; a < 3; ++a) {
-    if (node[axes[a]]) v[a] = number(doc, node[axes[a]], where, key + "." + axes[a]);
+    // AMBF reads all three; a missing one would be a silent 0 here.
+    if (!node[axes[a]]) {
+      fail(doc, node, where,
+           "'" + key + "' needs x, y and z; '" + axes[a] + "' is missing (AMBF reads all three)");
+    }
+    v[a] = number(doc, node[axes[a]], where, key + "." + axes[a]);
   }
   return v;
 }
@@ -162,9 +270,12 @@ Eigen::Matrix4d frame(const Doc& doc, const YAML::Node& node, const std::string&
     double rpy_values[3] = {0.0, 0.0, 0.0};
     const char* names[3] = {"r", "p", "y"};
     for (int a = 0; a < 3; ++a) {
-      if (o[names[a]]) {
-        rpy_values[a] = number(doc, o[names[a]], where, key + ".orientation." + names[a]);
+      if (!o[names[a]]) {
+        fail(doc, o, where,
+             "'" + key + ".orientation' needs r, p and y; '" + names[a] +
+                 "' is missing (AMBF reads all three)");
       }
+      rpy_values[a] = number(doc, o[names[a]], where, key + ".orientation." + names[a]);
     }
     pose.topLeftCorner<3, 3>() = rpy(rpy_values[0], rpy_values[1], rpy_values[2]);
   }
@@ -177,15 +288,11 @@ std::vector<std::pair<std::string, YAML::Node>> listed(const Doc& doc,
   const YAML::Node list = doc.root[list_key];
   if (!list || list.IsNull()) return out;
   if (!list.IsSequence()) fail(doc, list, "", "'" + list_key + "' must be a list of block names");
-  std::map<std::string, std::string> first;  // identifier -> where the list names it first
+  std::set<std::string> seen;
   for (const YAML::Node& entry : list) {
     const std::string id = text(doc, entry, list_key, list_key);
-    if (const auto seen = first.find(id); seen != first.end()) {
-      fail(doc, entry, "",
-           "'" + list_key + "' lists '" + id + "' twice (first " + seen->second +
-               "); a block is made once");
-    }
-    first[id] = at(entry).empty() ? "earlier" : at(entry).substr(0, at(entry).size() - 2);
+    // The same block named again is the same block (repeated_entries warns of it).
+    if (!seen.insert(id).second) continue;
     const YAML::Node block = doc.root[id];
     if (!block || !block.IsMap()) {
       fail(doc, entry, "",
@@ -245,6 +352,22 @@ void Diagnostics::repeated_names(const Doc& doc, std::initializer_list<const cha
       warn(doc.path, at(block) + id + ": its name '" + name + "' is also that of '" +
                          seen->second.first + "'" + seen->second.second +
                          "; it is renamed with a number suffix, as AMBF does for repeated names");
+    }
+  }
+}
+
+void Diagnostics::repeated_entries(const Doc& doc, std::initializer_list<const char*> list_keys) {
+  for (const char* list_key : list_keys) {
+    const YAML::Node list = doc.root[list_key];
+    if (!list || !list.IsSequence()) continue;  // listed() reports it where it is read
+    std::map<std::string, YAML::Node> first;
+    for (const YAML::Node& entry : list) {
+      if (!entry.IsScalar()) continue;
+      const auto [seen, fresh] = first.try_emplace(entry.Scalar(), entry);
+      if (fresh) continue;
+      warn(doc.path, at(entry) + "'" + list_key + "' names '" + entry.Scalar() +
+                         "' again (first on " + line_of(seen->second) +
+                         "); it is the same block, made once");
     }
   }
 }

@@ -24,6 +24,15 @@ namespace ambfplus::adf {
 
 namespace fs = std::filesystem;
 
+class Diagnostics;
+
+/// Bounds on what a block may ask, beyond which Bullet's solver and the renderer's precision are
+/// gone (AMBF takes them and the scene turns to NaN): a body's mass (kg), each principal moment of
+/// inertia (kg m^2) and a mesh or primitive's scale.
+constexpr double kMaxMass = 1e9;
+constexpr double kMaxInertia = 1e15;
+constexpr double kMaxScale = 1e6;
+
 /// One parsed ADF file.
 struct Doc {
   std::string path;  ///< as given
@@ -34,7 +43,10 @@ struct Doc {
 /// Reads a YAML file whose top level is a mapping (`what` names it in errors: "model file").
 /// Throws AssetNotFound when absent, ConfigError with the line for YAML syntax errors, a
 /// non-mapping top level, or an `adf version` other than 1.0.
-Doc load(const std::string& path, const std::string& what);
+/// A key written twice in one mapping is read as AMBF (yaml-cpp) reads it, the first one
+/// winning: a warning to diag (none when diag is null: the file is read again elsewhere) when
+/// both give the same value, a ConfigError naming both lines when they differ.
+Doc load(const std::string& path, const std::string& what, Diagnostics* diag = nullptr);
 
 /// "line N: " for a node (1-based), "" for a node without a position.
 std::string at(const YAML::Node& node);
@@ -78,7 +90,14 @@ YAML::Node mapping(const Doc& doc, const YAML::Node& block, const char* key,
 double number_or(const Doc& doc, const YAML::Node& parent, const char* key,
                  const std::string& where, double fallback);
 
-/// `{x, y, z}`: absent components keep the fallback's.
+/// block's `scale` (1 when absent): ConfigError unless in (0, kMaxScale].
+double scale_of(const Doc& doc, const YAML::Node& block, const std::string& where);
+
+/// A mass in kg at node: ConfigError unless in [0, kMaxMass] (0: static).
+double mass_of(const Doc& doc, const YAML::Node& node, const std::string& where);
+
+/// `{x, y, z}`, all three (AMBF reads each; ConfigError naming the one missing). An absent node
+/// gives the fallback.
 Eigen::Vector3d xyz(const Doc& doc, const YAML::Node& node, const std::string& where,
                     const std::string& key, const Eigen::Vector3d& fallback);
 
@@ -86,12 +105,14 @@ Eigen::Vector3d xyz(const Doc& doc, const YAML::Node& node, const std::string& w
 Eigen::Matrix3d rpy(double r, double p, double y);
 
 /// `{position: {x,y,z}, orientation: {r,p,y}}` as a pose; the position is multiplied by scale.
-/// ConfigError for a coordinate beyond kMaxPosition (1e6 m).
+/// Either part may be absent (zero), but one given needs all three of its keys. ConfigError
+/// for a coordinate beyond kMaxPosition (1e6 m).
 Eigen::Matrix4d frame(const Doc& doc, const YAML::Node& node, const std::string& where,
                       const std::string& key, double scale = 1.0);
 
-/// The blocks the list under root[list_key] names, in order. ConfigError for a list that is not
-/// a list, or names a block the file does not have.
+/// The blocks the list under root[list_key] names, in order, each once (a list naming a block
+/// twice makes it once; Diagnostics::repeated_entries warns of it). ConfigError for a list that
+/// is not a list, or names a block the file does not have.
 std::vector<std::pair<std::string, YAML::Node>> listed(const Doc& doc, const std::string& list_key);
 
 /// A block's `name` with spaces removed (AMBF), or the identifier's last word when absent.
@@ -160,6 +181,9 @@ class Diagnostics {
   /// One warning per block of the lists named that takes a name an earlier block of the file
   /// has (AMBF renames it with a number suffix), naming both blocks.
   void repeated_names(const Doc& doc, std::initializer_list<const char*> list_keys);
+  /// One warning per entry of the lists named that names a block an earlier entry of its list
+  /// names: the block is made once (AMBF's lists are looked up by name), naming both lines.
+  void repeated_entries(const Doc& doc, std::initializer_list<const char*> list_keys);
   /// One warning per key of `keys` that some block of the list `list_key` has: a key AMBF
   /// reads that ambfplus does not apply, naming the blocks (up to three) that have it.
   void not_applied(const Doc& doc, const char* list_key, std::initializer_list<const char*> keys,

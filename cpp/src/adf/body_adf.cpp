@@ -59,22 +59,34 @@ BodyPlan plan_body(const Doc& doc, const std::string& model_hr, const std::strin
   plan.ns = block_ns(doc, ctx, model_ns, id, b);
   RigidBodySpec& s = plan.spec;
   s.name = block_name(doc, id, b);
-  const double scale = number_or(doc, b, "scale", id, 1.0);
-  if (!(scale > 0)) fail(doc, b["scale"], id, "'scale' must be > 0");
+  const double scale = scale_of(doc, b, id);
   s.pose = frame(doc, b["location"], id, "location");
 
   // Mass and inertia.
   if (const YAML::Node mass = b["mass"]) {
-    s.dynamics.mass = number(doc, mass, id, "mass");
-    if (!(s.dynamics.mass >= 0)) fail(doc, mass, id, "'mass' must be >= 0 (0: static)");
+    s.dynamics.mass = mass_of(doc, mass, id);
   } else {
     ctx.diag->warn(doc.path, at(b) + id + ": no 'mass'; 1 kg is used (AMBF's default)");
   }
   if (const YAML::Node inertia = mapping(doc, b, "inertia", id)) {
-    const Eigen::Vector3d i(number_or(doc, inertia, "ix", id, 0.0),
-                            number_or(doc, inertia, "iy", id, 0.0),
-                            number_or(doc, inertia, "iz", id, 0.0));
-    if (!(i.array() >= 0).all()) fail(doc, inertia, id, "'inertia' must be >= 0");
+    Eigen::Vector3d i = Eigen::Vector3d::Zero();
+    const char* keys[3] = {"ix", "iy", "iz"};
+    for (int a = 0; a < 3; ++a) {
+      // AMBF reads all three; a missing one would be a silent 0 (an axis that never turns).
+      if (!inertia[keys[a]]) {
+        fail(doc, inertia, id,
+             std::string("'inertia' needs ix, iy and iz; '") + keys[a] +
+                 "' is missing (AMBF reads all three; leave 'inertia' out to have it computed "
+                 "from the shape)");
+      }
+      const YAML::Node n = inertia[keys[a]];
+      i[a] = number(doc, n, id, std::string("inertia.") + keys[a]);
+      if (!(i[a] >= 0) || i[a] > kMaxInertia) {
+        fail(doc, n, id,
+             std::string("'inertia.") + keys[a] + "' must be >= 0 and at most 1e15 kg m^2, got " +
+                 n.Scalar());
+      }
+    }
     // All zero on a moving body means "not given" (as exporters write it).
     if (s.dynamics.mass == 0 || i.norm() > 0) s.dynamics.inertia = i;
   }

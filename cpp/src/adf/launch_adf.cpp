@@ -166,7 +166,7 @@ void add_enclosure(World& world, const Doc& doc, const YAML::Node& node) {
 }
 
 void load_world(World& world, const std::string& path, adf::Context& ctx) {
-  const Doc doc = adf::load(path, "world file");
+  const Doc doc = adf::load(path, "world file", ctx.diag);
   const YAML::Node& root = doc.root;
   const std::string where = "world";
   static const std::set<std::string> known = {
@@ -226,6 +226,7 @@ void load_world(World& world, const std::string& path, adf::Context& ctx) {
   }
   if (shader) world.set_shader(shader);
   std::vector<adf::ObjectPlugins> object_plugins;
+  ctx.diag->repeated_entries(doc, {"cameras", "lights"});
   ctx.diag->repeated_names(doc, {"cameras", "lights"});
   adf::add_cameras_and_lights(world.default_model(), doc, ns, ctx, own, object_plugins);
   // Plugins once the world is built: its objects', then its own.
@@ -236,7 +237,8 @@ void load_world(World& world, const std::string& path, adf::Context& ctx) {
 }  // namespace
 
 AdfLaunch read_launch(const std::string& path) {
-  const Doc doc = adf::load(path, "launch file");
+  adf::Diagnostics diag;  // its warnings are logged
+  const Doc doc = adf::load(path, "launch file", &diag);
   AdfLaunch launch;
   launch.file = fs::absolute(path).lexically_normal().string();
   auto need = [&](const char* key) {
@@ -263,7 +265,8 @@ AdfLaunch read_launch(const std::string& path) {
 }
 
 AdfColors read_colors(const std::string& path) {
-  const Doc doc = adf::load(path, "colour file");
+  adf::Diagnostics diag;  // its warnings are logged
+  const Doc doc = adf::load(path, "colour file", &diag);
   AdfColors colors;
   for (const auto& entry : doc.root) {
     if (!entry.second.IsMap()) continue;
@@ -287,8 +290,9 @@ AdfColors read_colors(const std::string& path) {
 
 std::vector<AdfInputDevice> read_input_devices(const std::string& path,
                                                std::vector<AdfProblem>* warnings) {
-  const Doc doc = adf::load(path, "input devices file");
   adf::Diagnostics diag;
+  const Doc doc = adf::load(path, "input devices file", &diag);
+  diag.repeated_entries(doc, {"input devices"});
   std::vector<AdfInputDevice> out;
   for (const auto& [id, n] : adf::listed(doc, "input devices")) {
     diag.unknown_keys(doc, id, n,

@@ -105,6 +105,9 @@ void warn_model_keys(const Doc& doc, Context& ctx) {
   ctx.diag->unknown_top_level(doc, known,
                               {"bodies", "soft bodies", "ghost objects", "joints", "sensors",
                                "actuators", "cameras", "lights", "volumes", "vehicles", "drills"});
+  ctx.diag->repeated_entries(
+      doc, {"bodies", "soft bodies", "ghost objects", "joints", "sensors", "actuators", "cameras",
+            "lights", "volumes", "vehicles", "drills"});
   ctx.diag->repeated_names(doc, {"bodies", "soft bodies", "ghost objects", "joints", "sensors",
                                  "actuators", "cameras", "lights", "volumes"});
   for (const char* list : {"bodies", "ghost objects"}) {
@@ -152,7 +155,7 @@ void apply_model_gravity(const Doc& doc, std::vector<BodyPlan>& bodies, Context&
 }  // namespace
 
 Model& load_model(World& world, const std::string& path, Context& ctx) {
-  const Doc doc = load(path, "model file");
+  const Doc doc = load(path, "model file", ctx.diag);
   const YAML::Node& root = doc.root;
   const std::string where = "model";
   warn_model_keys(doc, ctx);

@@ -121,9 +121,18 @@ Material material(const Doc& doc, const std::string& where, const YAML::Node& bl
     }
     for (int i = 0; i < 3; ++i) out[i] = static_cast<float>(c[i]);
   };
+  // AMBF's alpha and transparency are opacities in 0..1, like its colour components.
+  auto opacity = [&](const YAML::Node& parent, const char* key, const std::string& name) {
+    const double value = number_or(doc, parent, key, where, 1.0);
+    if (!(value >= 0 && value <= 1)) {
+      fail(doc, parent[key], where,
+           "'" + name + "' must be in 0..1 (0: clear, 1: opaque), got " + parent[key].Scalar());
+    }
+    return static_cast<float>(value);
+  };
   if (const YAML::Node rgba = mapping(doc, block, "color rgba", where)) {
     rgb(rgba, "color rgba", m.color.data());
-    m.color[3] = static_cast<float>(number_or(doc, rgba, "a", where, 1.0));
+    m.color[3] = opacity(rgba, "a", "color rgba.a");
   } else if (const YAML::Node parts = mapping(doc, block, "color components", where)) {
     if (const YAML::Node diffuse = mapping(doc, parts, "diffuse", where, "color components.")) {
       rgb(diffuse, "color components.diffuse", m.color.data());
@@ -138,7 +147,7 @@ Material material(const Doc& doc, const std::string& where, const YAML::Node& bl
     if (parts["shininess"]) {
       m.shininess = static_cast<float>(number(doc, parts["shininess"], where, "shininess"));
     }
-    m.color[3] = static_cast<float>(number_or(doc, parts, "transparency", where, 1.0));
+    m.color[3] = opacity(parts, "transparency", "color components.transparency");
     // AMBF: ambient = level x diffuse when given, else CHAI3D's grey default.
     const YAML::Node ambient = mapping(doc, parts, "ambient", where, "color components.");
     const float level =

@@ -26,10 +26,9 @@ SoftBodySpec plan_soft_body(const Doc& doc, const std::string& model_lr,
        "compound collision shape", "collision mesh type"});
   SoftBodySpec s;
   s.name = block_name(doc, id, b);
-  s.scale = number_or(doc, b, "scale", id, 1.0);
-  if (!(s.scale > 0)) fail(doc, b["scale"], id, "'scale' must be > 0");
+  s.scale = scale_of(doc, b, id);
   s.pose = frame(doc, b["location"], id, "location");
-  s.mass = number_or(doc, b, "mass", id, s.mass);
+  if (b["mass"]) s.mass = mass_of(doc, b["mass"], id);
   s.margin = number_or(doc, b, "collision margin", id, s.margin);
   // AMBF builds a soft body from its collision mesh (low resolution folders first).
   const YAML::Node mesh = b["collision mesh"] ? b["collision mesh"] : b["mesh"];

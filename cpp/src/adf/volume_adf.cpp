@@ -60,10 +60,7 @@ std::vector<AdfVolumeBlock> read_adf_volumes(const std::string& path) {
     v.identifier = id;
     v.name = adf::block_name(doc, id, block);
     v.pose = adf::frame(doc, block["location"], id, "location");
-    const double scale = adf::number_or(doc, block, "scale", id, 1.0);
-    if (!std::isfinite(scale) || !(scale > 0)) {
-      adf::fail(doc, block["scale"], id, "'scale' must be a positive finite number");
-    }
+    const double scale = adf::scale_of(doc, block, id);
     v.images.dimensions = volume_dimensions(doc, block["dimensions"], id) * scale;
     const YAML::Node images = block["images"];
     if (!images || !images["path"]) {
@@ -212,6 +209,11 @@ std::vector<Volume*> adf::add_adf_volumes(
 
 std::vector<Volume*> load_adf_volumes(World& world, const std::string& path,
                                       const std::string& labels) {
+  {
+    // The readers below read the file again without warnings: warn (logged) once, here.
+    adf::Diagnostics diag;
+    diag.repeated_entries(adf::load(path, "ADF file", &diag), {"volumes", "drills"});
+  }
   const std::vector<AdfVolumeBlock> blocks = read_adf_volumes(path);
   std::vector<AdfDrillBlock> drills = read_adf_drills(path);
   // Without a launch to bring it later, a drill's volume is in the file or already in the world

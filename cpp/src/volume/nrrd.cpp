@@ -788,7 +788,11 @@ std::shared_ptr<VolumeData> build_segmentation(const std::string& path, const La
   }
   auto volume = std::make_shared<VolumeData>(
       l.shape, g.dimensions, table.max_id() > 255 ? LabelType::kUInt16 : LabelType::kUInt8, table);
-  std::int64_t overlaps = 0;
+  // The label values each layer's segments declare: any other value but 0 belongs to no segment.
+  std::vector<std::set<double>> declared(static_cast<std::size_t>(l.layers));
+  for (const Segment& s : segments) declared[s.layer].insert(static_cast<double>(s.label_value));
+  std::int64_t overlaps = 0, undeclared = 0;
+  std::set<double> undeclared_values;  // the first few, for the message
   visit_labels(volume->label_type(), volume->label_data(), [&](auto* labels) {
     using T = std::remove_pointer_t<decltype(labels)>;
     for (int k = 0; k < l.shape[2]; ++k)
@@ -801,11 +805,32 @@ std::shared_ptr<VolumeData> build_segmentation(const std::string& path, const La
             overlaps += out != 0;
             out = static_cast<T>(ids[n]);
           }
+          for (int layer = 0; layer < l.layers; ++layer) {
+            const double x = samples.at(layer, i, j, k);
+            if (x == 0 || declared[layer].count(x) != 0) continue;
+            ++undeclared;
+            if (undeclared_values.size() < 6) undeclared_values.insert(x);
+          }
         }
   });
   if (overlaps > 0) {
     log(LogLevel::kWarning, path + ": " + std::to_string(overlaps) +
                                 " voxels belong to more than one segment; the later segment wins");
+  }
+  if (undeclared > 0) {
+    // Slicer shows such voxels in no segment; they are kept as empty space, but said.
+    std::string values;
+    for (const double v : undeclared_values) {
+      if (values.size() > 0 && std::count(values.begin(), values.end(), ',') == 4) {
+        values += ", ...";
+        break;
+      }
+      values += (values.empty() ? "" : ", ") + std::to_string(static_cast<long long>(v));
+    }
+    log(LogLevel::kWarning,
+        path + ": " + std::to_string(undeclared) +
+            " voxels hold a label value that no Segment<N>_LabelValue of their layer declares (" +
+            values + "); they belong to no segment and load as empty (0)");
   }
   return volume;
 }

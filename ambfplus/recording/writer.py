@@ -98,6 +98,23 @@ class _Rows:
     def count(self) -> int:
         return len(next(iter(self.columns.values())))
 
+    @property
+    def time(self) -> float | None:
+        """The latest simulation time among the rows (None without a time column)."""
+        times = self.columns.get("time")
+        if times is None or not len(times):
+            return None
+        latest = float(np.max(times))
+        return latest if np.isfinite(latest) else None
+
+
+def _latest_time(items) -> float | None:
+    """The latest simulation time among queued items (rows, or batches of rows)."""
+    found = [_latest_time(i.items) if isinstance(i, _Batch) else getattr(i, "time", None)
+             for i in items]  # fmt: skip
+    times = [t for t in found if t is not None]
+    return max(times) if times else None
+
 
 @dataclass
 class _Legend:
@@ -126,14 +143,22 @@ class _Flush:
 
 
 _CLOSE = object()
+# The crash bound (Recorder._wait_for_durable): a part closes once it holds this fraction of the
+# flush interval of simulation time, and a producer this far past the last closed part waits.
+CLOSE_AFTER = 0.75
+BLOCK_AFTER = 0.9
 
 
 class Recorder:
     """Records frames, stereo pairs, steps, removed voxels and events into ``path`` (see the
     module docstring for the layout). All HDF5 work happens on a background thread; ``add_*``
     copies its arrays and returns, or blocks while ``max_pending_bytes`` are waiting (HDF5's
-    chunk cache, up to 8 MiB per image dataset, comes on top). Parts close every
-    ``flush_interval_s``; ``compression`` is "blosc-lz4" (the default), "lzf", "gzip" or None.
+    chunk cache, up to 8 MiB per image dataset, comes on top). A part closes once it holds 0.75
+    of ``flush_interval_s`` of simulation time (rows' ``time``) or after ``flush_interval_s`` of
+    wall-clock time, and ``add_*`` waits while what is queued runs more than 0.9 of the interval
+    past the last closed part, so that a SIGKILL loses at most one interval of simulation time
+    (the first part closes within it of the session's start); ``compression`` is "blosc-lz4"
+    (the default), "lzf", "gzip" or None.
     ``recording_id`` and ``created`` (ISO 8601) replace the random id and the clock's time:
     with them, the same rows give the same bytes (a reproducible file)."""
 
@@ -174,6 +199,11 @@ class Recorder:
         self._queue: deque = deque()
         self._stats = RecorderStats()
         self._pending = 0  # bytes queued or being written
+        # Simulation time, for the crash bound (see _enqueue): the latest queued, the latest in
+        # a closed part, and the first (the session's start, before any part is closed).
+        self._queued_time: float | None = None
+        self._durable_time: float | None = None
+        self._part_time: float | None = None  # the latest written into the open part
         self._error: BaseException | None = None
         self._closing = False
         # Writer side.
@@ -317,7 +347,35 @@ class Recorder:
             stats.bytes_queued += size
             stats.frames_queued += sum(getattr(item, "frames", 0) for item in items)
             stats.pending_high_water_bytes = max(stats.pending_high_water_bytes, self._pending)
+            latest = _latest_time(items)
+            if latest is not None:
+                if self._durable_time is None:
+                    self._durable_time = latest  # the session starts: nothing to lose before
+                self._queued_time = max(latest, self._queued_time or latest)
             self._cond.notify_all()
+            self._wait_for_durable()
+
+    def _wait_for_durable(self) -> None:
+        """The crash bound: a SIGKILL loses at most ``flush_interval_s`` of simulation time.
+        The writer closes a part once it holds CLOSE_AFTER of the interval (or after the
+        interval of wall-clock time); a producer whose queued rows run more than BLOCK_AFTER of
+        it past the last closed part waits here until the writer catches up (under load; at
+        the usual pace it never does). What a kill can lose is then under BLOCK_AFTER of the
+        interval plus the producer's own batch of steps not yet handed over."""
+        limit = BLOCK_AFTER * self.flush_interval_s
+        start = None
+        while (
+            self._error is None
+            and self._queued_time is not None
+            and self._durable_time is not None
+            and self._queued_time - self._durable_time > limit
+        ):
+            if start is None:
+                start = time.perf_counter()
+                self._stats.blocked_calls += 1
+            self._cond.wait()
+        if start is not None:
+            self._stats.seconds_blocked += time.perf_counter() - start
 
     def _wait_for_space(self, size: int) -> None:
         """Backpressure: blocks while the queue is full (an item larger than the whole budget
@@ -362,11 +420,23 @@ class Recorder:
             if item is not None:
                 self._write(item)
                 self._done_with(item)
-            if item is None or time.monotonic() >= deadline or isinstance(item, _Flush):
+            if (
+                item is None
+                or time.monotonic() >= deadline
+                or isinstance(item, _Flush)
+                or (self._part_spans(CLOSE_AFTER * self.flush_interval_s))
+            ):
                 self._rotate()
                 if isinstance(item, _Flush):
                     item.done.set()
                 deadline = time.monotonic() + self.flush_interval_s
+
+    def _part_spans(self, span: float) -> bool:
+        """Whether the open part holds rows more than `span` of simulation time past the last
+        closed part (or the session's start)."""
+        with self._cond:
+            durable, latest = self._durable_time, self._part_time
+        return durable is not None and latest is not None and latest - durable >= span
 
     def _next_item(self, deadline: float):
         """The next queued item, or None when the flush deadline passes first."""
@@ -396,6 +466,10 @@ class Recorder:
                 self._part = _PartFile(part_name(self.path, number), self._head, self.compression)
             self._part.append(item)
             self._part.raise_if_failed()
+            latest = item.time
+            if latest is not None:
+                with self._cond:
+                    self._part_time = max(latest, self._part_time or latest)
         elif isinstance(item, _Legend):
             self._head.legend = item.text
             self._head_dirty = True
@@ -412,6 +486,9 @@ class Recorder:
             with self._cond:
                 self._stats.frames_flushed += frames
                 self._stats.parts += 1
+                if self._part_time is not None:
+                    self._durable_time = self._part_time
+                self._cond.notify_all()
         if self._head_dirty:
             write_head(self.path, self._head, self._parts, complete=False)
             self._head_dirty = False

@@ -691,3 +691,40 @@ def test_a_recorder_left_open_is_completed_when_the_interpreter_exits(tmp_path):
     subprocess.run([sys.executable, "-c", code], check=True, cwd=tmp_path, timeout=60)
     with open_recording(path) as rec:
         assert rec.complete and np.array_equal(rec.steps["step"], np.arange(5))
+
+
+@pytest.mark.parametrize("slow_writer_s", [0.0, 0.05])
+def test_a_sigkill_loses_at_most_one_flush_interval_of_simulation_time(tmp_path, slow_writer_s):
+    """A drilling session that simulates faster than real time, its writer fast or starved (50
+    ms per append: the queue outgrew it before, and a kill lost everything queued), killed once
+    it reached 1.6 s: what its recording holds reaches within one flush interval (0.5 s) of
+    where the simulation was. The first part closed within the interval of the start."""
+    import sys
+
+    sys.path.insert(0, str(Path(__file__).parents[1]))
+    from helpers.killed_session import kill_session
+
+    result = kill_session(tmp_path, 1.6, flush=0.5, slow_writer_s=slow_writer_s)
+    assert result["reached"] >= 1.6 and result["recorded"] > 0, result
+    assert result["loss"] <= 0.5, result
+
+
+def test_the_recorder_keeps_queued_rows_within_the_crash_bound(tmp_path, monkeypatch):
+    """Whatever the writer's pace, a producer never gets more than 0.9 of the flush interval of
+    simulation time past the last closed part: add_* waits for the writer."""
+    import ambfplus.recording.writer as writer
+
+    append = writer._PartFile.append
+
+    def slow_append(self, rows):
+        time.sleep(0.01)
+        return append(self, rows)
+
+    monkeypatch.setattr(writer._PartFile, "append", slow_append)
+    with Recorder(tmp_path / "bound.h5", flush_interval_s=0.2) as rec:
+        for i in range(120):  # 1.2 s of simulation in 10 ms rows, far faster than the writer
+            rec.add_steps({"step": [i + 1], "time": [0.01 * (i + 1)]})
+            assert rec._queued_time - rec._durable_time <= writer.BLOCK_AFTER * 0.2 + 1e-12
+        assert rec.stats.blocked_calls > 0  # the bound held because add_steps waited
+    with open_recording(tmp_path / "bound.h5") as done:
+        assert len(done.parts) >= 6 and len(done.steps["step"]) == 120

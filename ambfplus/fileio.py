@@ -85,3 +85,27 @@ def refuse_writing_over(out, inputs: Iterable, command: str, error: type = OwnIn
                 f"{out}: the output {relation} the input {source}; {command} never writes over "
                 "its own input (with --force or without): choose another output"
             )
+
+
+def require_regular_file(path: Path, what: str, error: type = FileNotFoundError) -> None:
+    """Raises `error` naming `path` unless it is a regular file (after links): what it is
+    instead (missing, a folder, a FIFO, a socket, a device), so that nothing blocks opening a
+    FIFO and no folder is called missing (the engine's readers say the same: util/files.h)."""
+    import stat
+
+    try:
+        mode = Path(path).stat().st_mode
+    except FileNotFoundError:
+        raise error(f"{path}: no such {what}") from None
+    except OSError as failure:
+        raise error(f"{path}: cannot read this {what} ({failure.strerror})") from None
+    if stat.S_ISREG(mode):
+        return
+    kind = (
+        "a folder" if stat.S_ISDIR(mode)
+        else "a FIFO" if stat.S_ISFIFO(mode)
+        else "a socket" if stat.S_ISSOCK(mode)
+        else "a device" if stat.S_ISCHR(mode) or stat.S_ISBLK(mode)
+        else "something else"
+    )  # fmt: skip
+    raise error(f"{path}: not a regular file but {kind} (a {what} is read from a file)")

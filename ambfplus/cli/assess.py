@@ -49,25 +49,15 @@ def add_parser(commands) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Assesses one session (printing the score and the rubric) or a cohort; bad input ends it
-    with the message alone."""
-    from .._core import Error
-    from ..recording import RecordingError
-
-    try:
-        return _run(args)
-    except (Error, RecordingError, ValueError, OSError) as error:
-        raise SystemExit(f"ambfplus assess: {error}") from None
-
-
-def _run(args: argparse.Namespace) -> int:
+    """Assesses one session (printing the score and the rubric) or a cohort."""
+    from .._core import ArgumentError
     from ..training import assess, load_task
     from ..training.cohort import assess_cohort, write_group_report, write_table
 
     task = load_task(args.task) if args.task else None
     if args.group is not None:
         if args.session is not None:
-            raise SystemExit("ambfplus assess: give a session or --group, not both")
+            raise ArgumentError("give a session or --group, not both")
         rows = assess_cohort(args.group, task, args.reference)
         args.out.mkdir(parents=True, exist_ok=True)
         written = write_table(rows, args.out / "metrics.csv")
@@ -83,7 +73,7 @@ def _run(args: argparse.Namespace) -> int:
         )
         return 0
     if args.session is None:
-        raise SystemExit("ambfplus assess: name a session (a recording) or --group")
+        raise ArgumentError("name a session (a recording) or --group")
     result = assess(args.session, task, args.reference)
     d = result.data
     print(

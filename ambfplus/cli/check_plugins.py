@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from .._core import PluginError
+from .values import number
 
 
 def add_parser(commands) -> None:
@@ -15,7 +16,9 @@ def add_parser(commands) -> None:
         "here); exit 1 if any crashes, hangs or fails",
     )
     check.add_argument("plugins", nargs="+", help="plugin files (.so, .py) or names")
-    check.add_argument("--timeout", type=float, default=60.0, help="seconds a probe may take")
+    check.add_argument(
+        "--timeout", type=number(0, above=True), default=60.0, help="seconds a probe may take"
+    )
     check.set_defaults(func=run)
 
 

@@ -4,11 +4,11 @@ meshes."""
 from __future__ import annotations
 
 import argparse
-import sys
+import math
 from pathlib import Path
 
-from ..fileio import OwnInputError
 from ..volumes import convert_volume
+from .values import number, within
 
 
 def add_parser(commands) -> None:
@@ -29,40 +29,41 @@ def add_parser(commands) -> None:
     size = convert.add_mutually_exclusive_group()
     size.add_argument(
         "--dimensions",
-        type=float,
+        type=number(0, above=True),
         nargs=3,
         metavar=("X", "Y", "Z"),
         help="a slice folder's size, metres",
     )
     size.add_argument(
         "--voxel-size",
-        type=float,
+        type=number(0, above=True),
         nargs=3,
         metavar=("X", "Y", "Z"),
         help="a slice folder's voxel size, metres",
     )
-    convert.add_argument("--threshold", type=float, help="segment an intensity NRRD at this value")
     convert.add_argument(
-        "--label", type=int, default=0, help="mesh only this label id (default: every solid voxel)"
+        "--threshold", type=number(-math.inf), help="segment an intensity NRRD at this value"
+    )
+    convert.add_argument(
+        "--label",
+        type=within(0, 65535),
+        default=0,
+        help="mesh only this label id (default: every solid voxel)",
     )
     convert.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     """Converts an anatomy volume and prints what it wrote."""
-    try:
-        summary = convert_volume(
-            args.input,
-            args.output,
-            prefix=args.prefix,
-            labels=args.labels,
-            dimensions=args.dimensions,
-            voxel_size=args.voxel_size,
-            threshold=args.threshold,
-            label=args.label,
-        )
-    except OwnInputError as error:
-        print(f"ambfplus convert: {error}", file=sys.stderr)
-        return 2
+    summary = convert_volume(
+        args.input,
+        args.output,
+        prefix=args.prefix,
+        labels=args.labels,
+        dimensions=args.dimensions,
+        voxel_size=args.voxel_size,
+        threshold=args.threshold,
+        label=args.label,
+    )
     print(summary)
     return 0

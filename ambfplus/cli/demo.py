@@ -3,7 +3,6 @@ and previewed as PNG files."""
 
 from __future__ import annotations
 
-import argparse
 import json
 import sys
 from pathlib import Path
@@ -13,6 +12,7 @@ import numpy as np
 from .._core import ScriptedDevice, __version__, gl_info, write_image
 from ..config import MAX_PHANTOM_RESOLUTION
 from ..dataset.spec import MAX_SIDE
+from .values import within
 
 
 def add_parser(commands) -> None:
@@ -30,21 +30,6 @@ def add_parser(commands) -> None:
     demo.add_argument("--every", type=within(1, 1000), default=50,
                       help="steps (ms) between stereo frames")  # fmt: skip
     demo.set_defaults(func=run)
-
-
-def within(low: int, high: int):
-    """An argparse type: an integer in [low, high], else a one-line usage error saying so."""
-
-    def parse(text: str) -> int:
-        try:
-            value = int(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
-        if not low <= value <= high:
-            raise argparse.ArgumentTypeError(f"expected {low}..{high}, got {value}")
-        return value
-
-    return parse
 
 
 def run(args) -> int:

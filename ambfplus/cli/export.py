@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
 from pathlib import Path
 from typing import Any
 
@@ -54,9 +53,8 @@ def add_parser(commands) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Exports a recording or a dataset folder; errors are one line naming what is wrong."""
-    from ..export import ExportError, MissingExtra, export
-    from ..recording import RecordingError
+    """Exports a recording or a dataset folder (errors reach the CLI's one error path)."""
+    from ..export import export
 
     options: dict[str, Any] = {"bad_frames": "skip" if args.skip_bad_frames else "refuse"}
     if args.to in ("mcap", "rosbag2"):
@@ -72,12 +70,8 @@ def run(args: argparse.Namespace) -> int:
         options["chunk_size"] = args.chunk_size
     if args.to == "coco":
         options["images"] = not args.no_images
-    try:
-        results = export(args.source, args.out, args.to, force=args.force,
-                         progress=False if args.quiet else None, **options)  # fmt: skip
-    except (ExportError, RecordingError, MissingExtra) as error:
-        print(f"ambfplus export: {error}", file=sys.stderr)
-        return 1
+    results = export(args.source, args.out, args.to, force=args.force,
+                     progress=False if args.quiet else None, **options)  # fmt: skip
     results = results if isinstance(results, list) else [results]
     for result in results:
         line = result.to_dict()

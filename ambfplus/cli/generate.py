@@ -5,8 +5,9 @@ from __future__ import annotations
 import argparse
 import atexit
 import gc
-import sys
 from pathlib import Path
+
+from .values import number, within
 
 
 def add_parser(commands) -> None:
@@ -19,7 +20,7 @@ def add_parser(commands) -> None:
     generate.add_argument("spec", type=Path, help="the dataset spec (YAML)")
     generate.add_argument("--out", type=Path, required=True, help="the dataset folder")
     generate.add_argument(
-        "--workers", type=int, default=1, help="local worker processes (default 1)"
+        "--workers", type=within(1, 256), default=1, help="local worker processes (default 1)"
     )
     generate.add_argument(
         "--ray",
@@ -28,38 +29,40 @@ def add_parser(commands) -> None:
         'cluster) or local (a new one); needs pip install "ambfplus[ray]"',
     )
     generate.add_argument(
-        "--ray-cpus", type=float, default=1.0, help="CPUs each Ray task asks for (default 1)"
+        "--ray-cpus",
+        type=number(0, above=True),
+        default=1.0,
+        help="CPUs each Ray task asks for (default 1)",
     )
     generate.add_argument(
         "--ray-gpus",
-        type=float,
+        type=number(0),
         default=0.0,
         help="GPUs each Ray task asks for (default 0); a task given a GPU renders on it",
     )
     generate.add_argument(
-        "--retries", type=int, default=3, help="attempts after the first per episode"
+        "--retries", type=within(0, 100), default=3, help="attempts after the first per episode"
     )
-    generate.add_argument("--timeout", type=float, help="seconds an episode may take")
+    generate.add_argument(
+        "--timeout", type=number(0, above=True), help="seconds an episode may take"
+    )
     generate.add_argument("--quiet", action="store_true", help="no progress bar")
     generate.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    """Generates (or resumes) a dataset from a spec."""
-    from ..dataset import GenerateError, generate
+    """Generates (or resumes) a dataset from a spec; its errors (SpecError, GenerateError, ...)
+    end in ``main``'s one line."""
+    from ..dataset import generate
 
     # At exit, everything is written and closed: spare the driver the collection Python
     # runs then over every object (with Ray's modules loaded it costs about 0.3 CPU-s).
     atexit.register(gc.freeze)
-    try:
-        report = generate(
-            args.spec, args.out, workers=args.workers, ray=args.ray, retries=args.retries,
-            timeout=args.timeout, progress=not args.quiet,
-            ray_options={"cpus": args.ray_cpus, "gpus": args.ray_gpus},
-        )  # fmt: skip
-    except (ValueError, OSError, ImportError, GenerateError) as error:  # SpecError included
-        print(f"error: {error}", file=sys.stderr)
-        return 2
+    report = generate(
+        args.spec, args.out, workers=args.workers, ray=args.ray, retries=args.retries,
+        timeout=args.timeout, progress=not args.quiet,
+        ray_options={"cpus": args.ray_cpus, "gpus": args.ray_gpus},
+    )  # fmt: skip
     print(
         f"{report.folder}: {report.generated} episodes made ({report.frames} stereo pairs), "
         f"{report.skipped} already there, {report.retries} retries, {report.seconds:.1f} s; "

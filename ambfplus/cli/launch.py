@@ -8,6 +8,10 @@ import json
 from pathlib import Path
 
 from .._core import Simulator
+from .values import within
+
+# A day of 1 ms steps.
+MAX_STEPS = 86_400_000
 
 
 def add_parser(commands) -> None:
@@ -20,7 +24,8 @@ def add_parser(commands) -> None:
     launch.add_argument("-a", help="more model files, comma separated")
     launch.add_argument("-i", type=indices, help="input devices to set up, e.g. 0,1")
     launch.add_argument("--ns", default="", help="namespace prefix")
-    launch.add_argument("--steps", type=int, default=1000, help="1 ms steps to take")
+    launch.add_argument("--steps", type=within(0, MAX_STEPS), default=1000,
+                        help="1 ms steps to take (at most a day's)")  # fmt: skip
     launch.add_argument(
         "--strict", action="store_true", help="a model or plugin that fails is fatal"
     )

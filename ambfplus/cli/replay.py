@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
 from pathlib import Path
 
 
@@ -26,21 +25,16 @@ def add_parser(commands) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Re-simulates a recording from its device readings, optionally re-rendering it."""
-    from ..fileio import OwnInputError
     from ..scenes import replay
 
-    try:
-        report = replay(
-            args.recording,
-            out=args.out,
-            baseline=args.baseline,
-            width=args.width,
-            height=args.height,
-            progress=lambda line: print("  " + line, flush=True),
-        )
-    except OwnInputError as error:
-        print(f"ambfplus replay: {error}", file=sys.stderr)
-        return 2
+    report = replay(
+        args.recording,
+        out=args.out,
+        baseline=args.baseline,
+        width=args.width,
+        height=args.height,
+        progress=lambda line: print("  " + line, flush=True),
+    )
     print(
         json.dumps(
             {

@@ -35,6 +35,9 @@ def add_parser(commands) -> None:
 def run(args: argparse.Namespace) -> int:
     """Checks a recording or a dataset folder; exit code 0 only when every check passes."""
     report: DatasetReport | ValidationReport
+    if not args.recording.exists():
+        # Nothing to check is a usage error (status 2), not a failed check (status 1).
+        raise FileNotFoundError(2, "no such recording or dataset folder", str(args.recording))
     if args.recording.is_dir():
         from ..dataset import validate_dataset
 

@@ -8,6 +8,7 @@ from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from .._core import ConfigError
 from .driver import ENVIRONMENT
 from .episode import PARTIAL, SHARDS
 from .manifest import read_manifest, shard_checksum
@@ -61,13 +62,31 @@ def is_dataset(folder) -> bool:
 
 
 def _environment(folder: Path) -> dict:
+    """environment.json of a dataset folder, checked to be a JSON object whose ``spec`` is an
+    object and ``runs`` a list (a ConfigError naming the file otherwise)."""
     path = folder / ENVIRONMENT
     if not path.is_file():
         raise FileNotFoundError(2, f"not a dataset folder (no {ENVIRONMENT})", str(folder))
     try:
-        return json.loads(path.read_text())
-    except ValueError as error:
-        raise ValueError(f"{path}: not JSON ({error})") from None
+        environment = json.loads(path.read_text(encoding="utf-8"))
+    except (ValueError, RecursionError) as error:
+        raise ConfigError(f"{path}: not JSON ({error})") from None
+    if not isinstance(environment, dict):
+        raise ConfigError(f"{path}: expected a JSON object, got {type(environment).__name__}")
+    for key, kind in (("spec", dict), ("runs", list)):
+        if key in environment and not isinstance(environment[key], kind):
+            raise ConfigError(f"{path}: '{key}' must be a JSON {kind.__name__}, damaged")
+    episodes = environment.get("episodes")
+    if (
+        not isinstance(episodes, int)
+        or isinstance(episodes, bool)
+        or not (0 <= episodes <= MAX_EPISODES)
+    ):
+        raise ConfigError(
+            f"{path}: episodes is {episodes!r}, not a whole number in 0..{MAX_EPISODES} as a "
+            "spec gives it: the file is damaged"
+        )
+    return environment
 
 
 def validate_dataset(folder, match_images: bool = True) -> DatasetReport:
@@ -77,19 +96,7 @@ def validate_dataset(folder, match_images: bool = True) -> DatasetReport:
     seed), and nothing unlisted in shards/."""
     folder = Path(folder)
     environment = _environment(folder)
-    episodes = environment.get("episodes") if isinstance(environment, dict) else None
-    if (
-        not isinstance(episodes, int)
-        or isinstance(episodes, bool)
-        or not (0 <= episodes <= MAX_EPISODES)
-    ):
-        report = DatasetReport(folder)
-        report.problems.append(
-            f"{folder / ENVIRONMENT}: episodes is {episodes!r}, not a whole number in "
-            f"0..{MAX_EPISODES} as a spec gives it: the file is damaged"
-        )
-        return report
-    report = DatasetReport(folder, expected=episodes)
+    report = DatasetReport(folder, expected=environment["episodes"])
     records, problems = read_manifest(folder)
     report.problems += problems
     counts = Counter(r["episode"] for r in records)

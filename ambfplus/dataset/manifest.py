@@ -18,7 +18,7 @@ import hashlib
 import json
 import os
 from functools import partial
-from pathlib import Path
+from pathlib import Path, PurePosixPath
 
 from ..fileio import write_text
 
@@ -57,7 +57,8 @@ def without_run_fields(record: dict) -> dict:
 
 def read_manifest(folder) -> tuple[list[dict], list[str]]:
     """The manifest's records in file order, and a list of problems (lines that are not JSON
-    objects with every required field). A missing manifest has no records."""
+    objects with every required field, each of the type the writer gives it: ``record_problem``).
+    A missing manifest has no records."""
     path = Path(folder) / MANIFEST
     if not path.is_file():
         return [], []
@@ -68,7 +69,7 @@ def read_manifest(folder) -> tuple[list[dict], list[str]]:
             continue
         try:
             record = json.loads(line)
-        except ValueError:
+        except (ValueError, RecursionError):  # RecursionError: nested too deeply
             torn = number == len(lines)  # no newline after it: the writer was stopped
             problems.append(f"{path}: line {number} is not JSON" + (" (torn)" if torn else ""))
             continue
@@ -76,8 +77,58 @@ def read_manifest(folder) -> tuple[list[dict], list[str]]:
         if missing:
             problems.append(f"{path}: line {number} lacks {', '.join(missing)}")
             continue
+        problem = record_problem(record)
+        if problem:
+            problems.append(f"{path}: line {number}: {problem}")
+            continue
         records.append(record)
     return records, problems
+
+
+def _count(value) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool) and value >= 0
+
+
+def _relative(value) -> bool:
+    """A path inside the dataset folder, as the writer gives it (``shards/name.h5``)."""
+    if not isinstance(value, str) or not value or "\0" in value or "\\" in value:
+        return False
+    parts = PurePosixPath(value).parts
+    return not value.startswith("/") and ".." not in parts
+
+
+# A required field's check, and what the writer gives it.
+_FIELD_TYPES = {
+    "episode": (_count, "an integer >= 0"),
+    "seed": (_count, "an integer >= 0"),
+    "anatomy": (lambda v: isinstance(v, str), "a name"),
+    "scenario": (lambda v: isinstance(v, str), "a name"),
+    "frames": (_count, "an integer >= 0"),
+    "bytes": (_count, "an integer >= 0"),
+    "sha256": (lambda v: isinstance(v, str), "a hex digest"),
+    "file": (_relative, "a path inside the folder"),
+    "parts": (
+        lambda v: isinstance(v, list) and all(_relative(p) for p in v),
+        "a list of paths inside the folder",
+    ),
+    "version": (lambda v: isinstance(v, str), "a version"),
+    "renderer": (lambda v: isinstance(v, str), "a name"),
+    "label_pixels": (
+        lambda v: isinstance(v, dict) and all(_count(n) for n in v.values()),
+        "a mapping of label names to pixel counts",
+    ),
+}
+
+
+def record_problem(record: dict) -> str:
+    """What is wrong with a record's fields (a type the writer never gives them, a path that
+    leaves the folder), or ''."""
+    for key, (check, expected) in _FIELD_TYPES.items():
+        if key in record and not check(record[key]):
+            shown = repr(record[key])
+            shown = shown if len(shown) <= 60 else shown[:57] + "..."
+            return f"{key} is {type(record[key]).__name__} {shown}, expected {expected}"
+    return ""
 
 
 class ManifestWriter:

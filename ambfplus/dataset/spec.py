@@ -19,6 +19,7 @@ from pathlib import Path
 
 from .._core import ConfigError
 from ..config import (
+    MAX_SEED,
     Where,
     anatomy,
     describe,
@@ -44,6 +45,8 @@ MAX_EVERY = 60_000
 EVERY_LIMIT = "one minute of 1 ms steps between stereo pairs; an episode steps every frame"
 MAX_SIDE = 4096
 SIDE_LIMIT = "a 4096x4096 stereo pair of every pass takes about 0.6 GB"
+MAX_WEIGHT = 1e9
+WEIGHT_LIMIT = "weights are relative: scale them down"
 
 # The paper's camera: f = 1135 px at 480 rows.
 PAPER_FOV_Y = 2.0 * math.atan(240.0 / 1135.0)
@@ -52,13 +55,13 @@ SCHEMA_TEXT = """\
 version: 1                      # required: the spec's schema version
 name: text                      # optional
 episodes: 12                    # required, 1..1000000
-seed: 0                         # base seed (default 0)
+seed: 0                         # base seed (default 0; 0..2^63-1)
 capture:
   every: 40                     # 1 ms steps between stereo pairs (default 40; 1..60000)
   frames: 25                    # stereo pairs per episode (default 25; a scenario may say)
   passes: [rgb, depth, label, instance, voxel]   # (the default)
 anatomies:                      # required, one drawn per episode by weight
-  - phantom: {resolution: 128, seed: 0}          # values may vary; resolution 8..512
+  - phantom: {resolution: 128, seed: 0}          # values may vary; resolution 16..512
     weight: 1
   - file: ear.seg.nrrd          # NRRD, Slicer .seg.nrrd, slice folder or volume ADF,
     weight: 1                   # relative to the spec's folder; prefix, labels, dimensions,
@@ -150,7 +153,7 @@ def parse_spec(data, base: Path, source: str, text: str) -> DatasetSpec:
     out = {"version": SCHEMA_VERSION, "name": str(data.get("name", ""))}
     out["episodes"] = integer(data["episodes"], where.at("episodes"), minimum=1,
                               maximum=MAX_EPISODES, limit=EPISODES_LIMIT)  # fmt: skip
-    out["seed"] = integer(data.get("seed", 0), where.at("seed"), minimum=0)
+    out["seed"] = integer(data.get("seed", 0), where.at("seed"), minimum=0, maximum=MAX_SEED)
     out["capture"] = _capture(data.get("capture", {}), where.at("capture"))
     out["anatomies"] = _weighted_list(
         data["anatomies"], where.at("anatomies"), lambda e, w: anatomy(e, w, base, _varying)
@@ -209,10 +212,15 @@ def _weights(weights, count: int, where: Where) -> list[float]:
         return [1.0] * count
     if not isinstance(weights, list) or len(weights) != count:
         raise where.error(None, f"expected a list of {count} weights, got {describe(weights)}")
-    checked = [number(w, where.at(i), minimum=0) for i, w in enumerate(weights)]
+    checked = [_weight(w, where.at(i)) for i, w in enumerate(weights)]
     if sum(checked) <= 0:
         raise where.error(None, "the weights add up to 0")
     return checked
+
+
+def _weight(value, where: Where) -> float:
+    """A draw's weight: weights are relative, and their sum must stay a finite number."""
+    return number(value, where, minimum=0, maximum=MAX_WEIGHT, limit=WEIGHT_LIMIT)
 
 
 def _weighted_list(value, where: Where, entry: Callable) -> list[dict]:
@@ -221,7 +229,7 @@ def _weighted_list(value, where: Where, entry: Callable) -> list[dict]:
     out = []
     for i, item in enumerate(value):
         mapping(item, where.at(i), "an entry")
-        weight = number(item.get("weight", 1.0), where.at(i).at("weight"), minimum=0)
+        weight = _weight(item.get("weight", 1.0), where.at(i).at("weight"))
         body = {k: v for k, v in item.items() if k != "weight"}
         out.append({**entry(body, where.at(i)), "weight": weight})
     if sum(e["weight"] for e in out) <= 0:

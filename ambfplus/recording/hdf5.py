@@ -39,6 +39,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
+from ..fileio import require_regular_file
 from .schema import MINOR_VERSION_ATTR, RecordingError
 
 # A global heap collection starts with this signature and its version (1, the only one).
@@ -82,8 +83,7 @@ def open_checked(path: Path, heaps: str = "if_variable") -> CheckedFile:
 
 def open_hdf5(path: Path) -> h5py.File:
     """h5py.File(path, "r"), with a RecordingError naming the file if it cannot be opened."""
-    if not path.is_file():
-        raise RecordingError(f"{path}: no such file")
+    require_regular_file(path, "recording file", RecordingError)
     try:
         return h5py.File(path, "r")
     except OSError as error:

@@ -39,9 +39,8 @@ def recording(tmp_path) -> Path:
 
 
 def refused(capsys, *argv: str) -> str:
-    """Runs the command; asserts it fails (export's status for its errors is 1, the others'
-    2) with one line naming the refusal."""
-    assert main(list(argv)) == (1 if argv[0] == "export" else 2)
+    """Runs the command; asserts it fails (status 2) with one line naming the refusal."""
+    assert main(list(argv)) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "never writes over its own input" in err, err
     return err

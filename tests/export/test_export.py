@@ -964,7 +964,7 @@ def test_bad_input_gives_a_clear_error_and_writes_nothing(session, tmp_path):
         with pytest.raises(ValueError, match=message.replace("(", r"\(")):
             export(source, out, to, progress=False)
         completed = run_cli(tmp_path, str(source), "--to", to, str(out))
-        assert completed.returncode == 1 and message in completed.stderr, completed.stderr
+        assert completed.returncode == 2 and message in completed.stderr, completed.stderr
         assert not out.exists()
     # An existing output is kept unless --force.
     existing = tmp_path / "existing.mcap"
@@ -972,7 +972,7 @@ def test_bad_input_gives_a_clear_error_and_writes_nothing(session, tmp_path):
     with pytest.raises(ExportError, match="exists; pass --force"):
         export(session, existing, "mcap", progress=False)
     completed = run_cli(tmp_path, str(session), "--to", "mcap", str(existing))
-    assert completed.returncode == 1 and "exists; pass --force" in completed.stderr
+    assert completed.returncode == 2 and "exists; pass --force" in completed.stderr
     assert existing.read_text() == "keep me"
     completed = run_cli(tmp_path, str(session), "--to", "mcap", str(existing), "--force", "--quiet")
     assert completed.returncode == 0, completed.stderr
@@ -1063,7 +1063,7 @@ def test_an_existing_output_folder_is_kept_unless_forced(tmp_path, to):
     with pytest.raises(ExportError, match=re.escape(message)):
         export(source, out, to, progress=False)
     completed = run_cli(tmp_path, str(source), "--to", to, str(out))
-    assert completed.returncode == 1 and message in completed.stderr, completed.stderr
+    assert completed.returncode == 2 and message in completed.stderr, completed.stderr
     assert tree(outputs) == before
     completed = run_cli(tmp_path, str(source), "--to", to, str(out), "--force", "--quiet")
     assert completed.returncode == 0, completed.stderr
@@ -1333,7 +1333,7 @@ def test_a_dataset_is_exported_by_its_folder_or_a_shards_head(generated, tmp_pat
         with pytest.raises(ValueError, match=message):
             export(source, tmp_path / "out", "coco", progress=False)
         completed = run_cli(tmp_path, str(source), "--to", "coco", str(tmp_path / "out"))
-        assert completed.returncode == 1 and message in completed.stderr, completed.stderr
+        assert completed.returncode == 2 and message in completed.stderr, completed.stderr
         assert list(tmp_path.iterdir()) == []
     completed = run_cli(tmp_path, str(generated), "--to", "original-h5", str(tmp_path / "o"),
                         "--quiet")  # fmt: skip

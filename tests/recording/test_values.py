@@ -206,8 +206,11 @@ def test_a_dataset_whose_environment_claims_absurd_episodes_fails_fast(tmp_path,
 
     (tmp_path / "environment.json").write_text(f'{{"episodes": {episodes}}}')
     (tmp_path / "manifest.jsonl").write_text("")
+    from ambfplus import ConfigError
+
     before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-    report = validate_dataset(tmp_path)
-    assert not report.ok and "episodes is" in report.problems[0]
-    assert "not a whole number in 0..1000000" in report.problems[0]
+    with pytest.raises(
+        ConfigError, match=r"environment.json: episodes is .*, not a whole number in 0..1000000"
+    ):
+        validate_dataset(tmp_path)
     assert resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before < 100_000  # KiB

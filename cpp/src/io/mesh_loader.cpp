@@ -17,6 +17,7 @@
 
 #include "ambfplus/errors.h"
 #include "ambfplus/io/mesh.h"
+#include "io/json_check.h"
 #include "io/off_check.h"
 #include "io/ply_check.h"
 #include "io/stl_check.h"
@@ -51,6 +52,17 @@ std::string read_bytes(const std::string& path) {
   std::ostringstream s;
   s << in.rdbuf();
   return s.str();
+}
+
+// Whether the file's first bytes (after white space) are a JSON object's or binary glTF's.
+bool opens_like_gltf(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  char head[64] = {};
+  in.read(head, sizeof head);
+  const std::string start(head, static_cast<std::size_t>(in.gcount()));
+  if (start.compare(0, 4, "glTF") == 0) return true;
+  const std::size_t first = start.find_first_not_of(" \t\r\n");
+  return first != std::string::npos && start[first] == '{';
 }
 
 bool has_extension(const std::string& path, const char* wanted) {
@@ -171,6 +183,11 @@ MeshData load_mesh(const std::string& path, double scale) {
   if (has_extension(path, ".stl")) io::check_stl(path, read_bytes(path));
   // assimp allocates what an OFF header's counts ask for before reading a row.
   if (has_extension(path, ".off")) io::check_off(path, read_bytes(path));
+  // assimp's JSON reader recurses per level of nesting: a deep glTF overflowed the stack.
+  // assimp also tells glTF by its content, so any file that opens like JSON or binary glTF.
+  if (has_extension(path, ".gltf") || has_extension(path, ".glb") || opens_like_gltf(path)) {
+    io::check_gltf_json(path, read_bytes(path));
+  }
   Assimp::Importer importer;
   importer.SetIOHandler(new RegularFilesOnly);  // the importer owns and deletes it
   // Points and lines carry no surface; drop them so a file of only those reads as empty.

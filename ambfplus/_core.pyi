@@ -443,7 +443,7 @@ class Simulator:
         """
     def step(self, n: typing.SupportsInt | typing.SupportsIndex = 1) -> None:
         """
-        Advances the world by n fixed steps.
+        Advances the world by n fixed steps. StateError while a RealTimeLoop steps the world.
         """
     @property
     def arguments(self) -> list[str]:
@@ -669,7 +669,7 @@ class World:
         """
     def step(self, n: typing.SupportsInt | typing.SupportsIndex = 1) -> None:
         """
-        Advances the clock by n fixed steps.
+        Advances the clock by n fixed steps. StateError while a RealTimeLoop steps the world.
         """
     def stop_step_log(self) -> None:
         """
@@ -1949,7 +1949,7 @@ class RealTimeLoop:
         """
     def start(self) -> None:
         """
-        Starts stepping.
+        Starts stepping (interpreter exit stops it).
         """
     def stop(self) -> None:
         """

@@ -1,5 +1,7 @@
 #pragma once
 
+#include <type_traits>
+
 // What the binding files share. The module is built in two passes so that every signature names
 // Python classes (and the generated stubs are typed): each area first declares its classes and
 // enums (declare_<area>), then defines their methods and its functions (define_<area>).
@@ -147,6 +149,32 @@ pybind11::object state_lock(World& world);
 /// The world's state lock for a thread holding the GIL, taken so that it never waits for the
 /// GIL while holding the lock (a real-time loop waiting for the lock would wait as long).
 std::unique_lock<StateMutex> lock_holding_gil(World& world);
+/// Runs fn() with the GIL released and takes the GIL back in the normal flow, never in a
+/// destructor: a daemon thread taking it back while the interpreter finalizes is ended by Python
+/// (pthread_exit, an unwind), which through pybind11's gil_scoped_release (a noexcept
+/// destructor) was std::terminate ("terminate called without an active exception") at exit.
+template <typename F>
+decltype(auto) without_gil(F&& fn) {
+  PyThreadState* state = PyEval_SaveThread();
+  bool taking_back = false;
+  try {
+    if constexpr (std::is_void_v<decltype(fn())>) {
+      fn();
+      taking_back = true;
+      PyEval_RestoreThread(state);
+    } else {
+      auto result = fn();
+      taking_back = true;
+      PyEval_RestoreThread(state);
+      return result;
+    }
+  } catch (...) {
+    if (!taking_back) PyEval_RestoreThread(state);
+    throw;
+  }
+}
+/// Throws StateError naming `call` while a real-time loop steps the world.
+void refuse_during_loop(const World& world, const char* call);
 /// A drill's distances to each critical structure, by the structure's name (its label number
 /// where the label table has none), metres. Plain C++: callable under the world's lock.
 std::vector<std::pair<std::string, double>> critical_distances_by_name(const Drill& drill);

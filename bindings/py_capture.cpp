@@ -117,10 +117,7 @@ py::object capture(Camera& camera, py::object out, py::object passes, py::object
     auto frame = std::make_shared<Frame>();
     // The frame's buffers decide what a capture makes.
     if (!passes.is_none()) allocate_frame(camera, *frame, parse_passes(passes));
-    {
-      py::gil_scoped_release release;
-      capture_into(camera, *frame, request);
-    }
+    without_gil([&] { capture_into(camera, *frame, request); });
     return py::cast(frame);
   }
   if (!passes.is_none()) {
@@ -128,10 +125,7 @@ py::object capture(Camera& camera, py::object out, py::object passes, py::object
   }
   if (py::isinstance<Frame>(out)) {
     Frame& frame = out.cast<Frame&>();
-    {
-      py::gil_scoped_release release;
-      capture_into(camera, frame, request);
-    }
+    without_gil([&] { capture_into(camera, frame, request); });
     return out;
   }
   if (py::isinstance<py::dict>(out)) {
@@ -171,10 +165,7 @@ py::object capture(Camera& camera, py::object out, py::object passes, py::object
     py::object result = py::cast(frame);
     // The frame's views point into the caller's arrays: keep those alive with it.
     result.attr("_out") = buffers;
-    {
-      py::gil_scoped_release release;
-      capture_into(camera, targets, *frame, request);
-    }
+    without_gil([&] { capture_into(camera, targets, *frame, request); });
     return result;
   }
   throw ArgumentTypeError(

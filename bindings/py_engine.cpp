@@ -6,6 +6,9 @@
 #include <pybind11/stl.h>
 
 #include <memory>
+#include <mutex>
+#include <set>
+#include <vector>
 
 #include "ambfplus/engine/realtime.h"
 #include "ambfplus/plugin/registry.h"
@@ -17,9 +20,50 @@ namespace py = pybind11;
 namespace ambfplus::bindings {
 namespace {
 
+// The loops Python made, so that interpreter exit stops those still running (a loop's threads
+// running on while the interpreter and the engine's statics go away ended in SIGABRT).
+std::mutex& loops_mutex() {
+  static std::mutex m;
+  return m;
+}
+std::set<RealTimeLoop*>& loops() {
+  static std::set<RealTimeLoop*> all;
+  return all;
+}
+
+void start_loop(RealTimeLoop& loop) {
+  {
+    std::lock_guard<std::mutex> lock(loops_mutex());
+    loops().insert(&loop);
+  }
+  py::gil_scoped_release release;
+  loop.start();
+}
+
+// At exit (Python's atexit, before the interpreter finalizes): stops every running loop.
+void stop_loops_at_exit() {
+  std::vector<RealTimeLoop*> running;
+  {
+    std::lock_guard<std::mutex> lock(loops_mutex());
+    running.assign(loops().begin(), loops().end());
+  }
+  py::gil_scoped_release release;
+  for (RealTimeLoop* loop : running) {
+    try {
+      loop->stop();
+    } catch (const std::exception&) {
+      // An error that stopped a step: at exit there is nobody left to raise it to.
+    }
+  }
+}
+
 // Destroys a loop with the GIL released: its polling thread may be waiting for the GIL.
 struct ReleaseGilDelete {
   void operator()(RealTimeLoop* loop) const {
+    {
+      std::lock_guard<std::mutex> lock(loops_mutex());
+      loops().erase(loop);
+    }
     py::gil_scoped_release release;
     delete loop;
   }
@@ -57,6 +101,7 @@ void declare_engine(py::module_& m) {
 }
 
 void define_engine(py::module_& m) {
+  py::module_::import("atexit").attr("register")(py::cpp_function(&stop_loops_at_exit));
   bound<RealTimeLoop, LoopHolder>(m, "RealTimeLoop")
       .def(py::init([](std::shared_ptr<World> world, double rate, int fifo_priority, int cpu,
                        double poll_rate) {
@@ -86,13 +131,7 @@ void define_engine(py::module_& m) {
            "rate: steps per second; fifo_priority: SCHED_FIFO priority to ask for (0: none); "
            "cpu: pin to this CPU (-1: the last, only if SCHED_FIFO is refused; -2: never); "
            "poll_rate: Hz of the thread serving Python devices and plugins.")
-      .def(
-          "start",
-          [](RealTimeLoop& l) {
-            py::gil_scoped_release release;
-            l.start();
-          },
-          "Starts stepping.")
+      .def("start", &start_loop, "Starts stepping (interpreter exit stops it).")
       .def(
           "stop",
           [](RealTimeLoop& l) {
@@ -114,8 +153,7 @@ void define_engine(py::module_& m) {
       .def(
           "__enter__",
           [](RealTimeLoop& l) -> RealTimeLoop& {
-            py::gil_scoped_release release;
-            l.start();
+            start_loop(l);
             return l;
           },
           py::return_value_policy::reference, "Starts stepping.")

@@ -244,6 +244,7 @@ PluginInfo info(World& world, PluginInstance& p) {
 py::object load(World& world, const py::object& plugin, const PluginSite& site,
                 const std::optional<std::string>& name) {
   const py::object os = py::module_::import("os");
+  auto lock = lock_holding_gil(world);  // plugins load, close and reset one thread at a time
   PluginInstance* loaded = nullptr;
   if (py::isinstance<py::str>(plugin) || py::isinstance(plugin, os.attr("PathLike"))) {
     PluginSpec spec;
@@ -332,6 +333,7 @@ void reset_plugins(World& world) {
 }
 
 void close_plugins(World& world) {
+  auto lock = lock_holding_gil(world);
   py::gil_scoped_release release;
   plugins_of(world).close_all();
 }

@@ -262,6 +262,7 @@ void def_adders(Class& cls, GetModel get_model) {
                      std::optional<std::vector<double>> color, std::optional<double> specular,
                      std::optional<double> shininess, const py::kwargs& physics) {
            Model& model = get_model(self);
+           auto lock = lock_holding_gil(model.world());  // see the thread-safety contract
            const RigidBodySpec spec = body_spec(name, shape, size, radius, height, mesh, scale,
                                                 pose, mass, color, specular, shininess, physics);
            return handle(&add_body(model, spec), model.world());
@@ -289,6 +290,7 @@ void def_adders(Class& cls, GetModel get_model) {
               std::optional<Path> mesh, double scale, std::optional<Mat4> pose,
               std::optional<std::vector<double>> color, bool visible, const py::kwargs& collision) {
             Model& model = get_model(self);
+            auto lock = lock_holding_gil(model.world());  // see the thread-safety contract
             RigidBodySpec spec =
                 body_spec(name, shape, size, radius, height, mesh, scale, pose, std::nullopt, color,
                           std::nullopt, std::nullopt, collision);
@@ -314,6 +316,7 @@ void def_adders(Class& cls, GetModel get_model) {
           [get_model](Self& self, const std::string& name, RigidBody& parent, RigidBody& child,
                       const KindOrName<JointType>& type, const py::kwargs& kw) {
             Model& model = get_model(self);
+            auto lock = lock_holding_gil(model.world());  // see the thread-safety contract
             return handle(&add_joint(model, name, parent, child, type, kw), model.world());
           },
           py::arg("name"), py::arg("parent"), py::arg("child"), py::arg("type") = "revolute",
@@ -328,6 +331,7 @@ void def_adders(Class& cls, GetModel get_model) {
                       double near, double far, std::optional<Mat4> pose,
                       const std::vector<double>& background) {
             Model& model = get_model(self);
+            auto lock = lock_holding_gil(model.world());  // see the thread-safety contract
             return handle(
                 &add_camera(model, name, width, height, fov_y, near, far, pose, background),
                 model.world());
@@ -344,6 +348,7 @@ void def_adders(Class& cls, GetModel get_model) {
                       double intensity, double spot_cutoff, double spot_exponent,
                       const Vec3& attenuation) {
             Model& model = get_model(self);
+            auto lock = lock_holding_gil(model.world());  // see the thread-safety contract
             return handle(&add_light(model, name, type, position, direction, color, intensity,
                                      spot_cutoff, spot_exponent, attenuation),
                           model.world());
@@ -361,6 +366,7 @@ void def_adders(Class& cls, GetModel get_model) {
                       std::optional<Mat4> pose, double iso, double quality, double optical_density,
                       std::optional<double> specular, std::optional<double> shininess) {
             Model& model = get_model(self);
+            auto lock = lock_holding_gil(model.world());  // see the thread-safety contract
             return handle(&add_volume(model, name, std::move(data), pose, iso, quality,
                                       optical_density, specular, shininess),
                           model.world());
@@ -375,6 +381,7 @@ void def_adders(Class& cls, GetModel get_model) {
           "add_drill",
           [get_model](Self& self, const std::string& name, Volume& volume, const py::kwargs& kw) {
             Model& model = get_model(self);
+            auto lock = lock_holding_gil(model.world());  // see the thread-safety contract
             DrillSpec spec;
             spec.volume = &volume;
             return handle(&add_drill(model, make_spec(name, drill_options(), to_options(kw), spec)),
@@ -387,6 +394,7 @@ void def_adders(Class& cls, GetModel get_model) {
           [get_model](Self& self, const std::string& name, const std::shared_ptr<Device>& device,
                       Drill& drill, const py::kwargs& kw) {
             Model& model = get_model(self);
+            auto lock = lock_holding_gil(model.world());  // see the thread-safety contract
             return handle(&add_input_device(model, name, device, drill, kw), model.world());
           },
           py::arg("name"), py::arg("device"), py::arg("drill"),
@@ -396,6 +404,7 @@ void def_adders(Class& cls, GetModel get_model) {
           "add_soft_body",
           [get_model](Self& self, const std::string& name, const Path& mesh, const py::kwargs& kw) {
             Model& model = get_model(self);
+            auto lock = lock_holding_gil(model.world());  // see the thread-safety contract
             SoftBodySpec spec;
             spec.mesh = mesh.string();
             spec = make_spec(name, soft_body_options(), to_options(kw), spec);
@@ -416,6 +425,7 @@ void def_adders(Class& cls, GetModel get_model) {
           [get_model](Self& self, const std::string& name, RigidBody& parent,
                       const py::kwargs& kw) {
             Model& model = get_model(self);
+            auto lock = lock_holding_gil(model.world());  // see the thread-safety contract
             ProximitySensorSpec spec;
             spec.parent = &parent;
             return handle(&model.add_sensor(
@@ -433,6 +443,7 @@ void def_adders(Class& cls, GetModel get_model) {
           [get_model](Self& self, const std::string& name, RigidBody& parent,
                       const py::kwargs& kw) {
             Model& model = get_model(self);
+            auto lock = lock_holding_gil(model.world());  // see the thread-safety contract
             ConstraintActuatorSpec spec;
             spec.parent = &parent;
             return handle(&model.add_actuator(
@@ -471,6 +482,7 @@ std::shared_ptr<AdfReport> load_launch_into(World& w, const Path& path,
                                             const std::vector<std::string>& plugins) {
   const AdfLoadOptions options =
       load_options(std::move(models), extra, devices, strict, load_world, prefix, plugins);
+  auto lock = lock_holding_gil(w);  // the loop never steps a half-loaded launch
   py::gil_scoped_release release;
   return std::make_shared<AdfReport>(load_launch(w, path.string(), options));
 }
@@ -529,10 +541,13 @@ void define_simulator(py::class_<Simulator, std::shared_ptr<Simulator>>& simulat
       .def(
           "step",
           [](Simulator& s, std::int64_t n) {
+            refuse_during_loop(s.world(), "Simulator.step");
             py::gil_scoped_release release;
             s.step(n);
           },
-          py::arg("n") = 1, "Advances the world by n fixed steps.")
+          py::arg("n") = 1,
+          "Advances the world by n fixed steps. StateError while a RealTimeLoop steps the "
+          "world.")
       .def_static(
           "from_launch",
           [](const Path& path, std::optional<std::vector<int>> models,
@@ -622,6 +637,7 @@ void define_world_adf(py::class_<World, std::shared_ptr<World>>& world) {
       .def(
           "load_adf",
           [](World& w, const Path& path) {
+            auto lock = lock_holding_gil(w);
             Model* model = nullptr;
             {
               py::gil_scoped_release release;
@@ -634,6 +650,7 @@ void define_world_adf(py::class_<World, std::shared_ptr<World>>& world) {
       .def(
           "load_world_file",
           [](World& w, const Path& path) {
+            auto lock = lock_holding_gil(w);
             py::gil_scoped_release release;
             load_world_file(w, path.string());
           },
@@ -642,6 +659,7 @@ void define_world_adf(py::class_<World, std::shared_ptr<World>>& world) {
       .def(
           "load_volumes",
           [](World& w, const Path& path, std::optional<Path> labels) {
+            auto lock = lock_holding_gil(w);
             std::vector<Volume*> loaded;
             {
               py::gil_scoped_release release;
@@ -742,10 +760,13 @@ void define_world(py::class_<World, std::shared_ptr<World>>& world) {
       .def(
           "step",
           [](World& w, std::int64_t n) {
+            refuse_during_loop(w, "World.step");
             py::gil_scoped_release release;
             w.step(n);
           },
-          py::arg("n") = 1, "Advances the clock by n fixed steps.")
+          py::arg("n") = 1,
+          "Advances the clock by n fixed steps. StateError while a RealTimeLoop steps the "
+          "world.")
       .def_property_readonly("default_model",
                              [](World& w) { return handle(&w.default_model(), w); })
       .def_property_readonly("models",
@@ -756,7 +777,10 @@ void define_world(py::class_<World, std::shared_ptr<World>>& world) {
                              })
       .def(
           "add_model",
-          [](World& w, const std::string& name) { return handle(&w.add_model(name), w); },
+          [](World& w, const std::string& name) {
+            auto lock = lock_holding_gil(w);
+            return handle(&w.add_model(name), w);
+          },
           py::arg("name"), "Adds an empty model (a group of objects).")
       .def("__getitem__",
            [](World& w, const std::string& name) {
@@ -940,6 +964,7 @@ void define_volume_object(py::class_<Volume, Object, std::shared_ptr<Volume>>& v
           "remove_sphere",
           [](Volume& v, const Vec3& c, double r, bool only_removable) {
             py::gil_scoped_release release;
+            auto lock = v.world().lock_state();  // never while the world steps or renders
             return v.remove_sphere(c, r, only_removable);
           },
           py::arg("center"), py::arg("radius"), py::arg("only_removable") = true,
@@ -964,12 +989,20 @@ void define_volume_object(py::class_<Volume, Object, std::shared_ptr<Volume>>& v
           "mark_dirty",
           [](Volume& v, std::optional<std::array<int, 3>> lo,
              std::optional<std::array<int, 3>> hi) {
-            v.data()->mark_dirty(box_from(lo, hi, *v.data()));
+            const VoxelBox box = box_from(lo, hi, *v.data());
+            py::gil_scoped_release release;
+            auto lock = v.world().lock_state();
+            v.data()->mark_dirty(box);
           },
           py::arg("lo") = py::none(), py::arg("hi") = py::none(),
           "declares voxels [lo, hi) (default: all) changed through the labels view")
       .def(
-          "reset", [](Volume& v) { v.data()->reset(); },
+          "reset",
+          [](Volume& v) {
+            py::gil_scoped_release release;
+            auto lock = v.world().lock_state();
+            v.data()->reset();
+          },
           "restores the data's labels as loaded (or last committed)")
       .def_property_readonly(
           "last_upload",
@@ -1476,6 +1509,14 @@ py::object state_lock(World& world) { return py::cast(StateLock{handle(&world, w
 // while holding the lock: another Python thread may keep the GIL for a switch interval (5 ms),
 // and a real-time loop waiting for the lock would wait as long. The lock is only taken while
 // the GIL is held, and waited for, while busy, with the GIL released.
+void refuse_during_loop(const World& world, const char* call) {
+  if (world.realtime()) {
+    throw StateError(std::string(call) + ": a RealTimeLoop is stepping world '" + world.name() +
+                     "'; two steppers would interleave their steps. Stop the loop (loop.stop()) "
+                     "first, or leave the stepping to it");
+  }
+}
+
 std::unique_lock<StateMutex> lock_holding_gil(World& world) {
   std::unique_lock<StateMutex> lock(world.state_mutex(), std::defer_lock);
   while (!lock.try_lock()) {

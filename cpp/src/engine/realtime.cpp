@@ -95,6 +95,19 @@ RealTimeLoop::RealTimeLoop(World& world, const RealTimeOptions& options)
   if (!(options.poll_rate > 0 && options.poll_rate <= options.rate)) {
     throw ArgumentError("real-time loop: poll_rate must be in (0, rate]");
   }
+  if (options.fifo_priority < 0 || options.fifo_priority > 99) {
+    throw ArgumentError(
+        "real-time loop: fifo_priority must be 0 (do not ask) or 1..99 "
+        "(Linux's SCHED_FIFO range), got " +
+        std::to_string(options.fifo_priority));
+  }
+  const long cpus = sysconf(_SC_NPROCESSORS_CONF);
+  if (options.cpu < -2 || (cpus > 0 && options.cpu >= cpus)) {
+    throw ArgumentError(
+        "real-time loop: cpu must be -2 (never pin), -1 (the last CPU when "
+        "SCHED_FIFO is refused) or a CPU of this machine, 0.." +
+        std::to_string(cpus - 1) + ", got " + std::to_string(options.cpu));
+  }
 }
 
 RealTimeLoop::~RealTimeLoop() {

@@ -1,5 +1,8 @@
 #include "ambfplus/scene/volume.h"
+
 #include "ambfplus/errors.h"
+#include "ambfplus/scene/model.h"
+#include "ambfplus/scene/world.h"
 
 #include <stdexcept>
 
@@ -15,6 +18,12 @@ Volume::Volume(Model& model, const VolumeSpec& spec, int id)
       shininess_(spec.shininess) {
   spec.validate();
   set_pose(checked_pose(spec.pose));
+  if (data_) data_->set_guard(&model.world().state_mutex());
+}
+
+Volume::~Volume() {
+  // The data may outlive the world: it no longer guards edits with this world's lock.
+  if (data_ && data_->guard() == &world().state_mutex()) data_->set_guard(nullptr);
 }
 
 void Volume::set_iso(double iso) {

@@ -34,6 +34,7 @@ AMBFPLUS_API const OptionTable<VolumeSpec>& volume_options();
 /// volumes may share one VolumeData.
 class AMBFPLUS_API Volume : public Object {
  public:
+  ~Volume() override;
   ObjectKind kind() const override { return ObjectKind::kVolume; }
   const std::shared_ptr<VolumeData>& data() const { return data_; }
 

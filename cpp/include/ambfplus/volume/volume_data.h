@@ -1,6 +1,7 @@
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <deque>
 #include <string>
@@ -9,6 +10,7 @@
 #include <Eigen/Core>
 
 #include "ambfplus/export.h"
+#include "ambfplus/scene/state_mutex.h"
 #include "ambfplus/volume/label_table.h"
 
 namespace ambfplus {
@@ -157,6 +159,11 @@ class AMBFPLUS_API VolumeData {
   void reset();
   /// Makes the current labels the state reset() returns to.
   void commit();
+  /// The state lock of the world whose volume shows this data (set by Volume; nullptr while
+  /// none does): the Python API takes it around edits from other threads, so that an edit never
+  /// runs while the world steps or renders.
+  StateMutex* guard() const { return guard_.load(); }
+  void set_guard(StateMutex* mutex) { guard_.store(mutex); }
 
   /// Increases with every edit.
   std::int64_t revision() const { return revision_; }
@@ -232,6 +239,7 @@ class AMBFPLUS_API VolumeData {
   std::string source_;
 
   std::int64_t revision_ = 0;
+  std::atomic<StateMutex*> guard_{nullptr};
   std::deque<std::pair<std::int64_t, VoxelBox>> dirty_;  // recent edits, oldest first
   std::int64_t dirty_floor_ = 0;  // edits at or before this revision are no longer listed
   VoxelBox dirty_dropped_;        // the union of the boxes of those edits

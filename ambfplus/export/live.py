@@ -42,12 +42,24 @@ own and a small relay holds the public one: it passes each connection through un
 that a handshake offering only the old name reaches the SDK offering the new one and is
 answered with the name the client offered. The relay runs on a thread of its own and copies
 bytes as they come; the physics loop never waits for it.
+
+The relay also guards the server: at most ``max_clients`` WebSocket clients (32; more are
+answered HTTP 503) and MAX_HANDSHAKES connections in their handshake (past it the oldest is
+answered 503), each head within ``handshake_timeout`` (5 s), client frames checked as they pass
+(masked, known opcodes, messages of ``max_client_message`` bytes at most, each frame whole
+within FRAME_TIMEOUT_S: otherwise that client alone is cut), dead peers (half-open connections)
+found by TCP keepalive and a user timeout within about 7 s, and at most RELAY_CHUNK +
+RELAY_WRITE_BUFFER bytes held each way for a client, whether it reads or not. A second after
+clients leave, the C heap's free memory goes back to the system. The drills' helper bodies
+(drill_helpers) get no frame.
 """
 
 from __future__ import annotations
 
 import asyncio
 import contextlib
+import ctypes
+import re
 import socket
 import threading
 import time
@@ -83,19 +95,41 @@ SUBPROTOCOL = "foxglove.sdk.v1"
 LEGACY_SUBPROTOCOL = "foxglove.websocket.v1"
 SUBPROTOCOLS = (SUBPROTOCOL, LEGACY_SUBPROTOCOL)
 HANDSHAKE_LIMIT = 64 * 1024  # bytes; a longer HTTP head is refused
-HANDSHAKE_TIMEOUT_S = 10.0  # a client that sends no complete head in this time is dropped
-RELAY_CHUNK = 256 * 1024  # bytes copied per read
+HANDSHAKE_TIMEOUT_S = 5.0  # a client that sends no complete head in this time is dropped
+MAX_CLIENTS = 32  # WebSocket clients served at once; more are answered HTTP 503
+MAX_HANDSHAKES = 64  # connections still in their HTTP head; past it the oldest gets HTTP 503
+MAX_CLIENT_MESSAGE = 1024 * 1024  # bytes; a longer frame or message from a client drops it
+FRAME_TIMEOUT_S = 5.0  # a client frame begun must be whole within this time
+MESSAGE_BACKLOG = 64  # messages the SDK queues per client; a slow client loses the oldest
+# A dead peer (a half-open connection) is dropped within about 7 s: keepalive probes after 2 s
+# of silence, and data or probes unacknowledged for 6 s end the connection (TCP_USER_TIMEOUT).
+KEEPALIVE_IDLE_S, KEEPALIVE_INTERVAL_S, KEEPALIVE_PROBES = 2, 1, 4
+USER_TIMEOUT_MS = 6000
+RELAY_CHUNK = 64 * 1024  # bytes copied per read
+# What the relay holds for one client at most, each way: a chunk read and a write buffer the
+# reading waits on (asyncio's drain), so a client that does not read costs no more.
+RELAY_WRITE_BUFFER = 128 * 1024
 CLOSE_GRACE_S = 1.0  # on stop, how long relays may finish the SDK's closing handshakes
+TRIM_DELAY_S = 1.0  # after the last of a group of clients leaves, memory goes back to the system
 
 
 def _durations() -> deque:
     return deque(maxlen=TIMINGS_KEPT)
 
 
+def _connection_counts() -> dict:
+    return {"accepted": 0, "refused": 0, "malformed": 0, "timed_out": 0, "lost": 0,
+            "clients": 0, "open": 0}  # fmt: skip
+
+
 @dataclass
 class LiveStats:
-    """What the server did: state ticks run and skipped, messages sent, images sent, and
-    durations of the last ticks and image rounds (a capture of every subscribed camera)."""
+    """What the server did: state ticks run and skipped, messages sent, images sent,
+    durations of the last ticks and image rounds (a capture of every subscribed camera), and
+    what became of connections: ``connections`` counts those accepted, refused (HTTP 503: over
+    a limit), dropped for a malformed or oversized frame, timed out (no whole handshake or frame
+    in time) and lost (reset, or a dead peer found by keepalive), with the WebSocket clients
+    served and the connections open now."""
 
     ticks: int = 0
     skipped: int = 0
@@ -105,6 +139,7 @@ class LiveStats:
     image_seconds: float = 0.0  # wall time with an image subscriber
     tick_seconds: deque = field(default_factory=_durations)
     round_seconds: deque = field(default_factory=_durations)
+    connections: dict = field(default_factory=_connection_counts)
 
     def summary(self) -> dict:
         ticks = np.asarray(self.tick_seconds) if self.tick_seconds else np.zeros(1)
@@ -116,25 +151,61 @@ class LiveStats:
                 "tick_ms_median": float(np.median(ticks) * 1e3),
                 "tick_ms_max": float(ticks.max() * 1e3),
                 "image_round_ms_median": float(np.median(rounds) * 1e3),
-                "image_round_ms_max": float(rounds.max() * 1e3)}  # fmt: skip
+                "image_round_ms_max": float(rounds.max() * 1e3),
+                "connections": dict(self.connections)}  # fmt: skip
+
+
+# A burr's mesh as the drilling plugin finds it: a body named by its diameter in mm ("1mm").
+_BURR_MESH = re.compile(r"([0-9]+(?:\.[0-9]+)?)mm")
+
+
+def drill_helpers(world) -> set[str]:
+    """The names of the bodies that stand in for parts of the world's drills rather than being
+    objects of the scene, so the live view gives them no frame: the burr meshes the drilling
+    plugin shows one at a time on the drill, named by a diameter the drill has (``1mm`` ...
+    ``6mm``; the drill's own frame places them), and its cursor markers (``<drill>_proxy_<i>``
+    and ``<drill>_goal_<i>``, one of each per cursor, hidden unless asked for). These are the
+    names the plugin gives and looks for; bodies attached with ``Drill.attach`` in Python (a
+    scene's burr, shaft and handle) keep their frames."""
+    helpers: set[str] = set()
+    drills = list(world.drills)
+    if not drills:
+        return helpers
+    diameters = [d for drill in drills for d in drill.burr_diameters]
+    for body in world.objects:
+        found = _BURR_MESH.fullmatch(body.name) if body.kind == "body" else None
+        if found and any(abs(float(found[1]) * 1e-3 - d) < 1e-9 for d in diameters):
+            helpers.add(body.name)
+    for drill in drills:
+        for i in range(len(drill.cursor_radii)):
+            helpers.update((f"{drill.name}_proxy_{i}", f"{drill.name}_goal_{i}"))
+    return helpers
 
 
 class FoxgloveServer:
     """Serves ``world`` live (see the module docstring): ``cameras`` (default: all of the
     world's) and its first drill (or ``drill``), the state at ``rate`` Hz and images at up to
-    ``image_rate`` Hz (default ``rate``), on ``host``:``port`` (0: any free port).
-    ``start()``/``stop()`` or a ``with`` block."""
+    ``image_rate`` Hz (default ``rate``), on ``host``:``port`` (0: any free port), to at most
+    ``max_clients`` clients at once, each sending messages of ``max_client_message`` bytes at
+    most and its handshake within ``handshake_timeout`` s. ``start()``/``stop()`` or a
+    ``with`` block."""
 
     def __init__(self, world, cameras=None, *, drill=None, rate: float = 10.0,
                  image_rate: float | None = None, host: str = "127.0.0.1",
-                 port: int = DEFAULT_PORT, depth: bool = False,
-                 name: str = "ambfplus") -> None:  # fmt: skip
+                 port: int = DEFAULT_PORT, depth: bool = False, name: str = "ambfplus",
+                 max_clients: int = MAX_CLIENTS, max_client_message: int = MAX_CLIENT_MESSAGE,
+                 handshake_timeout: float = HANDSHAKE_TIMEOUT_S) -> None:  # fmt: skip
         self._foxglove = require("foxglove", "foxglove")
         require("foxglove", "rosbags.typesys")
         image_rate = rate if image_rate is None else image_rate
-        for what, value in (("rate", rate), ("image_rate", image_rate)):
+        for what, value in (("rate", rate), ("image_rate", image_rate),
+                            ("max_clients", max_clients),
+                            ("max_client_message", max_client_message),
+                            ("handshake_timeout", handshake_timeout)):  # fmt: skip
             if not value > 0:
-                raise ValueError(f"{what} must be > 0 Hz, got {value}")
+                raise ValueError(f"{what} must be > 0, got {value}")
+        self.max_clients, self.max_client_message = int(max_clients), int(max_client_message)
+        self.handshake_timeout = float(handshake_timeout)
         self.world = world
         self.cameras = list(world.cameras if cameras is None else cameras)
         drills = list(world.drills)
@@ -148,10 +219,13 @@ class FoxgloveServer:
         self._threads: list[threading.Thread] = []
         self._stop = threading.Event()
         self._errors: list[BaseException] = []
-        # Objects whose pose /tf carries, chosen once.
-        self._posed_objects = [o for o in world.objects if o.kind in ("body", "volume", "drill")]
+        # Objects whose pose /tf carries, chosen once: not the drills' helper bodies.
+        helpers = drill_helpers(world)
+        self._posed_objects = [o for o in world.objects if o.kind in ("body", "volume", "drill")
+                               and o.name not in helpers]  # fmt: skip
         # (object name, its TF frame: the rule the ROS exports follow)
         self._posed = [(o.name, tf_frame(o.name)) for o in self._posed_objects]
+        self._posed_names = [o.name for o in self._posed_objects]
         # What each tick reads: the posed objects, the cameras, then the drill.
         self._read_objects = self._posed_objects + list(self.cameras)
         if self.drill is not None:
@@ -183,12 +257,16 @@ class FoxgloveServer:
         try:
             server = fox.start_server(name=self.name, host="127.0.0.1", port=0,
                                       context=self._context,
-                                      message_backlog_size=64)  # fmt: skip
+                                      message_backlog_size=MESSAGE_BACKLOG)  # fmt: skip
         except Exception as error:
             listener.close()
             raise RuntimeError(f"the Foxglove SDK's server did not start: {error}") from None
         try:
-            self._relay = _SubprotocolRelay(listener, server.port)
+            self._relay = _SubprotocolRelay(
+                listener, server.port, max_clients=self.max_clients,
+                max_message=self.max_client_message, handshake_timeout=self.handshake_timeout,
+                counts=self.stats.connections,
+            )  # fmt: skip
         except BaseException:
             server.stop()
             raise
@@ -315,7 +393,7 @@ class FoxgloveServer:
                       if (p == "rgb" or self.depth) and self._wanted(topic)]  # fmt: skip
             if not passes:
                 continue
-            frame = camera.capture(passes=passes, poses=True)
+            frame = camera.capture(passes=passes, poses=self._posed_names)
             t = nanoseconds(frame.time)
             link, frame_id = camera_frames(camera.name)
             if self._wanted("/tf"):  # first, so a client has the pose when the image comes
@@ -467,20 +545,148 @@ def _answer_legacy_name(response: bytes) -> bytes:
     return b"\r\n".join(lines)
 
 
+class _Refused(Exception):
+    """A connection the relay ends on purpose; `what` is the count it goes to."""
+
+    def __init__(self, what: str, why: str) -> None:
+        super().__init__(why)
+        self.what = what
+
+
+def _busy(why: str) -> bytes:
+    """The HTTP answer to a connection over a limit: 503, saying which."""
+    body = f"the live view is busy: {why}\n".encode()
+    return (b"HTTP/1.1 503 Service Unavailable\r\nRetry-After: 5\r\nContent-Type: text/plain\r\n"
+            b"Connection: close\r\nContent-Length: %d\r\n\r\n%s" % (len(body), body))  # fmt: skip
+
+
+# A client's close frame, code 1001 (going away), masked with a zero key (RFC 6455 5.3).
+GOING_AWAY = b"\x88\x82\x00\x00\x00\x00" + (1001).to_bytes(2, "big")
+
+
+def _frame_head_size(head: bytes) -> int | None:
+    """The length of the frame header `head` begins (RFC 6455 5.2), None before 2 bytes."""
+    if len(head) < 2:
+        return None
+    length = head[1] & 0x7F
+    return 2 + (2 if length == 126 else 8 if length == 127 else 0) + (4 if head[1] & 0x80 else 0)
+
+
+class _ClientFrames:
+    """Follows the frames a client sends as the bytes pass, without keeping payloads (RFC 6455
+    5.2): each must be masked, of a known opcode, with no reserved bit that the handshake did not
+    negotiate (`reserved`), control frames whole and short, and no frame or fragmented message
+    longer than `limit` bytes, refused from its header on. Raises _Refused at the first that is
+    not. `begun`: when the frame under way began (None between frames)."""
+
+    def __init__(self, limit: int, reserved: int = 0) -> None:
+        self.limit, self.reserved = limit, reserved
+        self.begun: float | None = None
+        self.closed = False  # the client sent its close frame
+        self.whole = True  # what was passed on ends with a whole frame (set by _pump_client)
+        self._head = b""  # a header cut short by a read
+        self._left = 0  # payload bytes of the frame under way still to come
+        self._message: int | None = None  # bytes so far of a fragmented message
+
+    def feed(self, data: bytes) -> None:
+        i, n = 0, len(data)
+        while i < n:
+            if self.begun is None:
+                self.begun = time.monotonic()
+            if self._left:
+                step = min(self._left, n - i)
+                self._left -= step
+                i += step
+            else:
+                head = self._head + data[i : i + 14]
+                size = _frame_head_size(head)
+                if size is None or len(head) < size:  # the rest of the data is header
+                    self._head = head
+                    return
+                i += size - len(self._head)
+                self._head = b""
+                self._left = self._check(head[:size])
+            if not self._left:
+                self.begun = None
+
+    def _check(self, head: bytes) -> int:
+        """The payload length of a frame with header `head`, or _Refused."""
+        opcode, final = head[0] & 0x0F, head[0] & 0x80
+        if head[0] & 0x70 & ~self.reserved:
+            raise _Refused("malformed", "a reserved bit set")
+        if not head[1] & 0x80:
+            raise _Refused("malformed", "an unmasked frame")
+        length = head[1] & 0x7F
+        if length >= 126:
+            length = int.from_bytes(head[2:4] if length == 126 else head[2:10], "big")
+        if opcode >= 8:
+            if opcode > 10 or not final or length > 125:
+                raise _Refused("malformed", "a bad control frame")
+            self.closed = self.closed or opcode == 8
+            return length
+        if opcode > 2 or (opcode == 0) != (self._message is not None):
+            raise _Refused("malformed", f"opcode {opcode} out of place")
+        total = (self._message or 0) + length
+        if total > self.limit:
+            raise _Refused("malformed", f"a message over {self.limit} bytes")
+        self._message = None if final else total
+        return length
+
+
+def _guard_socket(writer: asyncio.StreamWriter) -> None:
+    """Keepalive and a user timeout on a client's socket, so that a dead peer (a half-open
+    connection) is dropped within seconds (Linux; elsewhere what the system offers)."""
+    sock = writer.get_extra_info("socket")
+    if sock is None:
+        return
+    options = [(socket.SOL_SOCKET, "SO_KEEPALIVE", 1),
+               (socket.IPPROTO_TCP, "TCP_KEEPIDLE", KEEPALIVE_IDLE_S),
+               (socket.IPPROTO_TCP, "TCP_KEEPINTVL", KEEPALIVE_INTERVAL_S),
+               (socket.IPPROTO_TCP, "TCP_KEEPCNT", KEEPALIVE_PROBES),
+               (socket.IPPROTO_TCP, "TCP_USER_TIMEOUT", USER_TIMEOUT_MS)]  # fmt: skip
+    for level, name, value in options:
+        if hasattr(socket, name):
+            with contextlib.suppress(OSError):
+                sock.setsockopt(level, getattr(socket, name), value)
+
+
+def _give_back_memory() -> None:
+    """Returns the C heap's free pages to the system (glibc's malloc_trim), so that what the
+    clients used (the SDK's queues, sockets' buffers) leaves the RSS when they do."""
+    try:
+        ctypes.CDLL(None).malloc_trim(0)
+    except (OSError, AttributeError):  # not glibc
+        pass
+
+
 class _SubprotocolRelay:
     """Accepts connections on `listener` and relays each to the SDK's server on the loopback
     `backend_port`, renaming the subprotocol in the handshake of a client that offers only
-    the old name (_offer_sdk_name, _answer_legacy_name); everything after the handshake is
-    copied unchanged both ways. An asyncio loop on a thread of its own."""
+    the old name (_offer_sdk_name, _answer_legacy_name); after the handshake, bytes are copied
+    both ways unchanged, the client's frames checked on the way (_ClientFrames). An asyncio loop
+    on a thread of its own. Limits: `max_clients` WebSocket clients (more get HTTP 503) and
+    MAX_HANDSHAKES connections in their handshake (past it the oldest gets HTTP 503), the head
+    within `handshake_timeout`,
+    client messages of `max_message` bytes at most, each frame whole within FRAME_TIMEOUT_S,
+    and at most RELAY_CHUNK + RELAY_WRITE_BUFFER bytes held each way per client. `counts`
+    (LiveStats.connections) says what happened to connections."""
 
-    def __init__(self, listener: socket.socket, backend_port: int) -> None:
+    def __init__(self, listener: socket.socket, backend_port: int, *, max_clients: int,
+                 max_message: int, handshake_timeout: float, counts: dict) -> None:  # fmt: skip
         self.port: int = listener.getsockname()[1]
         self.backend_port = backend_port
+        self.max_clients, self.max_message = max_clients, max_message
+        self.handshake_timeout = handshake_timeout
+        self.counts = counts
         self.errors: list[BaseException] = []  # unexpected ones, reported by stop()
         self._listener = listener
         self._loop = asyncio.new_event_loop()
         self._closing: asyncio.Event | None = None
         self._connections: dict[asyncio.Task, list[asyncio.StreamWriter]] = {}
+        # Connections in their handshake, oldest first, and those cut to make room.
+        self._handshaking: dict[asyncio.Task, asyncio.StreamWriter] = {}
+        self._evicted: set[asyncio.Task] = set()
+        self._trim: asyncio.TimerHandle | None = None
         started = threading.Event()
         self._thread = threading.Thread(target=self._run, args=(started,), daemon=True,
                                         name="foxglove-relay")  # fmt: skip
@@ -513,6 +719,7 @@ class _SubprotocolRelay:
             started.set()
             self._listener.close()
             self._loop.close()
+            _give_back_memory()
 
     async def _main(self, started: threading.Event) -> None:
         self._closing = asyncio.Event()
@@ -521,6 +728,8 @@ class _SubprotocolRelay:
         started.set()
         await self._closing.wait()
         server.close()
+        if self._trim is not None:
+            self._trim.cancel()
         # Cut the connections still in their handshake at once; the others pass on the SDK's
         # closing (it stopped first) for up to CLOSE_GRACE_S, then are cut. Cut transports
         # end their tasks (cancelling a connection's task makes asyncio log it on 3.11).
@@ -542,54 +751,147 @@ class _SubprotocolRelay:
         task = asyncio.current_task()
         assert task is not None, "a connection is served by a task"
         writers = self._connections[task] = [client_writer]
+        counts = self.counts
+        counts["accepted"] += 1
+        counts["open"] = len(self._connections)
+        outcome, served = None, False
         try:
-            request = await asyncio.wait_for(client_reader.readuntil(b"\r\n\r\n"),
-                                             HANDSHAKE_TIMEOUT_S)  # fmt: skip
-            request, renamed = _offer_sdk_name(request)
-            backend_reader, backend_writer = await asyncio.open_connection(
-                "127.0.0.1", self.backend_port, limit=HANDSHAKE_LIMIT
-            )
-            writers.append(backend_writer)
-            backend_writer.write(request)
-            response = await asyncio.wait_for(backend_reader.readuntil(b"\r\n\r\n"),
-                                              HANDSHAKE_TIMEOUT_S)  # fmt: skip
-            client_writer.write(_answer_legacy_name(response) if renamed else response)
-            upstream = asyncio.ensure_future(_pump(client_reader, backend_writer))
-            downstream = asyncio.ensure_future(_pump(backend_reader, client_writer))
-            pumps = [upstream, downstream]
+            _guard_socket(client_writer)
+            client_writer.transport.set_write_buffer_limits(high=RELAY_WRITE_BUFFER)
+            # Over MAX_HANDSHAKES, the oldest handshake makes room: a client sends its head
+            # as soon as it connects, so idle connections cannot keep one out.
+            self._handshaking[task] = client_writer
+            if len(self._handshaking) > MAX_HANDSHAKES:
+                self._evict(next(iter(self._handshaking)))
             try:
-                # A connection ends with the SDK's side; where the client ends first, the SDK
-                # is told (a half close) and its end awaited.
-                done, _ = await asyncio.wait(pumps, return_when=asyncio.FIRST_COMPLETED)
-                if downstream not in done and upstream.exception() is None:
-                    await downstream
+                request = await asyncio.wait_for(client_reader.readuntil(b"\r\n\r\n"),
+                                                 self.handshake_timeout)  # fmt: skip
             finally:
-                for pump in pumps:
-                    pump.cancel()
-                for result in await asyncio.gather(*pumps, return_exceptions=True):
-                    if isinstance(result, Exception):
-                        raise result
-        except (OSError, EOFError, asyncio.TimeoutError, asyncio.LimitOverrunError):
-            pass  # a peer that left, reset or never completed its HTTP head: dropped
+                self._handshaking.pop(task, None)
+            if counts["clients"] >= self.max_clients:
+                client_writer.write(_busy(f"it serves {self.max_clients} clients at most"))
+                raise _Refused("refused", "too many clients")
+            counts["clients"] += 1
+            served = True
+            await self._relay(request, client_reader, client_writer, writers)
+        except _Refused as refusal:
+            outcome = refusal.what
+            if refusal.what != "refused":  # cut mid-stream: no closing handshake to wait for
+                client_writer.transport.abort()
+        except asyncio.TimeoutError:
+            outcome = "timed_out"
+        except (OSError, EOFError, asyncio.LimitOverrunError):
+            outcome = "lost"  # a peer that left, reset or sent an HTTP head too long
         except Exception as error:  # reported by stop()
             self.errors.append(error)
         finally:
+            if task in self._evicted:
+                self._evicted.discard(task)
+                outcome = "refused"
+            if outcome is not None:
+                counts[outcome] += 1
+            if served:
+                counts["clients"] -= 1
             for writer in writers:
                 writer.close()  # sends what is buffered first (the SDK's closing frame)
             for writer in writers:
                 with contextlib.suppress(Exception):
                     await writer.wait_closed()
             del self._connections[task]
+            counts["open"] = len(self._connections)
+            # Memory back to the system a moment after a group of clients has left.
+            if self._trim is not None:
+                self._trim.cancel()
+            self._trim = self._loop.call_later(TRIM_DELAY_S, _give_back_memory)
+
+    def _evict(self, task: asyncio.Task) -> None:
+        """Ends a connection still in its handshake with HTTP 503, to make room."""
+        writer = self._handshaking.pop(task)
+        self._evicted.add(task)
+        writer.write(_busy(f"over {MAX_HANDSHAKES} connections in their handshake"))
+        writer.close()  # its read ends, and so its task
+
+    async def _relay(self, request: bytes, client_reader: asyncio.StreamReader,
+                     client_writer: asyncio.StreamWriter,
+                     writers: list[asyncio.StreamWriter]) -> None:  # fmt: skip
+        """One client's session: the handshake passed on, then bytes copied both ways until
+        the SDK's side ends (or the client's, then the SDK's within the handshake timeout)."""
+        request, renamed = _offer_sdk_name(request)
+        backend_reader, backend_writer = await asyncio.open_connection(
+            "127.0.0.1", self.backend_port, limit=HANDSHAKE_LIMIT
+        )
+        writers.append(backend_writer)
+        backend_writer.write(request)
+        response = await asyncio.wait_for(backend_reader.readuntil(b"\r\n\r\n"),
+                                          self.handshake_timeout)  # fmt: skip
+        client_writer.write(_answer_legacy_name(response) if renamed else response)
+        # An extension the SDK agreed to may use RSV1 (permessage-deflate); it agrees to none.
+        extensions = any(line.lower().startswith(b"sec-websocket-extensions:")
+                         for line in _header_lines(response))  # fmt: skip
+        frames = _ClientFrames(self.max_message, 0x40 if extensions else 0)
+        upstream = asyncio.ensure_future(_pump_client(client_reader, backend_writer, frames))
+        downstream = asyncio.ensure_future(_pump(backend_reader, client_writer))
+        pumps = [upstream, downstream]
+        try:
+            # A connection ends with the SDK's side; where the client ends first, the SDK is
+            # told (a half close) and its end awaited.
+            done, _ = await asyncio.wait(pumps, return_when=asyncio.FIRST_COMPLETED)
+            if downstream not in done and upstream.exception() is None:
+                await asyncio.wait([downstream], timeout=self.handshake_timeout)
+        finally:
+            for pump in pumps:
+                pump.cancel()
+            results = await asyncio.gather(*pumps, return_exceptions=True)
+            # A client gone or cut without its close frame: the SDK is told it went away
+            # (1001) in a frame of the client's, and what it still sends until it closes is
+            # read and dropped, rather than leaving it to log a reset or a broken pipe.
+            if not frames.closed and frames.whole and not backend_writer.is_closing():
+                backend_writer.write(GOING_AWAY)
+                with contextlib.suppress(Exception):
+                    await asyncio.wait_for(_discard(backend_reader), CLOSE_GRACE_S)
+        for result in results:
+            if isinstance(result, Exception) and not isinstance(result, asyncio.CancelledError):
+                raise result
 
 
 async def _pump(reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
-    """Copies reader to writer as bytes come; at the reader's end, half-closes the writer so
-    that the other direction can finish its closing handshake."""
+    """Copies reader to writer as bytes come, a read waiting while the writer holds more than
+    its buffer limit; at the reader's end, half-closes the writer so that the other direction
+    can finish its closing handshake."""
     while True:
         data = await reader.read(RELAY_CHUNK)
         if not data:
             break
         writer.write(data)
+        await writer.drain()
+    if writer.can_write_eof():
+        writer.write_eof()
+
+
+async def _discard(reader: asyncio.StreamReader) -> None:
+    """Reads and drops until the end of the stream."""
+    while await reader.read(RELAY_CHUNK):
+        pass
+
+
+async def _pump_client(reader: asyncio.StreamReader, writer: asyncio.StreamWriter,
+                       frames: _ClientFrames) -> None:  # fmt: skip
+    """_pump for what a client sends: its frames checked before they pass (_ClientFrames),
+    and a frame begun but not whole within FRAME_TIMEOUT_S ends the connection."""
+    while True:
+        if frames.begun is None:
+            data = await reader.read(RELAY_CHUNK)
+        else:
+            left = frames.begun + FRAME_TIMEOUT_S - time.monotonic()
+            try:
+                data = await asyncio.wait_for(reader.read(RELAY_CHUNK), max(left, 0.0))
+            except asyncio.TimeoutError:
+                raise _Refused("timed_out", "a frame not finished in time") from None
+        if not data:
+            break
+        frames.feed(data)
+        writer.write(data)
+        frames.whole = frames.begun is None
         await writer.drain()
     if writer.can_write_eof():
         writer.write_eof()

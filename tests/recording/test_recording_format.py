@@ -156,14 +156,16 @@ def open_in_a_subprocess(head: Path) -> subprocess.CompletedProcess:
     hanging the test run."""
     script = textwrap.dedent(
         f"""
-        import resource
         from ambfplus.recording import RecordingError, open_recording
         try:
             with open_recording({str(head)!r}) as rec:
                 rec.events
         except RecordingError as error:
             print("RecordingError:", error)
-        print("peak MB:", resource.getrusage(resource.RUSAGE_SELF).ru_maxrss // 1024)
+        # This process's own peak (VmHWM): ru_maxrss would report the parent's peak before
+        # exec (Linux keeps the larger of the two), a test runner's gigabytes.
+        status = open("/proc/self/status").read()
+        print("peak MB:", int(status.split("VmHWM:")[1].split()[0]) // 1024)
         """
     )
     return subprocess.run(

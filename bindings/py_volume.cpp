@@ -25,13 +25,6 @@ namespace py = pybind11;
 namespace ambfplus::bindings {
 namespace {
 
-// The state lock of the world showing this data, for an edit from Python (taken with the GIL
-// released): an edit then never runs while the world steps or renders.
-std::unique_lock<StateMutex> guard_lock(const VolumeData& v) {
-  StateMutex* mutex = v.guard();
-  return mutex != nullptr ? std::unique_lock<StateMutex>(*mutex) : std::unique_lock<StateMutex>();
-}
-
 using Vec3 = Eigen::Vector3d;
 
 // A Fortran-order (i fastest) NumPy view of a grid owned by the VolumeData behind `owner`.
@@ -303,7 +296,6 @@ void define_volume(py::module_& m) {
           "remove_sphere",
           [](VolumeData& v, const Vec3& c, double r, bool only_removable) {
             py::gil_scoped_release release;
-            auto lock = guard_lock(v);
             return v.remove_sphere(c, r, only_removable);
           },
           py::arg("center"), py::arg("radius"), py::arg("only_removable") = true,
@@ -313,7 +305,6 @@ void define_volume(py::module_& m) {
           [](VolumeData& v, std::array<int, 3> lo, std::array<int, 3> hi, int label) {
             if (label < 0 || label > 65535) throw ArgumentError("label must be 0..65535");
             py::gil_scoped_release release;
-            auto lock = guard_lock(v);
             return v.set_region(VoxelBox{lo, hi}, static_cast<std::uint16_t>(label));
           },
           py::arg("lo"), py::arg("hi"), py::arg("label"), "sets voxels [lo, hi) to label")
@@ -323,7 +314,6 @@ void define_volume(py::module_& m) {
              std::optional<std::array<int, 3>> hi) {
             const VoxelBox box = box_from(lo, hi, v);
             py::gil_scoped_release release;
-            auto lock = guard_lock(v);
             v.mark_dirty(box);
           },
           py::arg("lo") = py::none(), py::arg("hi") = py::none(),
@@ -332,7 +322,6 @@ void define_volume(py::module_& m) {
           "reset",
           [](VolumeData& v) {
             py::gil_scoped_release release;
-            auto lock = guard_lock(v);
             v.reset();
           },
           "restores the labels as loaded (or last committed)")
@@ -340,7 +329,6 @@ void define_volume(py::module_& m) {
           "commit",
           [](VolumeData& v) {
             py::gil_scoped_release release;
-            auto lock = guard_lock(v);
             v.commit();
           },
           "makes the current labels what reset() restores")

@@ -356,6 +356,7 @@ std::vector<AdfInputDevice> read_input_devices(const std::string& path,
 
 void load_world_file(World& world, const std::string& path, const AdfColors& colors,
                      std::vector<AdfProblem>* warnings) {
+  auto lock = world.lock_state();  // a real-time loop never steps a half-loaded file
   adf::Diagnostics diag;
   adf::Context ctx{&colors, &diag, ""};
   adf::yaml_checked(path, [&] { load_world(world, path, ctx); });
@@ -367,6 +368,7 @@ void load_world_file(World& world, const std::string& path, const AdfColors& col
 
 Model& load_model_file(World& world, const std::string& path, const AdfColors& colors,
                        std::vector<AdfProblem>* warnings) {
+  auto lock = world.lock_state();  // a real-time loop never steps a half-loaded file
   adf::Diagnostics diag;
   adf::Context ctx{&colors, &diag, ""};
   Model& model =
@@ -380,6 +382,7 @@ Model& load_model_file(World& world, const std::string& path, const AdfColors& c
 }
 
 AdfReport load_launch(World& world, const std::string& path, const AdfLoadOptions& options) {
+  auto lock = world.lock_state();  // a real-time loop never steps a half-loaded launch
   AdfReport report;
   report.launch = read_launch(path);
   const AdfLaunch& launch = report.launch;

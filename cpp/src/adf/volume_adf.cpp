@@ -209,6 +209,7 @@ std::vector<Volume*> adf::add_adf_volumes(
 
 std::vector<Volume*> load_adf_volumes(World& world, const std::string& path,
                                       const std::string& labels) {
+  auto lock = world.lock_state();  // the thread-safety contract
   {
     // The readers below read the file again without warnings: warn (logged) once, here.
     adf::Diagnostics diag;

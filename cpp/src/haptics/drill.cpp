@@ -28,6 +28,7 @@ constexpr double kStopTolerance = 1e-6;
 }  // namespace
 
 Drill& add_drill(Model& model, const DrillSpec& spec) {
+  auto lock = model.world().lock_state();  // claim, build and adopt as one
   const int id = model.claim_name(spec.name, "drill");
   return model.adopt(std::unique_ptr<Drill>(new Drill(model, spec, id)));
 }

@@ -12,6 +12,7 @@
 namespace ambfplus {
 
 InputDevice& add_input_device(Model& model, const InputDeviceSpec& spec) {
+  auto lock = model.world().lock_state();  // claim, build and adopt as one
   if (spec.drill != nullptr && &spec.drill->world() != &model.world()) {
     throw ArgumentError("input device '" + spec.name + "': its drill is in another world");
   }

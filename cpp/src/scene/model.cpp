@@ -35,22 +35,26 @@ Object& Model::adopt(std::unique_ptr<Object> object) {
 }
 
 RigidBody& Model::add_body(const RigidBodySpec& spec) {
+  auto lock = world_->lock_state();  // claim, build and adopt as one (thread-safety contract)
   const int id = world_->claim_name(spec.name, "body");
   // The constructor loads or builds geometry and may throw, as may physics when adopted.
   return adopt(std::unique_ptr<RigidBody>(new RigidBody(*this, spec, id)));
 }
 
 Joint& Model::add_joint(const JointSpec& spec) {
+  auto lock = world_->lock_state();  // claim, build and adopt as one (thread-safety contract)
   const int id = world_->claim_name(spec.name, "joint");
   return adopt(std::unique_ptr<Joint>(new Joint(*this, spec, id)));
 }
 
 Camera& Model::add_camera(const CameraSpec& spec) {
+  auto lock = world_->lock_state();  // claim, build and adopt as one (thread-safety contract)
   const int id = world_->claim_name(spec.name, "camera");
   return adopt(std::unique_ptr<Camera>(new Camera(*this, spec, id)));
 }
 
 Light& Model::add_light(const LightSpec& spec) {
+  auto lock = world_->lock_state();  // claim, build and adopt as one (thread-safety contract)
   const int id = world_->claim_name(spec.name, "light");
   int same_type = 0;
   for (const Light* l : world_->objects_of_kind<Light>()) same_type += l->type() == spec.type;
@@ -63,22 +67,26 @@ Light& Model::add_light(const LightSpec& spec) {
 }
 
 Volume& Model::add_volume(const VolumeSpec& spec) {
+  auto lock = world_->lock_state();  // claim, build and adopt as one (thread-safety contract)
   const int id = world_->claim_name(spec.name, "volume");
   return adopt(std::unique_ptr<Volume>(new Volume(*this, spec, id)));
 }
 
 SoftBody& Model::add_soft_body(const SoftBodySpec& spec) {
+  auto lock = world_->lock_state();  // claim, build and adopt as one (thread-safety contract)
   const int id = world_->claim_name(spec.name, "soft body");
   // The constructor reads the mesh and may throw, as may physics when adopted.
   return adopt(std::unique_ptr<SoftBody>(new SoftBody(*this, spec, id)));
 }
 
 ProximitySensor& Model::add_sensor(const ProximitySensorSpec& spec) {
+  auto lock = world_->lock_state();  // claim, build and adopt as one (thread-safety contract)
   const int id = world_->claim_name(spec.name, "sensor");
   return adopt(std::unique_ptr<ProximitySensor>(new ProximitySensor(*this, spec, id)));
 }
 
 ConstraintActuator& Model::add_actuator(const ConstraintActuatorSpec& spec) {
+  auto lock = world_->lock_state();  // claim, build and adopt as one (thread-safety contract)
   const int id = world_->claim_name(spec.name, "actuator");
   return adopt(std::unique_ptr<ConstraintActuator>(new ConstraintActuator(*this, spec, id)));
 }

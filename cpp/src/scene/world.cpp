@@ -57,6 +57,7 @@ World::~World() {
 }
 
 void World::add_system(std::unique_ptr<System> system) {
+  auto lock = lock_state();  // the thread-safety contract
   if (!system) throw ArgumentError("world '" + name_ + "': add_system needs a system");
   for (int s = 0; s < kStepStageCount; ++s) {
     if (system->stages() & (1u << s)) schedule_[s].push_back(system.get());
@@ -71,6 +72,7 @@ std::vector<System*> World::systems() const {
 }
 
 Model& World::add_model(const std::string& name) {
+  auto lock = lock_state();  // the thread-safety contract
   for (const auto& m : models_) {
     if (m->name() == name) throw ArgumentError("a model named '" + name + "' exists");
   }
@@ -142,6 +144,7 @@ std::vector<Joint*> World::descendant_joints(const RigidBody& root) const {
 }
 
 void World::remove_model(Model& model) {
+  auto lock = lock_state();  // the thread-safety contract
   if (&model == models_.front().get()) {
     throw ArgumentError("the world's default model cannot be removed");
   }

@@ -241,6 +241,7 @@ void VolumeData::log_edit(VolumeEdit edit) {
 
 std::int64_t VolumeData::remove_sphere(const Eigen::Vector3d& center, double radius,
                                        bool only_removable) {
+  auto guarded = guard_lock();  // the world showing it steps and renders under this lock
   if (!(radius >= 0.0) || !std::isfinite(radius) || !center.allFinite()) {
     throw ArgumentError(
         "remove_sphere needs a finite centre and a finite radius >= 0, got radius " +
@@ -288,6 +289,7 @@ std::int64_t VolumeData::remove_sphere(const Eigen::Vector3d& center, double rad
 
 std::vector<std::uint16_t> VolumeData::remove_voxels(const std::vector<std::array<int, 3>>& voxels,
                                                      const std::string& kind) {
+  auto guarded = guard_lock();  // the world showing it steps and renders under this lock
   std::vector<std::uint16_t> old(voxels.size(), 0);
   VolumeEdit edit;
   edit.kind = kind;
@@ -313,6 +315,7 @@ std::vector<std::uint16_t> VolumeData::remove_voxels(const std::vector<std::arra
 }
 
 std::int64_t VolumeData::set_region(const VoxelBox& region, std::uint16_t label) {
+  auto guarded = guard_lock();  // the world showing it steps and renders under this lock
   if (label_type_ == LabelType::kUInt8 && label > 255) {
     throw ArgumentError("label " + std::to_string(label) + " does not fit a uint8 grid");
   }
@@ -341,6 +344,7 @@ std::int64_t VolumeData::set_region(const VoxelBox& region, std::uint16_t label)
 }
 
 void VolumeData::mark_dirty(const VoxelBox& box) {
+  auto guarded = guard_lock();  // the world showing it steps and renders under this lock
   check_box("mark_dirty", box, shape_);
   VolumeEdit edit;
   edit.kind = "mark_dirty";
@@ -349,6 +353,7 @@ void VolumeData::mark_dirty(const VoxelBox& box) {
 }
 
 void VolumeData::reset() {
+  auto guarded = guard_lock();  // the world showing it steps and renders under this lock
   // Only the voxels that differ are rewritten, and only their box is marked.
   VoxelBox changed;
   std::int64_t count = 0;
@@ -377,7 +382,10 @@ void VolumeData::reset() {
   record(std::move(edit));
 }
 
-void VolumeData::commit() { original_ = labels_; }
+void VolumeData::commit() {
+  auto guarded = guard_lock();
+  original_ = labels_;
+}
 
 bool VolumeData::dirty_since(std::int64_t since, VoxelBox* box) const {
   if (since >= revision_) return false;

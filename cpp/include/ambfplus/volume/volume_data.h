@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cstdint>
 #include <deque>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -160,10 +161,15 @@ class AMBFPLUS_API VolumeData {
   /// Makes the current labels the state reset() returns to.
   void commit();
   /// The state lock of the world whose volume shows this data (set by Volume; nullptr while
-  /// none does): the Python API takes it around edits from other threads, so that an edit never
-  /// runs while the world steps or renders.
+  /// none does): the edits take it, so that an edit from another thread never runs while the
+  /// world steps or renders.
   StateMutex* guard() const { return guard_.load(); }
   void set_guard(StateMutex* mutex) { guard_.store(mutex); }
+  /// The guard's lock (not owning one while no world shows the data); the edits above take it.
+  std::unique_lock<StateMutex> guard_lock() const {
+    StateMutex* mutex = guard_.load();
+    return mutex != nullptr ? std::unique_lock<StateMutex>(*mutex) : std::unique_lock<StateMutex>();
+  }
 
   /// Increases with every edit.
   std::int64_t revision() const { return revision_; }

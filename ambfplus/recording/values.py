@@ -17,29 +17,36 @@ RIGID_TOLERANCE = 1e-5
 
 
 def pose_problem(pose) -> str | None:
-    """Why a 4x4 pose is not a rigid transform (finite, rotation with determinant +1, last row
-    0 0 0 1), or None."""
+    """Why a 4x4 pose is not a rigid transform (``rigid``'s rule), or None."""
     pose = np.asarray(pose, dtype=float)
     if pose.shape != (4, 4):
         return f"a pose of shape {pose.shape}, not 4x4"
+    if rigid(pose[None])[0]:
+        return None
     if not np.isfinite(pose).all():
         return f"a pose holding {_non_finite(pose)}"
     if np.abs(pose[3] - (0.0, 0.0, 0.0, 1.0)).max() > RIGID_TOLERANCE:
         return f"a pose whose last row is {_short(pose[3])}, not 0 0 0 1"
     rotation = pose[:3, :3]
     error = float(np.abs(rotation.T @ rotation - np.eye(3)).max())
-    if error > RIGID_TOLERANCE or np.linalg.det(rotation) < 0:
-        what = "a reflection" if np.linalg.det(rotation) < 0 else f"off by {error:.3g}"
-        return f"a pose whose rotation is not one ({what})"
-    return None
+    what = "a reflection" if np.linalg.det(rotation) < 0 else f"off by {error:.3g}"
+    return f"a pose whose rotation is not one ({what})"
+
+
+def camera_intrinsics(ks: np.ndarray) -> np.ndarray:
+    """Per K of an (N, 3, 3) array, whether it is a camera's: finite, fx and fy > 0, last row
+    0 0 1."""
+    ks = np.asarray(ks, dtype=float)
+    good = np.isfinite(ks).all(axis=(1, 2)) & (ks[:, 0, 0] > 0) & (ks[:, 1, 1] > 0)
+    return good & (np.abs(ks[:, 2] - (0.0, 0.0, 1.0)) <= 1e-12).all(axis=1)
 
 
 def intrinsics_problem(k) -> str | None:
-    """Why a 3x3 K is not a camera's (finite, fx and fy > 0, last row 0 0 1), or None."""
+    """Why a 3x3 K is not a camera's (``camera_intrinsics``' rule), or None."""
     k = np.asarray(k, dtype=float)
     if k.shape != (3, 3) or not np.isfinite(k).all():
         return f"intrinsics {_short(k)} that are not a finite 3x3 matrix"
-    if k[0, 0] <= 0 or k[1, 1] <= 0 or np.abs(k[2] - (0.0, 0.0, 1.0)).max() > 1e-12:
+    if not camera_intrinsics(k[None])[0]:
         return f"intrinsics {_short(k)} with no positive focal lengths or a last row not 0 0 1"
     return None
 
@@ -162,31 +169,36 @@ class Rules:
         )
 
 
+def _bad_step_column(column: str, values: np.ndarray) -> tuple[np.ndarray, str] | None:
+    """A float step column's rows that break the rules and how ("not finite" first, then
+    "not rigid" for a ``*.pose`` column), or None for a column the rules do not cover."""
+    if values.dtype.kind != "f" or not len(values):
+        return None
+    flat = values.reshape(len(values), -1)
+    bad = ~np.isfinite(flat).all(axis=1)
+    if bad.any():
+        return bad, "not finite"
+    if column.endswith(".pose") and flat.shape[1] == 16:
+        return ~rigid(flat.reshape(-1, 4, 4)), "not rigid"
+    return bad, "not finite"
+
+
 def step_problems(steps: dict) -> list[str]:
     """What is wrong with a step log's values: numbers that are not finite (naming the column,
     the row and the value) and ``*.pose`` columns that are not rigid transforms."""
     problems = []
     for column, values in steps.items():
         values = np.asarray(values)
-        if values.dtype.kind != "f" or not len(values):
+        found = _bad_step_column(column, values)
+        if found is None or not found[0].any():
             continue
-        flat = values.reshape(len(values), -1)
-        bad = ~np.isfinite(flat)
-        if bad.any():
-            row = int(np.argwhere(bad)[0][0])
-            problems.append(
-                f"steps/{column} row {row} holds {_short(values[row])} "
-                f"({int(bad.any(axis=1).sum())} rows not finite)"
-            )
-            continue
-        if column.endswith(".pose") and flat.shape[1] == 16:
-            bad_rows = np.flatnonzero(~rigid(flat.reshape(-1, 4, 4)))
-            if bad_rows.size:
-                row = int(bad_rows[0])
-                problem = pose_problem(flat[row].reshape(4, 4))
-                problems.append(
-                    f"steps/{column} row {row} is {problem} ({bad_rows.size} rows not rigid)"
-                )
+        bad, how = found
+        row = int(np.flatnonzero(bad)[0])
+        if how == "not finite":
+            what = f"holds {_short(values[row])}"
+        else:
+            what = f"is {pose_problem(values[row].reshape(4, 4))}"
+        problems.append(f"steps/{column} row {row} {what} ({int(bad.sum())} rows {how})")
     return problems
 
 
@@ -203,18 +215,16 @@ def rigid(poses: np.ndarray) -> np.ndarray:
 
 
 def bad_step_rows(steps: dict) -> np.ndarray:
-    """Per row of a step log, whether any of its numbers is not finite or any ``*.pose`` not
-    rigid (the rows step_problems describes)."""
+    """Per row of a step log, whether it breaks the rules (the rows step_problems describes)."""
     rows = len(steps["step"]) if "step" in steps else 0
     bad: np.ndarray = np.zeros(rows, dtype=bool)
     for column, values in steps.items():
         values = np.asarray(values)
-        if values.dtype.kind != "f" or len(values) != rows:
+        if len(values) != rows:
             continue
-        flat = values.reshape(rows, -1)
-        bad |= ~np.isfinite(flat).all(axis=1)
-        if column.endswith(".pose") and flat.shape[1] == 16:
-            bad |= ~rigid(flat.reshape(-1, 4, 4))
+        found = _bad_step_column(column, values)
+        if found is not None:
+            bad |= found[0]
     return bad
 
 
@@ -254,11 +264,9 @@ class FrameGate:
     @staticmethod
     def _column_rows(stream) -> np.ndarray:
         times = np.asarray(stream.time[:], dtype=float)
-        k = np.asarray(stream.intrinsics[:], dtype=float).reshape(-1, 3, 3)
-        good_k = np.isfinite(k).all(axis=(1, 2)) & (k[:, 0, 0] > 0) & (k[:, 1, 1] > 0)
-        good_k &= (np.abs(k[:, 2] - (0.0, 0.0, 1.0)) <= 1e-12).all(axis=1)
+        ks = np.asarray(stream.intrinsics[:], dtype=float).reshape(-1, 3, 3)
         poses = np.asarray(stream.pose[:], dtype=float).reshape(-1, 4, 4)
-        return ~(np.isfinite(times) & good_k & rigid(poses))
+        return ~(np.isfinite(times) & camera_intrinsics(ks) & rigid(poses))
 
     def _refuse(self, what: str) -> None:
         raise self.error(

@@ -10,12 +10,13 @@ from ._core import Frame, World
 
 
 def legend(world: World) -> dict[int, dict]:
-    """Every object id a capture's instance image can hold: name, kind, model and flat colour
-    (RGB 0..255; bodies their material colour); volumes also list their labels (id -> name,
+    """Every object id a capture's instance image can hold: name (its key: ``psm1/baselink``
+    under a namespace, the bare name in AMBF's root one), kind, model and flat colour (RGB
+    0..255; bodies their material colour); volumes also list their labels (id -> name,
     colour)."""
     out = {}
     for o in world.objects:
-        entry = {"name": o.name, "kind": o.kind, "model": o.model.name}
+        entry = {"name": o.key, "kind": o.kind, "model": o.model.name}
         color = getattr(o, "color", None)
         if color is not None:
             entry["color"] = tuple(int(round(255 * c)) for c in list(color)[:3])

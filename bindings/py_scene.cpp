@@ -784,7 +784,7 @@ void define_world(py::class_<World, std::shared_ptr<World>>& world) {
           py::arg("name"), "Adds an empty model (a group of objects).")
       .def("__getitem__",
            [](World& w, const std::string& name) {
-             Object* o = w.find(name);
+             Object* o = w.find(name);  // by key (Object::key)
              if (o == nullptr) throw NotFound(name);
              return to_python(o);
            })
@@ -853,7 +853,13 @@ void define_model(py::class_<Model, std::shared_ptr<Model>>& model) {
 }
 
 void define_object(py::class_<Object, std::shared_ptr<Object>>& object) {
-  object.def_property_readonly("name", &Object::name)
+  object
+      .def_property_readonly("name", &Object::name,
+                             "the name it was declared with; two namespaces may each have one")
+      .def_property_readonly("key", &Object::key,
+                             "its name unique in the world, as AMBF's client keys it: the "
+                             "namespace below /ambf/env/ and the name ('psm1/baselink'), the "
+                             "bare name in the root namespace; legends and recordings use it")
       .def_property_readonly("id", &Object::id, "stable instance id (>= 1) used by segmentation")
       .def_property_readonly("kind", [](Object& o) { return object_kind_name(o.kind()); })
       .def_property_readonly("model", [](Object& o) { return handle(&o.model(), o.world()); })
@@ -861,8 +867,14 @@ void define_object(py::class_<Object, std::shared_ptr<Object>>& object) {
           "pose", [](Object& o) { return Mat4(o.pose().matrix()); },
           [](Object& o, const Mat4& m) { o.set_pose(checked_pose(m, o)); },
           "4x4 world-from-object rigid transform (a copy; assign to change it)")
-      .def_property("namespace", &Object::name_space, &Object::set_name_space,
-                    "AMBF namespace, e.g. '/ambf/env/'")
+      .def_property(
+          "namespace", &Object::name_space,
+          [](Object& o, std::string ns) {
+            auto lock = lock_holding_gil(o.world());
+            o.set_name_space(std::move(ns));
+          },
+          "AMBF namespace, e.g. '/ambf/env/' (setting it changes the key; a key taken is an "
+          "ArgumentError)")
       .def_property_readonly("qualified_name", &Object::qualified_name, "namespace + name")
       .def_property_readonly("identifier", &Object::identifier,
                              "the ADF block it was loaded from ('BODY l1'), or ''")

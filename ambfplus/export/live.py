@@ -175,10 +175,10 @@ def drill_helpers(world) -> set[str]:
     for body in world.objects:
         found = _BURR_MESH.fullmatch(body.name) if body.kind == "body" else None
         if found and any(abs(float(found[1]) * 1e-3 - d) < 1e-9 for d in diameters):
-            helpers.add(body.name)
+            helpers.add(body.key)
     for drill in drills:
         for i in range(len(drill.cursor_radii)):
-            helpers.update((f"{drill.name}_proxy_{i}", f"{drill.name}_goal_{i}"))
+            helpers.update((f"{drill.key}_proxy_{i}", f"{drill.key}_goal_{i}"))
     return helpers
 
 
@@ -222,10 +222,10 @@ class FoxgloveServer:
         # Objects whose pose /tf carries, chosen once: not the drills' helper bodies.
         helpers = drill_helpers(world)
         self._posed_objects = [o for o in world.objects if o.kind in ("body", "volume", "drill")
-                               and o.name not in helpers]  # fmt: skip
+                               and o.key not in helpers]  # fmt: skip
         # (object name, its TF frame: the rule the ROS exports follow)
-        self._posed = [(o.name, tf_frame(o.name)) for o in self._posed_objects]
-        self._posed_names = [o.name for o in self._posed_objects]
+        self._posed = [(o.key, tf_frame(o.key)) for o in self._posed_objects]
+        self._posed_names = [o.key for o in self._posed_objects]
         # What each tick reads: the posed objects, the cameras, then the drill.
         self._read_objects = self._posed_objects + list(self.cameras)
         if self.drill is not None:
@@ -245,8 +245,8 @@ class FoxgloveServer:
                 self._channel(f"/{camera.name}/depth/image_rect", IMAGE)
         self._channel("/tf", TF)
         if self.drill is not None:
-            self._channel(f"/{self.drill.name}/wrench", WRENCH)
-            self._channel(f"/{self.drill.name}/critical", DIAGNOSTICS)
+            self._channel(f"/{self.drill.key}/wrench", WRENCH)
+            self._channel(f"/{self.drill.key}/critical", DIAGNOSTICS)
         # The public port first, so that a port in use fails before anything starts.
         try:
             listener = _listen(self.host, self.requested_port)
@@ -417,7 +417,7 @@ class FoxgloveServer:
         structures, from one batch of reads under the world's lock."""
         topics = ["/tf"] + [f"/{c.name}/camera_info" for c in self.cameras]
         if self.drill is not None:
-            topics += [f"/{self.drill.name}/wrench", f"/{self.drill.name}/critical"]
+            topics += [f"/{self.drill.key}/wrench", f"/{self.drill.key}/critical"]
         if not any(self._wanted(topic) for topic in topics):
             return
         state = self._snapshot()
@@ -435,7 +435,7 @@ class FoxgloveServer:
             self._send("/tf", t, {"transforms": transforms})
         if self.drill is None:
             return
-        wrench_topic = f"/{self.drill.name}/wrench"
+        wrench_topic = f"/{self.drill.key}/wrench"
         if self._wanted(wrench_topic):
             f = state["force"]
             self._send(wrench_topic, t, {
@@ -443,7 +443,7 @@ class FoxgloveServer:
                 "wrench": {"force": {"x": f[0], "y": f[1], "z": f[2]},
                            "torque": {"x": 0.0, "y": 0.0, "z": 0.0}},
             })  # fmt: skip
-        critical_topic = f"/{self.drill.name}/critical"
+        critical_topic = f"/{self.drill.key}/critical"
         if self._wanted(critical_topic):
             self._send(critical_topic, t, self._critical(t, state))
 
@@ -490,10 +490,10 @@ class FoxgloveServer:
                 level = DIAGNOSTIC_WARN
             statuses.append({
                 "level": level, "name": name, "message": f"{distance * 1000:.2f} mm",
-                "hardware_id": self.drill.name,
+                "hardware_id": self.drill.key,
                 "values": [{"key": "distance_m", "value": repr(float(distance))}],
             })  # fmt: skip
-        return {"header": header(t, tf_frame(self.drill.name)), "status": statuses}
+        return {"header": header(t, tf_frame(self.drill.key)), "status": statuses}
 
 
 # The relay on the public port -----------------------------------------------------------------

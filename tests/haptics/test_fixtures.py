@@ -282,8 +282,6 @@ def adf_world(tmp_path, fixtures: str):
 
 
 def test_a_drill_block_sets_fixtures(tmp_path):
-    prefix = sorted(p.name for p in (tmp_path / "slab").glob("*.png")) if False else None
-    del prefix
     world = adf_world(
         tmp_path,
         "fixtures:\n"

@@ -10,6 +10,7 @@
 #include "adf/adf_yaml.h"
 #include "ambfplus/adf/adf.h"
 #include "ambfplus/adf/volume_adf.h"
+#include "ambfplus/scene/model.h"
 #include "ambfplus/scene/shader_spec.h"
 
 namespace ambfplus {
@@ -79,7 +80,28 @@ void load_plugins(const std::vector<ObjectPlugins>& objects, const std::string& 
 std::string join_ns(const std::string& prefix, const std::string& base, const std::string& ns);
 
 /// name, or name1, name2, ... : the first the world does not use (AMBF's duplicate loads).
-std::string unique_name(const World& world, const std::string& name);
+/// While it lives, objects `model` makes are in namespace `ns` (Model::set_object_name_space);
+/// the model's namespace before it is restored after.
+class InNameSpace {
+ public:
+  InNameSpace(Model& model, std::string ns) : model_(model), before_(model.object_name_space()) {
+    model_.set_object_name_space(std::move(ns));
+  }
+  ~InNameSpace() { model_.set_object_name_space(before_); }
+  InNameSpace(const InNameSpace&) = delete;
+  InNameSpace& operator=(const InNameSpace&) = delete;
+
+ private:
+  Model& model_;
+  std::string before_;
+};
+
+/// `name` if its key in namespace `ns` is free; else the first free `name` + n, with a warning
+/// naming `file` when the name is taken by another model's object (two blocks of one file with
+/// one name have a warning of their own): nothing is renamed silently, and names in different
+/// namespaces never clash.
+std::string unique_name(const World& world, const std::string& ns, const std::string& name,
+                        const std::string& file, const Model& loading);
 std::string unique_model_name(const World& world, const std::string& base);
 
 /// The `cameras` and `lights` a file lists, added to model; parents are looked up in `own`

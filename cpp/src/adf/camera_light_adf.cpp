@@ -283,10 +283,10 @@ void add_cameras_and_lights(Model& model, const Doc& doc, const std::string& bas
   warn_not_applied(doc, ctx);
   // A parent that is not there yet leaves the object in the world frame until it comes.
   for (CameraPlan& c : cameras) {
-    c.spec.name = unique_name(world, c.spec.name);
+    c.spec.name = unique_name(world, c.ns, c.spec.name, doc.path, model);
+    const InNameSpace in_ns(model, c.ns);
     Camera& camera = model.add_camera(c.spec);
     camera.set_identifier(c.id);
-    camera.set_name_space(c.ns);
     camera.set_preprocessing_shader(c.preprocessing);
     camera.look_at(c.eye, c.target, c.up);
     attach_when_found(model, doc.path, camera, c.id, c.parent, c.ns, own, camera.pose());
@@ -297,9 +297,9 @@ void add_cameras_and_lights(Model& model, const Doc& doc, const std::string& bas
       const double shift = c.stereo_focal > 0 ? f * c.eye_separation / c.stereo_focal / 2 : 0.0;
       for (const int side : {-1, 1}) {
         CameraSpec eye = c.spec;
-        eye.name = unique_name(world, c.spec.name + (side < 0 ? "_left" : "_right"));
+        eye.name = unique_name(world, c.ns, c.spec.name + (side < 0 ? "_left" : "_right"), doc.path,
+                               model);
         Camera& e = model.add_camera(eye);
-        e.set_name_space(c.ns);
         e.set_preprocessing_shader(c.preprocessing);
         Eigen::Isometry3d local = Eigen::Isometry3d::Identity();
         local.translation().x() = side * c.eye_separation / 2;
@@ -310,10 +310,10 @@ void add_cameras_and_lights(Model& model, const Doc& doc, const std::string& bas
     if (!c.plugins.empty()) plugins.push_back({&camera, c.id, c.plugins});
   }
   for (LightPlan& l : lights) {
-    l.spec.name = unique_name(world, l.spec.name);
+    l.spec.name = unique_name(world, l.ns, l.spec.name, doc.path, model);
+    const InNameSpace in_ns(model, l.ns);
     Light& light = model.add_light(l.spec);
     light.set_identifier(l.id);
-    light.set_name_space(l.ns);
     attach_when_found(model, doc.path, light, l.id, l.parent, l.ns, own, light.pose());
     if (!l.plugins.empty()) plugins.push_back({&light, l.id, l.plugins});
   }

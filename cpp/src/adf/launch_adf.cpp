@@ -155,13 +155,14 @@ void add_enclosure(World& world, const Doc& doc, const YAML::Node& node) {
                         {"enclosure_wall_y_pos", -Eigen::Vector3d::UnitY(), width / 2}};
   for (const Wall& w : walls) {
     RigidBodySpec spec;
-    spec.name = adf::unique_name(world, w.name);
+    spec.name = adf::unique_name(world, world.name_space(), w.name, "the world's enclosure", model);
     spec.shape.kind = Shape::Kind::kPlane;
     spec.dynamics.mass = 0;
     spec.pose.topLeftCorner<3, 3>() =
         Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), w.normal).toRotationMatrix();
     spec.pose.topRightCorner<3, 1>() = -w.normal * w.distance;
-    model.add_body(spec).set_name_space(world.name_space());
+    const adf::InNameSpace in_ns(model, world.name_space());
+    model.add_body(spec);
   }
 }
 

@@ -11,9 +11,11 @@
 #include "adf/model_blocks.h"
 #include "ambfplus/adf/volume_adf.h"
 #include "ambfplus/errors.h"
+#include "ambfplus/log.h"
 #include "ambfplus/plugin/registry.h"
 #include "ambfplus/scene/ghost.h"
 #include "ambfplus/scene/model.h"
+#include "ambfplus/scene/names.h"
 #include "ambfplus/scene/six_dof.h"
 #include "ambfplus/scene/world.h"
 
@@ -67,11 +69,19 @@ std::string join_ns(const std::string& prefix, const std::string& base, const st
   return out;
 }
 
-std::string unique_name(const World& world, const std::string& name) {
-  if (world.find(name) == nullptr) return name;
+std::string unique_name(const World& world, const std::string& ns, const std::string& name,
+                        const std::string& file, const Model& loading) {
+  const Object* taken = world.find(name_key(ns, name));
+  if (taken == nullptr) return name;
   for (int n = 1;; ++n) {
     const std::string candidate = name + std::to_string(n);
-    if (world.find(candidate) == nullptr) return candidate;
+    if (world.find(name_key(ns, candidate)) == nullptr) {
+      if (&taken->model() == &loading) return candidate;  // the file's own repeat: warned
+      log(LogLevel::kWarning, file + ": the world already has '" + name_key(ns, name) +
+                                  "' (the same name in the same namespace): this one is named '" +
+                                  name_key(ns, candidate) + "'");
+      return candidate;
+    }
   }
 }
 
@@ -235,10 +245,10 @@ Model& load_model(World& world, const std::string& path, Context& ctx) {
     std::vector<ObjectPlugins> object_plugins;
     for (BodyPlan& b : bodies) {
       current = b.id;
-      b.spec.name = unique_name(world, b.spec.name);
+      b.spec.name = unique_name(world, b.ns, b.spec.name, doc.path, model);
+      const InNameSpace in_ns(model, b.ns);
       RigidBody& body = model.add_body(b.spec);
       body.set_identifier(b.id);
-      body.set_name_space(b.ns);
       own.emplace_back(b.id, &body);
       if (!b.plugins.empty()) object_plugins.push_back({&body, b.id, b.plugins});
     }
@@ -253,10 +263,10 @@ Model& load_model(World& world, const std::string& path, Context& ctx) {
     for (std::size_t i = 0; i < softs.size(); ++i) {
       auto& [id, spec] = softs[i];
       current = id;
-      spec.name = unique_name(world, spec.name);
+      spec.name = unique_name(world, model_ns, spec.name, doc.path, model);
+      const InNameSpace in_ns(model, model_ns);
       SoftBody& soft = model.add_soft_body(spec);
       soft.set_identifier(id);
-      soft.set_name_space(model_ns);
       if (!soft_plugins[i].empty()) object_plugins.push_back({&soft, id, soft_plugins[i]});
     }
     // Joints, sensors and actuators whose bodies are not in the world yet are made when a
@@ -282,10 +292,10 @@ Model& load_model(World& world, const std::string& path, Context& ctx) {
         spec.child = child;
         spec.parent_pivot *= parent->shape().scale;
         spec.child_pivot *= child->shape().scale;
-        spec.name = unique_name(w, spec.name);
+        spec.name = unique_name(w, plan.ns, spec.name, file, *target);
+        const InNameSpace in_ns(*target, plan.ns);
         Joint& joint = target->add_joint(spec);
         joint.set_identifier(plan.id);
-        joint.set_name_space(plan.ns);
         if (plan.six_dof) set_six_dof_axes(joint, *plan.six_dof);
         if (plan.cone)
           set_cone_twist_limits(joint, (*plan.cone)[0], (*plan.cone)[1], (*plan.cone)[2]);
@@ -327,16 +337,17 @@ Model& load_model(World& world, const std::string& path, Context& ctx) {
         if (plan.actuator) {
           ConstraintActuatorSpec spec = plan.act;
           spec.parent = parent;
-          spec.name = unique_name(w, spec.name);
+          spec.name = unique_name(w, plan.ns, spec.name, file, *target);
+          const InNameSpace in_ns(*target, plan.ns);
           made = &target->add_actuator(spec);
         } else {
           ProximitySensorSpec spec = plan.sensor;
           spec.parent = parent;
-          spec.name = unique_name(w, spec.name);
+          spec.name = unique_name(w, plan.ns, spec.name, file, *target);
+          const InNameSpace in_ns(*target, plan.ns);
           made = &target->add_sensor(spec);
         }
         made->set_identifier(plan.id);
-        made->set_name_space(plan.ns);
         if (!plan.plugins.empty()) {
           ObjectPlugins plugins{made, plan.id, plan.plugins};
           if (sink != nullptr) {
@@ -358,10 +369,10 @@ Model& load_model(World& world, const std::string& path, Context& ctx) {
     }
     for (GhostPlan& g : ghosts) {
       current = g.body.id;
-      g.body.spec.name = unique_name(world, g.body.spec.name);
+      g.body.spec.name = unique_name(world, g.body.ns, g.body.spec.name, doc.path, model);
+      const InNameSpace in_ns(model, g.body.ns);
       RigidBody& ghost = add_ghost(model, g.body.spec);
       ghost.set_identifier(g.body.id);
-      ghost.set_name_space(g.body.ns);
       if (!g.body.plugins.empty()) object_plugins.push_back({&ghost, g.body.id, g.body.plugins});
       attach_when_found(model, doc.path, ghost, g.body.id, g.parent, g.body.ns, own,
                         Eigen::Isometry3d(g.body.spec.pose));

@@ -8,6 +8,7 @@
 #include "ambfplus/haptics/drill.h"
 #include "ambfplus/scene/ghost.h"
 #include "ambfplus/scene/model.h"
+#include "ambfplus/scene/names.h"
 #include "ambfplus/scene/world.h"
 
 namespace ambfplus::plugin {
@@ -58,8 +59,10 @@ Object& add_object(Model& model, const std::string& kind, const std::string& nam
         continue;
       }
       const std::string& volume = e.value.text("volume");
-      Object* v = model.world().find(volume);
-      if (v == nullptr || v->kind() != ObjectKind::kVolume) {
+      const std::vector<Object*> found =
+          name_candidates(model.world(), volume, ObjectKind::kVolume);
+      Object* v = found.size() == 1 ? found.front() : nullptr;
+      if (v == nullptr) {
         throw ArgumentError("drill '" + name + "': no volume named '" + volume + "'");
       }
       spec.volume = static_cast<Volume*>(v);

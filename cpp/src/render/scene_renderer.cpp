@@ -12,6 +12,7 @@
 #include "ambfplus/io/image.h"
 #include "ambfplus/io/mesh.h"
 #include "ambfplus/log.h"
+#include "ambfplus/scene/names.h"
 #include "ambfplus/scene/world.h"
 #include "render/custom_shader.h"
 #include "render/egl_context.h"
@@ -146,12 +147,16 @@ void SceneRenderer::snapshot(const Camera& camera, unsigned passes, const PoseRe
     for (const Object* o : world_.objects()) posed.push_back(o);
   } else {
     for (const std::string& name : poses.names) {
-      const Object* o = world_.find(name);
-      if (o == nullptr) {
-        throw ArgumentError("poses: no object named '" + name + "' in world '" + world_.name() +
-                            "'");
+      const std::vector<Object*> found = name_candidates(world_, name);
+      if (found.size() != 1) {
+        throw ArgumentError("poses: " +
+                            std::string(found.empty()
+                                            ? "no object named '" + name + "'"
+                                            : "'" + name + "' is ambiguous (" + found[0]->key() +
+                                                  ", " + found[1]->key() + ")") +
+                            " in world '" + world_.name() + "'");
       }
-      posed.push_back(o);
+      posed.push_back(found.front());
     }
   }
   world_.graphics_update();
@@ -166,7 +171,7 @@ void SceneRenderer::snapshot(const Camera& camera, unsigned passes, const PoseRe
   // Every capture replaces the poses: a frame refilled without asking keeps none.
   frame.has_poses = !poses.empty();
   frame.poses.clear();
-  for (const Object* o : posed) frame.poses.push_back({o->name(), o->id(), o->pose().matrix()});
+  for (const Object* o : posed) frame.poses.push_back({o->key(), o->id(), o->pose().matrix()});
 }
 
 void SceneRenderer::render(const Camera& camera, const CaptureBuffers& buffers,

@@ -15,6 +15,20 @@ constexpr ObjectKind kAllKinds[] = {
 
 }  // namespace
 
+std::string name_key(std::string_view name_space, std::string_view name) {
+  std::string_view ns = name_space;
+  if (ns.substr(0, kRootNameSpace.size()) == kRootNameSpace) {
+    ns.remove_prefix(kRootNameSpace.size());
+  } else if (ns == kRootNameSpace.substr(0, kRootNameSpace.size() - 1)) {
+    ns = {};
+  }
+  while (!ns.empty() && ns.front() == '/') ns.remove_prefix(1);
+  std::string out(ns);
+  if (!out.empty() && out.back() != '/') out += '/';
+  out += name;
+  return out;
+}
+
 ObjectKind parse_object_kind(std::string_view name) {
   for (ObjectKind k : kAllKinds) {
     if (name == object_kind_name(k)) return k;
@@ -26,7 +40,6 @@ ObjectKind parse_object_kind(std::string_view name) {
 
 std::vector<Object*> name_candidates(const World& world, const std::string& name,
                                      std::optional<ObjectKind> kind) {
-  if (Object* o = world.find(name); o != nullptr && (!kind || o->kind() == *kind)) return {o};
   std::vector<Object*> found = world.lookup(name, kind);
   if (found.size() > 1 && !kind) {
     std::vector<Object*> not_joints;
@@ -44,7 +57,7 @@ Object& resolve_name(const World& world, const std::string& name, std::optional<
   if (found.empty()) throw NotFound("no object named '" + name + "' in the world");
   std::string names;
   for (std::size_t i = 0; i < found.size() && i < 6; ++i) {
-    names += (i ? ", " : "") + found[i]->qualified_name();
+    names += (i ? ", " : "") + found[i]->key();
   }
   throw NotFound("'" + name + "' is ambiguous: it matches " + std::to_string(found.size()) +
                  " objects (" + names + (found.size() > 6 ? ", ..." : "") + ")");

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "ambfplus/scene/model.h"
+#include "ambfplus/scene/names.h"
 #include "ambfplus/scene/world.h"
 #include "scene/scene_systems.h"
 
@@ -44,8 +45,19 @@ Object::~Object() = default;
 
 World& Object::world() const { return model_->world(); }
 
+std::string Object::key() const { return name_key(name_space_, name_); }
+
+void Object::set_name_space(std::string ns) {
+  World& w = world();
+  if (w.find(key()) == this) {
+    w.move_to_name_space(*this, std::move(ns));
+  } else {
+    name_space_ = std::move(ns);  // not listed yet (being built)
+  }
+}
+
 std::string Object::describe() const {
-  return std::string(object_kind_name(kind())) + " '" + name_ + "'";
+  return std::string(object_kind_name(kind())) + " '" + key() + "'";
 }
 
 void Object::attach_to(const Object* parent, const Eigen::Isometry3d& local) {

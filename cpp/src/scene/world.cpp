@@ -1,5 +1,6 @@
 #include "ambfplus/scene/world.h"
 #include "ambfplus/errors.h"
+#include "ambfplus/scene/names.h"
 
 #include <algorithm>
 #include <cmath>
@@ -100,21 +101,29 @@ Object* World::object_with_id(int id) const {
 }
 
 std::vector<Object*> World::lookup(const std::string& query, std::optional<ObjectKind> kind) const {
-  std::vector<Object*> exact, partial;
-  if (query.empty()) return exact;
+  // The tiers, first that matches wins: full names, keys, bare names, then containing.
+  std::vector<Object*> full, keyed, bare, partial;
+  if (query.empty()) return full;
   for (Object* o : objects_) {
     if (kind && o->kind() != *kind) continue;
     const std::string qualified = o->qualified_name();
     const std::string& id = o->identifier();
-    if (o->name() == query || qualified == query ||
-        (!id.empty() && (id == query || o->name_space() + id == query))) {
-      exact.push_back(o);
+    const std::string qualified_id = id.empty() ? std::string() : o->name_space() + id;
+    if (qualified == query || (!id.empty() && qualified_id == query)) {
+      full.push_back(o);
+    } else if (o->key() == query || (!id.empty() && name_key(o->name_space(), id) == query)) {
+      keyed.push_back(o);
+    } else if (o->name() == query || (!id.empty() && id == query)) {
+      bare.push_back(o);
     } else if (qualified.find(query) != std::string::npos ||
-               (!id.empty() && (o->name_space() + id).find(query) != std::string::npos)) {
+               (!id.empty() && qualified_id.find(query) != std::string::npos)) {
       partial.push_back(o);
     }
   }
-  return exact.empty() ? partial : exact;
+  for (auto* tier : {&full, &keyed, &bare}) {
+    if (!tier->empty()) return std::move(*tier);
+  }
+  return partial;
 }
 
 std::vector<Joint*> World::descendant_joints(const RigidBody& root) const {
@@ -162,7 +171,7 @@ void World::remove_model(Model& model) {
     for (auto sys = systems_.rbegin(); sys != systems_.rend(); ++sys) {
       (*sys)->object_removed(*object);
     }
-    by_name_.erase(object->name());
+    by_name_.erase(object->key());
     objects_.erase(std::find(objects_.begin(), objects_.end(), object));
   }
   while (!model.owned_.empty()) model.owned_.pop_back();
@@ -202,18 +211,34 @@ int World::resolve_deferred_links() {
   return resolved;
 }
 
-int World::claim_name(const std::string& name, const char* what) {
+int World::claim_name(const std::string& name, const std::string& key, const char* what) {
   if (name.empty()) throw ArgumentError(std::string("a ") + what + " needs a name");
-  if (Object* existing = find(name)) {
-    throw ArgumentError(std::string("cannot add ") + what + " '" + name +
+  if (Object* existing = find(key)) {
+    throw ArgumentError(std::string("cannot add ") + what + " '" + key +
                         "': the world already has a " + object_kind_name(existing->kind()) +
                         " with that name");
   }
   return next_id_;
 }
 
+void World::move_to_name_space(Object& object, std::string ns) {
+  auto lock = lock_state();
+  const std::string old_key = object.key();
+  const std::string new_key = name_key(ns, object.name());
+  if (new_key != old_key) {
+    if (Object* other = find(new_key)) {
+      throw ArgumentError("cannot move " + object.describe() + " to namespace '" + ns +
+                          "': the world already has a " + object_kind_name(other->kind()) + " '" +
+                          new_key + "'");
+    }
+    by_name_.erase(old_key);
+    by_name_[new_key] = &object;
+  }
+  object.name_space_ = std::move(ns);
+}
+
 void World::register_object(Object* object) {
-  by_name_[object->name()] = object;
+  by_name_[object->key()] = object;
   objects_.push_back(object);
   next_id_ = object->id() + 1;
   std::size_t told = 0;
@@ -221,7 +246,7 @@ void World::register_object(Object* object) {
     for (; told < systems_.size(); ++told) systems_[told]->object_added(*object);
   } catch (...) {
     while (told-- > 0) systems_[told]->object_removed(*object);
-    by_name_.erase(object->name());
+    by_name_.erase(object->key());
     objects_.pop_back();
     throw;
   }

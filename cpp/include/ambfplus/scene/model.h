@@ -59,6 +59,11 @@ class AMBFPLUS_API Model {
   /// a bad spec or a taken name.
   ConstraintActuator& add_actuator(const ConstraintActuatorSpec& spec);
 
+  /// The namespace objects this model makes from now on are in ("" at first: Python's objects;
+  /// a model file's loader sets its `namespace`). Their keys (Object::key) must be free.
+  void set_object_name_space(std::string ns) { object_name_space_ = std::move(ns); }
+  const std::string& object_name_space() const { return object_name_space_; }
+
   /// For objects of kinds defined above the scene (haptics' drills and input devices): the id
   /// an object named `name` gets. Throws ArgumentError if the name is empty or taken (`what`
   /// names the kind in the message).
@@ -80,6 +85,7 @@ class AMBFPLUS_API Model {
 
   World* world_;
   std::string name_;
+  std::string object_name_space_;
   std::vector<std::unique_ptr<Object>> owned_;
   std::vector<Object*> objects_;
   std::optional<ShaderSpec> shader_;

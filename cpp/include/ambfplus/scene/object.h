@@ -43,8 +43,13 @@ class AMBFPLUS_API Object {
   Object& operator=(const Object&) = delete;
 
   virtual ObjectKind kind() const = 0;
-  /// Unique within the world.
+  /// The name it was declared with (an ADF block's `name`, a spec's name). Unique within its
+  /// namespace; objects of different namespaces may share it (two arms' "baselink").
   const std::string& name() const { return name_; }
+  /// Its name unique in the world, as AMBF's client keys it: the namespace below AMBF's root
+  /// "/ambf/env/" and the name ("psm1/baselink"); the bare name in the root namespace or none.
+  /// Legends, recordings, exports and the live view name objects by it.
+  std::string key() const;
   /// Its kind and name as messages name it: "body 'a'".
   std::string describe() const;
   /// Stable instance id (>= 1, never reused in a world); segmentation images use it.
@@ -58,7 +63,9 @@ class AMBFPLUS_API Object {
 
   /// AMBF namespace ("/ambf/env/"), "" for objects built from Python without one.
   const std::string& name_space() const { return name_space_; }
-  void set_name_space(std::string ns) { name_space_ = std::move(ns); }
+  /// Moves it to another namespace (its key changes with it). Throws ArgumentError if the world
+  /// has another object with the key it would get.
+  void set_name_space(std::string ns);
   /// namespace + name, as AMBF publishes it ("/ambf/env/l1").
   std::string qualified_name() const { return name_space_ + name_; }
   /// The ADF block it came from ("BODY l1"), "" when not loaded from a file.
@@ -81,6 +88,8 @@ class AMBFPLUS_API Object {
   Object(Model& model, std::string name, int id);
 
  private:
+  friend class World;
+  friend class Model;
   Model* model_;
   std::string name_;
   int id_;

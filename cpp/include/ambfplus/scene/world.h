@@ -60,14 +60,17 @@ class AMBFPLUS_API World {
   /// Models in creation order, the default model first.
   std::vector<Model*> models() const;
 
-  /// The object with exactly this name, or nullptr.
+  /// The object with exactly this key (Object::key: "psm1/baselink", or the bare name in AMBF's
+  /// root namespace), or nullptr.
   Object* find(const std::string& name) const;
   /// The object with this id, or nullptr (ids grow with creation, so this is a search).
   Object* object_with_id(int id) const;
-  /// Objects a name refers to, the way AMBF finds them: those whose name, qualified name
-  /// ("/ambf/env/l1"), identifier ("BODY l1") or namespace + identifier equals the query; if
-  /// none does, every object whose qualified name or identifier contains it. Optionally of one
-  /// kind only. One result is a match; none or several are for the caller to report.
+  /// Objects a name refers to, the way AMBF finds them, in tiers (the first that matches
+  /// anything answers): 1. the full name (namespace + name, "/ambf/env/psm1/l1", or namespace +
+  /// identifier) equals the query; 2. the key (Object::key, "psm1/l1", or the identifier's);
+  /// 3. the bare name or identifier ("l1", "BODY l1"); 4. the full name or namespace +
+  /// identifier contains it. Optionally of one kind only. One result is a match; none or
+  /// several are for the caller to report.
   std::vector<Object*> lookup(const std::string& query,
                               std::optional<ObjectKind> kind = std::nullopt) const;
   /// The joints below a body, as AMBF lists a root body's joints: every joint reachable through
@@ -168,7 +171,11 @@ class AMBFPLUS_API World {
   friend class Simulator;
   friend class Model;
   World(Simulator& simulator, std::string name, double time_step);
-  int claim_name(const std::string& name, const char* what);
+  /// The id an object named `name` (key `key`: Object::key) gets; throws ArgumentError if the
+  /// name is empty or the key taken.
+  int claim_name(const std::string& name, const std::string& key, const char* what);
+  /// Object::set_name_space for a listed object: re-keys it, or throws if the key is taken.
+  void move_to_name_space(Object& object, std::string ns);
   friend class Object;
   /// Lists an object and tells the systems; if one refuses it, it is taken out again.
   void register_object(Object* object);

@@ -919,6 +919,11 @@ class Object:
         the ADF block it was loaded from ('BODY l1'), or ''
         """
     @property
+    def key(self) -> str:
+        """
+        its name unique in the world, as AMBF's client keys it: the namespace below /ambf/env/ and the name ('psm1/baselink'), the bare name in the root namespace; legends and recordings use it
+        """
+    @property
     def kind(self) -> str:
         ...
     @property
@@ -926,11 +931,13 @@ class Object:
         ...
     @property
     def name(self) -> str:
-        ...
+        """
+        the name it was declared with; two namespaces may each have one
+        """
     @property
     def namespace(self) -> str:
         """
-        AMBF namespace, e.g. '/ambf/env/'
+        AMBF namespace, e.g. '/ambf/env/' (setting it changes the key; a key taken is an ArgumentError)
         """
     @namespace.setter
     def namespace(self, arg1: str) -> None:
@@ -2452,9 +2459,9 @@ class SkillMetrics:
         """
         Adds one tick: the burr centre `tip` (volume frame), the force on the hand, and the voxels removed during it (M, 3) with the labels they had (M,).
         """
-    def add_ticks(self, steps: typing.Annotated[numpy.typing.ArrayLike, numpy.int64], times: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], dt: typing.SupportsFloat | typing.SupportsIndex, tips: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], forces: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], burr_radii: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], burr_on: typing.Annotated[numpy.typing.ArrayLike, numpy.bool], removed_tick: typing.Annotated[numpy.typing.ArrayLike, numpy.int64], removed: typing.Annotated[numpy.typing.ArrayLike, numpy.int32], removed_labels: typing.Annotated[numpy.typing.ArrayLike, numpy.uint16]) -> None:
+    def add_ticks(self, steps: typing.Annotated[numpy.typing.ArrayLike, numpy.int64], times: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], dt: typing.SupportsFloat | typing.SupportsIndex, tips: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], forces: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], burr_radii: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], burr_on: typing.Annotated[numpy.typing.ArrayLike, numpy.bool], removed_tick: typing.Annotated[numpy.typing.ArrayLike, numpy.int64], removed: typing.Annotated[numpy.typing.ArrayLike, numpy.int32], removed_labels: typing.Annotated[numpy.typing.ArrayLike, numpy.uint16], fields_taken: typing.Annotated[numpy.typing.ArrayLike, numpy.float64] | None = None) -> None:
         """
-        Adds N ticks at once (a recording's): steps (N,), times (N,), tips and forces (N, 3), burr radii and burr on (N,), and the removed voxels (M, 3) with their labels (M,) and the index of the tick that removed each (M,), sorted.
+        Adds N ticks at once (a recording's): steps (N,), times (N,), tips and forces (N, 3), burr radii and burr on (N,), and the removed voxels (M, 3) with their labels (M,) and the index of the tick that removed each (M,), sorted. fields_taken: a real-time session's step-log column '<drill>.metrics_fields' (N, W): the protected structures' updated fields are taken at those ticks, as live.
         """
     def clearance(self, structure: typing.SupportsInt | typing.SupportsIndex, point: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], radius: typing.SupportsFloat | typing.SupportsIndex) -> float:
         """

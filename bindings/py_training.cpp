@@ -228,8 +228,36 @@ void define_training(py::module_& m) {
           [](SkillMetrics& s, const Int64s& steps, const Doubles& times, double dt,
              const Doubles& tips, const Doubles& forces, const Doubles& radii,
              const py::array_t<bool, py::array::c_style | py::array::forcecast>& on,
-             const Int64s& removed_tick, const Int32s& removed, const UInt16s& labels) {
+             const Int64s& removed_tick, const Int32s& removed, const UInt16s& labels,
+             const std::optional<Doubles>& fields_taken) {
             const py::ssize_t n = steps.size();
+            // The step log's "<drill>.metrics_fields" of a real-time session: (N, W) bits.
+            std::vector<std::vector<int>> takes;
+            if (fields_taken) {
+              const Doubles& f = *fields_taken;
+              if (f.ndim() != 2 || f.shape(0) != n || f.shape(1) < 1) {
+                throw ArgumentError("SkillMetrics.add_ticks: fields_taken must have shape (" +
+                                    std::to_string(n) + ", W), one row per tick");
+              }
+              const py::ssize_t w = f.shape(1);
+              takes.resize(static_cast<std::size_t>(n));
+              for (py::ssize_t i = 0; i < n; ++i) {
+                for (py::ssize_t c = 0; c < w; ++c) {
+                  const double v = f.data()[i * w + c];
+                  if (!(v >= 0.0 && v < 281474976710656.0) || v != std::floor(v)) {
+                    throw ArgumentError("SkillMetrics.add_ticks: fields_taken row " +
+                                        std::to_string(i) +
+                                        " is not a set of 48 bits (an integer 0..2^48-1)");
+                  }
+                  const auto bits = static_cast<std::uint64_t>(v);
+                  for (int b = 0; b < 48; ++b) {
+                    if (bits >> b & 1) {
+                      takes[static_cast<std::size_t>(i)].push_back(static_cast<int>(c * 48 + b));
+                    }
+                  }
+                }
+              }
+            }
             check_rows(times, n, 0, "times");
             check_rows(tips, n, 3, "tips");
             check_rows(forces, n, 3, "forces");
@@ -272,15 +300,21 @@ void define_training(py::module_& m) {
                 t.removed.push_back({rv[3 * r], rv[3 * r + 1], rv[3 * r + 2]});
                 t.removed_labels.push_back(rl[r]);
               }
+              if (fields_taken) {
+                t.scheduled = true;
+                t.take_fields = std::move(takes[static_cast<std::size_t>(i)]);
+              }
               s.add(t);
             }
           },
           py::arg("steps"), py::arg("times"), py::arg("dt"), py::arg("tips"), py::arg("forces"),
           py::arg("burr_radii"), py::arg("burr_on"), py::arg("removed_tick"), py::arg("removed"),
-          py::arg("removed_labels"),
+          py::arg("removed_labels"), py::arg("fields_taken") = py::none(),
           "Adds N ticks at once (a recording's): steps (N,), times (N,), tips and forces "
           "(N, 3), burr radii and burr on (N,), and the removed voxels (M, 3) with their labels "
-          "(M,) and the index of the tick that removed each (M,), sorted.")
+          "(M,) and the index of the tick that removed each (M,), sorted. fields_taken: a "
+          "real-time session's step-log column '<drill>.metrics_fields' (N, W): the protected "
+          "structures' updated fields are taken at those ticks, as live.")
       .def(
           "summary", [](const SkillMetrics& s) { return summary_dict(s.summary()); },
           "Everything measured so far, as a dict (distances in metres, times in seconds, "

@@ -169,6 +169,11 @@ class Recording:
             for name, (dtype, trailing) in datasets.items()
         }
 
+    def column_names(self, group: str) -> list[str]:
+        """The names of a group's columns (none for a group the recording lacks), read from
+        its first part without reading any data."""
+        return list(self._columns(group)) if group in self._groups else []
+
     @cached_property
     def steps(self) -> dict[str, np.ndarray]:
         """Columns at the physics rate (``step``, ``time`` and the producer's), read whole."""

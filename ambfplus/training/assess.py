@@ -82,6 +82,9 @@ def load_session(path) -> SessionData:
     if drill is None:
         raise ValueError(f"{path}: the recorded scene has no drill: nothing to assess")
     wanted = ["step", "time"] + [f"{drill.name}.{c}" for c in ("pose", "force", "on", "burr")]
+    # A real-time session's live metrics say when they took each updated field.
+    if f"{drill.name}.metrics_fields" in rec.column_names("steps"):
+        wanted.append(f"{drill.name}.metrics_fields")
     rig = rec.rigs.get(meta.get("rig", "rig"))
     stream = rig.left if rig is not None else rec.cameras.get(meta.get("camera", ""))
     if stream is not None and not len(stream):

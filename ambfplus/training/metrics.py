@@ -57,7 +57,14 @@ def drill_ticks(
     times = np.asarray(steps["time"], dtype=float)
     dt = tick_seconds(times)
     index = removed_ticks(step, removed["step"])
+    # A real-time session's live metrics took the protected structures' updated fields at the
+    # ticks this column gives; the replay takes them at the same ticks.
+    taken = steps.get(f"{drill}.metrics_fields")
+    extra = {}
+    if taken is not None:
+        extra["fields_taken"] = np.asarray(taken, dtype=float).reshape(len(step), -1)
     return {
+        **extra,
         "steps": step,
         "times": times,
         "dt": dt,

@@ -200,5 +200,47 @@ TEST(StructureDistances, FollowCutsAsAFreshFieldWould) {
   EXPECT_LT(distances.local_updates(), distances.rebuilds());
 }
 
+// A replay takes a successor exactly at the tick a real-time run took it (tick_taking), not on
+// the kFollowTicks schedule, and says which ticks took what (taken()).
+TEST(StructureDistances, ASchedulesTakesAreTheTicksItNames) {
+  VolumeData v({40, 36, 30}, Eigen::Vector3d(0.008, 0.0072, 0.009), LabelType::kUInt8, anatomy());
+  v.set_region(VoxelBox{{0, 0, 0}, {40, 36, 30}}, 1);
+  v.set_region(VoxelBox{{12, 10, 8}, {28, 26, 22}}, 2);
+  v.commit();
+  const double band = 0.0012;
+  StructureDistances scheduled(v);
+  StructureDistances plain(v);
+  scheduled.track(2, band);
+  plain.track(2, band);
+  const Eigen::Vector3d inside_cut = v.voxel_center(13, 18, 15);
+  const double before_cut = scheduled.distance(2, inside_cut);
+  // No successor under way: a schedule that takes one is from another session.
+  EXPECT_THROW(scheduled.tick_taking({2}), StateError);
+  const std::int64_t revision = v.revision();
+  v.take_edit_log();
+  v.remove_sphere(inside_cut, 0.0006, false);  // a cut into the structure's face
+  const auto log = v.take_edit_log();
+  ASSERT_EQ(log.size(), 1u);
+  scheduled.removed(revision, log.front().voxels, log.front().old_labels);
+  plain.removed(revision, log.front().voxels, log.front().old_labels);
+  const std::int64_t late = 3 * StructureDistances::kFollowTicks;
+  for (std::int64_t t = 1; t < late; ++t) {
+    scheduled.tick_taking({});
+    plain.tick(true);
+    EXPECT_TRUE(scheduled.taken().empty()) << t;
+    if (t == StructureDistances::kFollowTicks + 1) {
+      EXPECT_EQ(plain.taken(), std::vector<int>{2});  // the plain schedule took it here
+    } else {
+      EXPECT_TRUE(plain.taken().empty()) << t;
+    }
+  }
+  // Until the named tick the old field answers, then the successor.
+  EXPECT_EQ(scheduled.distance(2, inside_cut), before_cut);
+  scheduled.tick_taking({2});
+  EXPECT_EQ(scheduled.taken(), std::vector<int>{2});
+  EXPECT_GT(scheduled.distance(2, inside_cut), before_cut);
+  EXPECT_DOUBLE_EQ(scheduled.distance(2, inside_cut), plain.distance(2, inside_cut));
+}
+
 }  // namespace
 }  // namespace ambfplus

@@ -75,3 +75,50 @@ def test_live_metrics_check_their_config_and_count_every_step():
     scene.world.step(7)
     assert live.active and live.summary()["ticks"] == 12 and later.summary()["ticks"] == 7
     assert live.summary()["total_time"] == pytest.approx(0.012)
+
+
+def test_the_replay_takes_each_updated_field_at_the_step_the_live_metrics_took_it(tmp_path):
+    # The live metrics log the steps at which they took a protected structure's updated field
+    # ("<drill>.metrics_fields"); in a real-time loop those follow the background work, and the
+    # replay takes each field at the logged step, whatever the schedule would say.
+    from ambfplus.recording import open_recording
+    from ambfplus.training.metrics import drill_ticks
+
+    task = load_task({**TASK, "protect": [{"structure": "Bone", "margin": 1.0}]})
+    setup = task_setup(task, NOVICE)
+
+    def scene_and_device():
+        return _trainee_on_phantom(novice_like, 4, 2.0, setup["protect"], 128,
+                                   setup["region"], 0.03, setup["burr"], 160, 120)  # fmt: skip
+
+    scene, device = scene_and_device()
+    drill = scene.drill
+    live = ambfplus.live_metrics(drill, protect=task.protect_config(drill.volume.data))
+    path = tmp_path / "live.h5"
+    record_session(scene, path, device, 2.0, capture_every=500, passes=("depth",))
+    with open_recording(path) as rec:
+        steps, removed = dict(rec.steps), rec.removed
+    taken = np.asarray(steps[f"{drill.name}.metrics_fields"]).reshape(2000, -1)
+    assert taken.shape == (2000, 1) and int((taken > 0).sum()) >= 5  # drilling bone: updates
+    ticks = drill_ticks(steps, removed, drill.name, drill.burr_diameters, drill.volume.pose)
+    np.testing.assert_array_equal(ticks["fields_taken"], taken)
+
+    def replay(fields_taken):
+        anatomy = scene_and_device()[0].drill.volume.data  # the anatomy as it began
+        metrics = ambfplus.SkillMetrics(anatomy, protect=task.protect_config(anatomy),
+                                        apply_removals=True)  # fmt: skip
+        metrics.add_ticks(**{**ticks, "fields_taken": fields_taken})
+        return metrics.summary()
+
+    same(live.summary(), replay(taken))
+    # The first field taken 30 steps later than logged (as a slower machine would): the replay
+    # follows, and measures otherwise. (The later updates start as the first was taken, so they
+    # are still under way at their logged steps.)
+    first = int(np.flatnonzero(taken[:, 0])[0])
+    late = taken.copy()
+    late[first + 30], late[first] = taken[first], 0.0
+    delayed = replay(late)["structures"][0]
+    assert delayed != live.summary()["structures"][0]
+    # A schedule naming a structure the metrics lack is refused.
+    with pytest.raises(ambfplus.ArgumentError, match="protected structure 1"):
+        replay(np.where(taken > 0, 2.0, 0.0))

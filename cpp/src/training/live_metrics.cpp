@@ -7,6 +7,7 @@
 
 #include "ambfplus/errors.h"
 #include "ambfplus/haptics/drill.h"
+#include "ambfplus/scene/step_log.h"
 #include "ambfplus/scene/volume.h"
 #include "ambfplus/scene/world.h"
 #include "util/clock.h"
@@ -46,6 +47,7 @@ void LiveMetrics::tick(const StepContext& context) {
     tick_.removed.push_back(it->voxel);
     tick_.removed_labels.push_back(it->label);
   }
+  metrics_.set_realtime(d.realtime());
   metrics_.add(tick_);
   tick_cpu_seconds_.push_back(thread_cpu_seconds() - started);
   if (tick_cpu_seconds_.size() > kTickHistory) tick_cpu_seconds_.pop_front();
@@ -84,9 +86,34 @@ class TrainingSystem : public System {
   void run(StepStage, const StepContext& context) override {
     for (auto& m : metrics_) m->tick(context);
   }
+  // "<drill>.metrics_fields": the protected structures whose updated fields the drill's live
+  // metrics took at the step, as bits (structure s: bit s % 48 of value s / 48, an integer
+  // exact in a double), so an offline assessment takes them at the same steps.
+  void add_step_log_columns(const Object& object, StepLogColumns& columns) const override {
+    const LiveMetrics* found = find(object);
+    if (found == nullptr) return;
+    const std::size_t count = found->metrics().config().protect.size();
+    const int width = static_cast<int>(std::max<std::size_t>(1, (count + 47) / 48));
+    columns.add("metrics_fields", width, [this, width](const Object& o, std::vector<double>& out) {
+      const std::size_t at = out.size();
+      out.resize(at + static_cast<std::size_t>(width), 0.0);
+      if (const LiveMetrics* m = find(o)) {
+        for (int s : m->metrics().fields_taken()) {
+          out[at + static_cast<std::size_t>(s / 48)] +=
+              static_cast<double>(std::uint64_t{1} << (s % 48));
+        }
+      }
+    });
+  }
   LiveMetrics& add(Drill& drill, MetricsConfig config) {
     metrics_.push_back(std::make_unique<LiveMetrics>(drill, std::move(config)));
     return *metrics_.back();
+  }
+  const LiveMetrics* find(const Object& drill) const {
+    for (const auto& m : metrics_) {
+      if (m->active() && static_cast<const Object*>(&m->drill()) == &drill) return m.get();
+    }
+    return nullptr;
   }
   void remove(const LiveMetrics& metrics) {
     metrics_.erase(std::remove_if(metrics_.begin(), metrics_.end(),

@@ -93,6 +93,13 @@ void SkillMetrics::add(const ToolTick& tick) {
   if (tick.removed.size() != tick.removed_labels.size()) {
     throw ArgumentError("SkillMetrics: a tick's removed voxels and their labels differ in count");
   }
+  for (int s : tick.take_fields) {
+    if (s < 0 || static_cast<std::size_t>(s) >= watches_.size()) {
+      throw ArgumentError("SkillMetrics: step " + std::to_string(tick.step) +
+                          " takes the field of protected structure " + std::to_string(s) +
+                          ", but there are " + std::to_string(watches_.size()));
+    }
+  }
   if (config_.apply_removals && !tick.removed.empty()) {
     const std::vector<std::uint16_t> had = volume_.remove_voxels(tick.removed, "replay");
     for (std::size_t r = 0; r < had.size(); ++r) {
@@ -136,9 +143,22 @@ void SkillMetrics::add(const ToolTick& tick) {
 
   // The fields follow the structures' own edits: told this tick's removed voxels (every edit of
   // the volume since the last tick), they start local updates, taken kFollowTicks later.
+  // Replayed from a real-time session, they are taken at the ticks that session took them.
+  fields_taken_.clear();
   if (!watches_.empty()) {
     distances_->removed(-1, tick.removed, tick.removed_labels);
-    distances_->tick();
+    if (tick.scheduled) {
+      std::vector<int> keys;
+      for (int s : tick.take_fields) keys.push_back(watches_[static_cast<std::size_t>(s)].key);
+      distances_->tick_taking(keys);
+    } else {
+      distances_->tick(!realtime_);
+    }
+    for (int key : distances_->taken()) {
+      for (std::size_t s = 0; s < watches_.size(); ++s) {
+        if (watches_[s].key == key) fields_taken_.push_back(static_cast<int>(s));
+      }
+    }
   }
   for (std::size_t s = 0; s < watches_.size(); ++s) {
     Watch& w = watches_[s];

@@ -441,31 +441,53 @@ void StructureDistances::start(Entry& e) {
 void StructureDistances::tick(bool wait) {
   ++tick_;
   notice_edits();
+  taken_.clear();
   for (Entry& e : entries_) {
     const bool ready = e.next.valid() && (wait || e.next.wait_for(std::chrono::seconds(0)) ==
                                                       std::future_status::ready);
-    if (ready && tick_ >= e.due) {
-      std::shared_ptr<const Field> old = std::move(e.current);
-      // Waits only if the machine is slower than kFollowTicks.
-      if (e.next.wait_for(std::chrono::seconds(0)) != std::future_status::ready) {
-        const auto began = std::chrono::steady_clock::now();
-        e.next.wait();
-        ++waits_;
-        wait_seconds_ +=
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
+    if (ready && tick_ >= e.due) take(e);
+    if (!e.next.valid() && e.changed) start(e);
+  }
+}
+
+void StructureDistances::tick_taking(const std::vector<int>& take_keys) {
+  ++tick_;
+  notice_edits();
+  taken_.clear();
+  for (Entry& e : entries_) {
+    if (std::find(take_keys.begin(), take_keys.end(), e.label) != take_keys.end()) {
+      if (!e.next.valid()) {
+        throw StateError("distance fields: the schedule takes structure " +
+                         std::to_string(e.label) + "'s field at tick " + std::to_string(tick_) +
+                         ", but no update of it is under way (a schedule of another session)");
       }
-      e.current = e.next.get();
-      ++rebuilds_;
-      if (!e.next_patch.empty() && e.spare == nullptr) {
-        e.spare = std::move(old);  // behind current over the patch just applied
-        e.spare_lag = e.next_patch;
-      } else {
-        worker_->submit([old = std::move(old)]() mutable { old.reset(); });
-      }
-      e.next_patch = VoxelBox{};
+      take(e);
     }
     if (!e.next.valid() && e.changed) start(e);
   }
+}
+
+void StructureDistances::take(Entry& e) {
+  std::shared_ptr<const Field> old = std::move(e.current);
+  // A successor not built yet is waited for (scripted stepping on a machine slower than
+  // kFollowTicks, or a replayed schedule).
+  if (e.next.wait_for(std::chrono::seconds(0)) != std::future_status::ready) {
+    const auto began = std::chrono::steady_clock::now();
+    e.next.wait();
+    ++waits_;
+    wait_seconds_ +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
+  }
+  e.current = e.next.get();
+  ++rebuilds_;
+  if (!e.next_patch.empty() && e.spare == nullptr) {
+    e.spare = std::move(old);  // behind current over the patch just applied
+    e.spare_lag = e.next_patch;
+  } else {
+    worker_->submit([old = std::move(old)]() mutable { old.reset(); });
+  }
+  e.next_patch = VoxelBox{};
+  taken_.push_back(e.label);
 }
 
 double StructureDistances::distance(int label, const Eigen::Vector3d& p,

@@ -22,9 +22,10 @@ class World;
 /// burr's centre in its volume's frame, the force fed back, the burr, whether it spins and the
 /// voxels it removed in the step (which the drill has already taken from the volume, so the
 /// structures' distance fields follow the drilling). Read it under the world's lock while a
-/// real-time loop steps. Its fields follow the drilling on the offline schedule, so that the
-/// live metrics equal the offline assessment exactly; a machine too slow for that schedule makes
-/// a tick wait (SkillMetrics::field_waits counts it).
+/// real-time loop steps. Its fields follow the drilling: in a real-time loop a field is taken
+/// when it is ready (never waited for), and the step log's "<drill>.metrics_fields" says at
+/// which step, so that the offline assessment of the recording takes it at the same step and
+/// equals the live metrics exactly; scripted, on the offline schedule.
 class AMBFPLUS_API LiveMetrics {
  public:
   LiveMetrics(Drill& drill, MetricsConfig config);

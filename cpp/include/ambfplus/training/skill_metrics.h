@@ -59,6 +59,12 @@ struct AMBFPLUS_API ToolTick {
   /// Voxels removed during the step, with the labels they had.
   std::vector<std::array<int, 3>> removed;
   std::vector<std::uint16_t> removed_labels;
+  /// Replaying a real-time session: `scheduled` ticks take exactly the updated fields of the
+  /// protected structures (indices into MetricsConfig::protect) in `take_fields`, those the live
+  /// metrics took at this tick (SkillMetrics::fields_taken, the step log's
+  /// "<drill>.metrics_fields"), and no other.
+  bool scheduled = false;
+  std::vector<int> take_fields;
 };
 
 /// The metrics of one protected structure.
@@ -139,11 +145,19 @@ class AMBFPLUS_API SkillMetrics {
   /// the field's band (margin + field_band) it reads as the band.
   double clearance(std::size_t s, const Eigen::Vector3d& p, double r) const;
   /// A structure's field brought up to date after a breach is taken
-  /// StructureDistances::kFollowTicks ticks after the breach, waited for when not yet built:
-  /// live (LiveMetrics, in a real-time loop) as offline, so the live metrics equal the offline
-  /// assessment of the session's recording on any machine. On a machine slower than that the
-  /// tick waits (the drill's own fields, which the fixtures push with, never do): how often and
-  /// for how long.
+  /// StructureDistances::kFollowTicks ticks after the breach, waited for when not yet built
+  /// (scripted stepping: deterministic). In real time (a RealTimeLoop, which must never block)
+  /// it is taken at the first tick after it is ready instead; the ticks that took one say so
+  /// (fields_taken, logged by the step log), and an offline replay given them (ToolTick's
+  /// take_fields) takes each field at the same tick, so the live metrics equal the offline
+  /// assessment of the session's recording on any machine.
+  void set_realtime(bool realtime) { realtime_ = realtime; }
+  bool realtime() const { return realtime_; }
+  /// The protected structures (indices into MetricsConfig::protect) whose updated fields the
+  /// last tick took into use.
+  const std::vector<int>& fields_taken() const { return fields_taken_; }
+  /// Due fields not yet built when a tick had to take them (scripted, or a replayed schedule),
+  /// and the seconds (wall clock) waited for them.
   std::int64_t field_waits() const;
   double field_wait_seconds() const;
 
@@ -178,6 +192,8 @@ class AMBFPLUS_API SkillMetrics {
   double cutting_force_sum_ = 0.0;
   OpenStroke stroke_;
   bool have_tick_ = false;
+  bool realtime_ = false;
+  std::vector<int> fields_taken_;
 };
 
 }  // namespace ambfplus

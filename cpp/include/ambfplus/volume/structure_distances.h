@@ -69,6 +69,13 @@ class AMBFPLUS_API StructureDistances {
   /// is waited for (deterministic, scripted stepping); without it (a real-time loop, which must
   /// never block) it is taken at the first tick after it is ready.
   void tick(bool wait = true);
+  /// One tick that takes exactly the successors of the structures keyed in `take` (waiting for
+  /// them if not yet built) and no other: a replay of the ticks at which a real-time run took
+  /// them (taken()), so that it sees every field when the run did. Throws StateError for a key
+  /// whose structure has no successor under way (a schedule from another session).
+  void tick_taking(const std::vector<int>& take);
+  /// The keys (labels, as track_labels gives them) whose successors the last tick took.
+  const std::vector<int>& taken() const { return taken_; }
 
   /// Distance (metres) from p (volume frame) to the nearest centre of a voxel of `label`,
   /// negative inside, infinity when none is left; its gradient when asked (zero beyond the
@@ -125,6 +132,8 @@ class AMBFPLUS_API StructureDistances {
   std::future<std::shared_ptr<const Field>> follow(Entry& e);
   /// Starts e's successor (a local update or a new build) and clears e's record of changes.
   void start(Entry& e);
+  /// Replaces the field in use by its successor (waiting for it if need be).
+  void take(Entry& e);
   std::unique_ptr<VolumeData> copy(int label, const VoxelBox& box) const;
   /// Whether voxel (i, j, k), whose label is l, belongs to the structure of `label`.
   bool member(int label, std::uint16_t l, int i, int j, int k) const {
@@ -147,6 +156,7 @@ class AMBFPLUS_API StructureDistances {
   std::int64_t rebuilds_ = 0;
   std::int64_t local_updates_ = 0;
   std::int64_t waits_ = 0;
+  std::vector<int> taken_;
   double wait_seconds_ = 0.0;
   std::shared_ptr<const std::vector<std::uint8_t>> plan_;
   std::vector<std::vector<bool>> sets_;  // by key kPlanTarget - 1 - n: membership by label id

@@ -10,13 +10,16 @@ from ._core import Frame, World
 
 
 def legend(world: World) -> dict[int, dict]:
-    """Every object id a capture's instance image can hold: name (its key: ``psm1/baselink``
-    under a namespace, the bare name in AMBF's root one), kind, model and flat colour (RGB
-    0..255; bodies their material colour); volumes also list their labels (id -> name,
+    """Every object id a capture's instance image can hold: name (as declared), kind, model and
+    flat colour (RGB 0..255; bodies their material colour), and, for an object under a namespace
+    other than AMBF's root, its key (``psm1/baselink``: unique where names are not, and what
+    COCO categories and TF frames are named by); volumes also list their labels (id -> name,
     colour)."""
     out = {}
     for o in world.objects:
-        entry = {"name": o.key, "kind": o.kind, "model": o.model.name}
+        entry = {"name": o.name, "kind": o.kind, "model": o.model.name}
+        if o.key != o.name:
+            entry["key"] = o.key
         color = getattr(o, "color", None)
         if color is not None:
             entry["color"] = tuple(int(round(255 * c)) for c in list(color)[:3])

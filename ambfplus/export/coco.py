@@ -100,7 +100,8 @@ class CocoExport:
                         self._category[whole] = self._volume_category(object_id, entry, whole[1])
             elif entry.get("kind") not in SKIPPED_KINDS:
                 self._category[(object_id, None)] = self._add_category(
-                    entry["name"], entry.get("kind", "object"), object_id=object_id,
+                    entry.get("key") or entry["name"], entry.get("kind", "object"),
+                    object_id=object_id,
                     color=list(entry.get("color", ())),
                 )  # fmt: skip
         for key in sorted(self._seen - self._category.keys(), key=lambda k: k[0]):

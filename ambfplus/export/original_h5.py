@@ -58,7 +58,7 @@ from pathlib import Path
 import numpy as np
 
 from ..recording.values import FrameGate
-from ._common import ExportError, StepClock, export_conventions, pose_vector
+from ._common import ExportError, StepClock, export_conventions, legend_index, pose_vector
 
 CHUNK_SIZE = 500
 # The original's constant extrinsic: AMBF camera axes (x back, y right, z up; its clouds) to
@@ -97,7 +97,7 @@ class OriginalLayout:
         self.rec = recording
         self.chunk_size = chunk_size
         self.warnings: list[str] = []
-        self.legend_names = {e.get("name"): e for e in recording.legend.values()}
+        self.legend_names = legend_index(recording.legend)
         self.clock = StepClock(recording)
         self.gate = FrameGate(recording, bad_frames, ExportError)
         self._choose_streams()
@@ -159,7 +159,7 @@ class OriginalLayout:
     def _names(self, names: dict) -> dict:
         """ambfplus object name -> the name it takes in the layout."""
         out = {}
-        drills = [n for n, e in self.legend_names.items() if e.get("kind") == "drill"]
+        drills = [e.get("name") for e in self.rec.legend.values() if e.get("kind") == "drill"]
         if drills:
             out[drills[0]] = DEFAULT_NAMES["drill"]
         if self.left is not None:
@@ -174,7 +174,7 @@ class OriginalLayout:
         removed = self.rec.removed.get("volume")
         if removed:
             return removed
-        volumes = [n for n, e in self.legend_names.items() if e.get("kind") == "volume"]
+        volumes = [e.get("name") for e in self.rec.legend.values() if e.get("kind") == "volume"]
         return volumes[0] if volumes else None
 
     def _skip_bad(self) -> None:
@@ -336,8 +336,14 @@ class OriginalLayout:
         out = {}
         for column, values in self.steps.items():
             if column.endswith(".pose") and values.ndim == 3 and values.shape[1:] == (4, 4):
-                name = column[: -len(".pose")]
-                kind = (self.legend_names.get(name) or {}).get("kind")
+                key = column[: -len(".pose")]
+                entry = self.legend_names.get(key) or {}
+                kind = entry.get("kind")
+                # The original's layout names objects plainly (it had no namespaces): by the
+                # declared name where one object has it, else by the key with '_' for '/'.
+                name = entry.get("name") or key
+                if self.legend_names.get(name) is not entry:
+                    name = key.replace("/", "_")
                 # Camera bodies in AMBF's camera axes, as the original's camera states are.
                 out[name] = values @ T_CV_AMBF if kind == "camera" else values
         return out

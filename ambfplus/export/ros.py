@@ -82,8 +82,10 @@ from ._common import (
     StepClock,
     camera_frames,
     export_conventions,
+    legend_index,
     link_pose,
     nanoseconds,
+    object_key,
     quaternion_xyzw,
     require,
     tf_frame,
@@ -344,7 +346,7 @@ class RosExport:
         self.rgb_codec, self.jpeg_quality = rgb_codec, jpeg_quality
         self.clock = StepClock(recording)
         self.legend = recording.legend
-        self.names = {entry.get("name"): entry for entry in self.legend.values()}
+        self.names = legend_index(self.legend)
         self.warnings: list[str] = []
         self._stereo = self._stereo_partners()
         self._check()
@@ -356,7 +358,8 @@ class RosExport:
             if "depth" not in stream.passes and self.point_clouds:
                 self.warnings.append(f"stream {name} has no depth: no point cloud for it")
         removed = self.rec.removed
-        for name, entry in self.names.items():
+        for entry in self.legend.values():
+            name = entry.get("name")
             if entry.get("kind") == "volume" and "pose" not in entry:
                 self.warnings.append(f"the legend has no pose of volume {name}: no transform "
                                      "from world to it")  # fmt: skip
@@ -385,8 +388,12 @@ class RosExport:
         return np.asarray(entry["dimensions"], float), np.asarray(entry["shape"], int)
 
     def _frame(self, name: str) -> str:
-        """The TF frame of a legend object (its namespace from the legend, where it has one)."""
-        return tf_frame(name, (self.names.get(name) or {}).get("namespace") or "")
+        """The TF frame of a legend object: its key where the legend gives one (an object under
+        a namespace: ``psm1/baselink``), else its name under the legend's namespace, if any."""
+        entry = self.names.get(name) or {}
+        if entry.get("key"):
+            return tf_frame(entry["key"])
+        return tf_frame(name, entry.get("namespace") or "")
 
     def _camera_frames(self, stream) -> tuple[str, str]:
         """(body, optical) frames of a stream's camera."""
@@ -402,13 +409,13 @@ class RosExport:
 
     def _pose_columns(self) -> dict[str, np.ndarray]:
         """Step-log pose columns of objects other than recorded cameras: name -> (N, 4, 4)."""
-        filmed = {s.camera for s in self.rec.cameras.values()}
+        filmed = {object_key(self.names, s.camera) for s in self.rec.cameras.values()}
         out = {}
         for column, values in self.rec.steps.items():
             if not column.endswith(".pose") or values.ndim != 3 or values.shape[1:] != (4, 4):
                 continue
             name = column[: -len(".pose")]
-            if name in filmed:
+            if object_key(self.names, name) in filmed:
                 continue  # cameras are placed where their frames were taken
             out[name] = values
         return out
@@ -446,7 +453,7 @@ class RosExport:
     def _drills(self) -> list[str]:
         steps = self.rec.steps
         return [
-            n for n in self.names
+            n for n in dict.fromkeys(e.get("key") or e.get("name") for e in self.legend.values())
             if self._kind(n) == "drill" and f"{n}.force" in steps
         ]  # fmt: skip
 
@@ -454,10 +461,11 @@ class RosExport:
         """Volumes whose pose the legend holds and the step log does not: fixed."""
         logged = self._pose_columns()
         return {
-            name: np.asarray(entry["pose"], dtype=np.float64)
-            for name, entry in self.names.items()
-            if entry.get("kind") == "volume" and "pose" in entry and name not in logged
-        }
+            key: np.asarray(entry["pose"], dtype=np.float64)
+            for entry in self.legend.values()
+            if entry.get("kind") == "volume" and "pose" in entry
+            and (key := entry.get("key") or entry.get("name")) not in logged
+        }  # fmt: skip
 
     def describe(self) -> dict:
         """The export's own metadata: conventions, topics, frames, legend, warnings."""

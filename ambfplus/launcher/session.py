@@ -69,7 +69,7 @@ class LaunchSession:
             },
         }
         self.device_options = {
-            "reference": self.camera.name,
+            "reference": self.camera.key,
             "drill_button": 0,
             "clutch_button": 1,
             "burr_button": 2,

@@ -42,9 +42,11 @@ from .schema import (
     GroupSummary,
     PartSummary,
     RecordingError,
+    column_name,
     find_parts,
     legend_from_json,
     part_name,
+    stored_name,
 )
 
 # Parts kept open at once while reading (a long session has many).
@@ -285,7 +287,7 @@ class Column(Sequence):
 
     def __init__(self, files, group, name, dtype, trailing, pieces) -> None:
         self._files = files
-        self.path = f"{group}/{name}"
+        self.path = f"{group}/{stored_name(name)}"
         self.is_text = np.dtype(dtype).kind == "O"
         self.dtype = np.dtype(object) if self.is_text else np.dtype(dtype)
         self._trailing = tuple(trailing)
@@ -576,6 +578,7 @@ def _summarise_dataset(checked: CheckedFile, summary: PartSummary, name: str, da
     if heap_type(type_id):
         check_variable_dataset(checked, name, dataset)
     group, column = name.rsplit("/", 1) if "/" in name else ("", name)
+    column = column_name(column)
     shape = dataset.shape
     entry = summary.groups.get(group)
     if entry is None:

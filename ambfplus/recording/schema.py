@@ -93,6 +93,23 @@ class RecordingError(ConfigError):
     """A file that is not a readable ambfplus recording, or a recorder that failed."""
 
 
+_STORED_ESCAPES = {"25": "%", "2F": "/"}
+
+
+def stored_name(name: str) -> str:
+    """A column's name as its HDF5 dataset is named: a namespaced object's step-log column
+    (``psm1/link.pose``) holds '/', which HDF5 reads as a path, so '%' and '/' are stored as
+    ``%25`` and ``%2F`` (``psm1%2Flink.pose``); every other name is stored as it is."""
+    return name.replace("%", "%25").replace("/", "%2F")
+
+
+def column_name(stored: str) -> str:
+    """The column name a dataset name stands for (``stored_name`` undone)."""
+    if "%" not in stored:
+        return stored
+    return re.sub(r"%(25|2F)", lambda m: _STORED_ESCAPES[m[1]], stored)
+
+
 def text_dtype(length: int | None):
     """h5py's dtype for UTF-8 text: fixed-length (`length` bytes), or variable-length for None
     (format 1.0 only)."""

@@ -50,6 +50,7 @@ from .schema import (
     check_text,
     find_parts,
     part_name,
+    stored_name,
     text_attribute,
     text_column,
     to_json,
@@ -591,7 +592,7 @@ def _step_rows(columns: Mapping) -> _Rows:
     one_row = np.ndim(columns["step"]) == 0
     out = {}
     for name, value in columns.items():
-        _check_name(name, "steps column")
+        _check_name(name, "steps column", slash=True)
         array = np.asarray(value)
         array = array[None] if one_row else array
         if name in STEP_REQUIRED:
@@ -696,9 +697,12 @@ def _check_lengths(columns: dict, group: str) -> None:
         raise ValueError(f"{group}: columns of different lengths {lengths}")
 
 
-def _check_name(name: str, what: str) -> None:
-    if not name or "/" in name or "\0" in name or name in (".", ".."):
-        raise ValueError(f"invalid {what} name {name!r} (non-empty, no '/', no NUL)")
+def _check_name(name: str, what: str, *, slash: bool = False) -> None:
+    """Stream and rig names become HDF5 groups: no '/'. Step-log columns may hold one (a
+    namespaced object's, ``psm1/link.pose``: stored as ``stored_name`` gives it)."""
+    if not name or ("/" in name and not slash) or "\0" in name or name in (".", ".."):
+        allowed = "" if slash else ", no '/'"
+        raise ValueError(f"invalid {what} name {name!r} (non-empty{allowed}, no NUL)")
 
 
 def _schema_difference(known: dict, got: dict) -> str:
@@ -910,7 +914,9 @@ class _PartFile:
         dataset = self._datasets.get((group, name))
         if dataset is None:
             assert self.file is not None, "open from __init__ on"
-            dataset = _create(self.file[group], name, data, chunk_rows, self.compression)
+            dataset = _create(
+                self.file[group], stored_name(name), data, chunk_rows, self.compression
+            )
         else:
             if data.dtype.kind == "S" and data.dtype.itemsize > dataset.dtype.itemsize:
                 dataset = self._widen(group, name, dataset, data.dtype)
@@ -927,8 +933,10 @@ class _PartFile:
         HDF5 reuses the space it frees while the part is open)."""
         rows, chunk_rows = dataset[()], dataset.chunks[0]
         assert self.file is not None, "open from __init__ on"
-        del self.file[group][name]
-        return _create(self.file[group], name, rows.astype(dtype), chunk_rows, self.compression)
+        del self.file[group][stored_name(name)]
+        return _create(
+            self.file[group], stored_name(name), rows.astype(dtype), chunk_rows, self.compression
+        )
 
     def close(self) -> PartSummary:
         """Writes what is buffered, closes the file and renames it into place; a failed write
@@ -1058,7 +1066,9 @@ def _write_virtual_datasets(f: h5py.File, parts: list[PartSummary]) -> None:
             if column in first.strings:
                 dtype = _text_union([group.strings.get(column) for _, group in pieces])
             sources = [(part.path.name, group.rows) for part, group in pieces]
-            _virtual_dataset(f[name], column, dtype, (total,) + tuple(trailing), sources)
+            _virtual_dataset(
+                f[name], stored_name(column), dtype, (total,) + tuple(trailing), sources
+            )
 
 
 def _virtual_dataset(group: h5py.Group, name: str, dtype, shape: tuple, sources: list) -> None:
@@ -1067,7 +1077,8 @@ def _virtual_dataset(group: h5py.Group, name: str, dtype, shape: tuple, sources:
     parts always give the same head, byte for byte."""
     dcpl = h5py.h5p.create(h5py.h5p.DATASET_CREATE)
     dcpl.set_obj_track_times(False)
-    path = f"{group.name}/{name}".lstrip("/").encode()
+    # HDF5 reads '%' in a source's file and dataset names as a format specifier: '%%' is one.
+    path = f"{group.name}/{name}".lstrip("/").replace("%", "%%").encode()
     start = 0
     for file_name, rows in sources:
         if rows == 0:
@@ -1076,7 +1087,8 @@ def _virtual_dataset(group: h5py.Group, name: str, dtype, shape: tuple, sources:
         selection = h5py.h5s.create_simple(shape)
         selection.select_hyperslab((start,) + (0,) * (len(shape) - 1), (1,) * len(shape),
                                    block=block)  # fmt: skip
-        dcpl.set_virtual(selection, file_name.encode(), path, h5py.h5s.create_simple(block))
+        source = file_name.replace("%", "%%").encode()
+        dcpl.set_virtual(selection, source, path, h5py.h5s.create_simple(block))
         start += rows
     space = h5py.h5s.create_simple(shape)
     h5py.h5d.create(group.id, name.encode(), h5py.h5t.py_create(np.dtype(dtype), logical=1),

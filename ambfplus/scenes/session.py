@@ -41,14 +41,15 @@ RIG = "rig"
 
 
 def _serialisable_options(options: dict) -> dict:
-    """Device binding options with objects replaced by their names."""
-    return {k: (v.name if hasattr(v, "name") else v) for k, v in options.items()}
+    """Device binding options with objects replaced by their keys (the bare name in AMBF's root
+    namespace; what the step log names their columns by)."""
+    return {k: (v.key if hasattr(v, "key") else v) for k, v in options.items()}
 
 
 def _bind(scene: Scene, device: Device, options: dict | None = None):
     options = dict(scene.device_options if options is None else options)
     if isinstance(options.get("reference"), str):
-        options["reference"] = scene.world[options["reference"]]
+        options["reference"] = scene.world.get(options["reference"])
     return scene.world.add_input_device(scene.device_name, device, scene.drill, **options)
 
 
@@ -258,7 +259,7 @@ def replay(
                     if same_rig and recorded is not None:
                         identical_frames += _same_images(pair, recorded[i], passes)
                 s, r, _ = drain(world, drill, recorder)
-                new_forces.append(s[f"{drill.name}.force"])
+                new_forces.append(s[f"{drill.key}.force"])
                 new_removed.append(r)
                 if progress is not None and (i + 1) % max(1, len(plan) // 10) == 0:
                     _progress(progress, world.step_index, int(plan[-1][0]), started,
@@ -266,7 +267,7 @@ def replay(
             last = int(steps["step"][-1]) if len(steps["step"]) else world.step_index
             step_to(last)
             s, r, _ = drain(world, drill, recorder)
-            new_forces.append(s[f"{drill.name}.force"])
+            new_forces.append(s[f"{drill.key}.force"])
             new_removed.append(r)
         finally:
             world.stop_step_log()
@@ -277,7 +278,7 @@ def replay(
     differences = [
         k for k in ("step", "voxel", "label") if not np.array_equal(removed[k], again[k])
     ]
-    recorded_forces = steps[f"{drill.name}.force"]
+    recorded_forces = steps[f"{drill.key}.force"]
     return ReplayReport(
         steps=world.step_index,
         frames=len(plan),
@@ -312,7 +313,7 @@ def _stepper(world, steps: dict, reference: str | None) -> Callable[[int], None]
                 world.step(target - world.step_index)
 
         return step_to
-    camera = world[reference]
+    camera = world.get(reference)
     poses = dict(zip(steps["step"].tolist(), steps[column]))
 
     def step_with_camera(target: int) -> None:

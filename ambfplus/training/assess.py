@@ -81,10 +81,10 @@ def load_session(path) -> SessionData:
     drill = scene.drill
     if drill is None:
         raise ValueError(f"{path}: the recorded scene has no drill: nothing to assess")
-    wanted = ["step", "time"] + [f"{drill.name}.{c}" for c in ("pose", "force", "on", "burr")]
+    wanted = ["step", "time"] + [f"{drill.key}.{c}" for c in ("pose", "force", "on", "burr")]
     # A real-time session's live metrics say when they took each updated field.
-    if f"{drill.name}.metrics_fields" in rec.column_names("steps"):
-        wanted.append(f"{drill.name}.metrics_fields")
+    if f"{drill.key}.metrics_fields" in rec.column_names("steps"):
+        wanted.append(f"{drill.key}.metrics_fields")
     rig = rec.rigs.get(meta.get("rig", "rig"))
     stream = rig.left if rig is not None else rec.cameras.get(meta.get("camera", ""))
     if stream is not None and not len(stream):
@@ -122,7 +122,7 @@ def load_session(path) -> SessionData:
         metadata=meta,
         created=rec.created,
         software_version=rec.software_version,
-        drill=drill.name,
+        drill=drill.key,
         burr_diameters=list(drill.burr_diameters),
         volume_pose=np.asarray(drill.volume.pose, float),
         anatomy=drill.volume.data,

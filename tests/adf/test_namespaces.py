@@ -5,10 +5,12 @@ client key (``ns1/link``) and, where unique, by its bare name; nothing is rename
 
 from __future__ import annotations
 
+import json
 import logging
 import textwrap
 from pathlib import Path
 
+import h5py
 import numpy as np
 import pytest
 
@@ -150,16 +152,22 @@ def test_the_stereo_camera_rides_on_the_later_models_body_with_its_baseline(scen
     assert (right.pose[:3, 3] - left.pose[:3, 3]) @ x_axis == pytest.approx(BASELINE, abs=1e-9)
     world.step(1)
     legend = object_legend(world)
-    names = {entry["name"] for entry in legend.values()}
-    assert {"ns1/link", "ns2/link", "ns1/base", "ns2/base"} <= names
+    # The legend keeps declared names, and the key of each object under a namespace.
+    keys = {entry.get("key", entry["name"]) for entry in legend.values()}
+    assert {"ns1/link", "ns2/link", "ns1/base", "ns2/base"} <= keys
+    assert {e["name"] for e in legend.values() if e.get("key") == "ns2/link"} == {"link"}
     for eye in (left, right):
         frame = eye.capture(passes=("rgb", "instance"), poses=["ns1/link", "/ambf/env/ns2/link"])
-        assert frame.camera == eye.key
+        assert frame.camera == eye.name
         # Poses asked for by key or full name come back under the key.
         assert set(frame.poses) == {"ns1/link", "ns2/link"}
         for key in ("ns1/link", "ns2/link"):
             np.testing.assert_allclose(frame.poses[key], world.get(key).pose, atol=1e-6)
-        seen = {legend[int(i)]["name"] for i in np.unique(frame.instance) if int(i) in legend}
+        seen = {
+            legend[int(i)].get("key", legend[int(i)]["name"])
+            for i in np.unique(frame.instance)
+            if int(i) in legend
+        }
         # Both arms are in view of each eye: the camera sees the scene from the ridden link.
         assert {"ns1/link", "ns2/link"} <= seen, seen
 
@@ -188,3 +196,50 @@ def test_the_same_name_twice_in_one_namespace_is_renamed_with_a_warning(tmp_path
         if "the same name in the same namespace" in r.getMessage()
     ]
     assert len(warned) >= 2 and all("arm.yaml" in w for w in warned), warned
+
+
+def test_exports_name_frames_and_categories_by_key(scene, tmp_path):
+    # A recording of the scene: COCO categories and TF frames carry the namespaced names.
+    pytest.importorskip("mcap_ros2")
+    pytest.importorskip("pycocotools")
+    from mcap.reader import make_reader
+    from mcap_ros2.decoder import DecoderFactory
+
+    from ambfplus.export import export
+    from ambfplus.recording import Recorder, open_recording
+
+    sim, _, _ = scene
+    world, left = sim.world, sim.world.get("main_left")
+    path = tmp_path / "ns.h5"
+    world.start_step_log([world.get("ns1/link"), world.get("ns2/link")])
+    with Recorder(path) as rec:
+        rec.set_legend(world)
+        for _ in range(3):
+            world.step(5)
+            rec.add_frame("main_left", left.capture(passes=("rgb", "depth", "instance")))
+            rec.add_steps(world.take_step_log())
+    world.stop_step_log()
+    # Step-log columns are named by keys, and come back so from the recording (HDF5 stores
+    # the '/' escaped).
+    with open_recording(path) as rec:
+        steps = rec.steps
+        for key in ("ns1/link", "ns2/link"):
+            np.testing.assert_allclose(steps[f"{key}.pose"][-1], world.get(key).pose, atol=1e-12)
+    export(path, tmp_path / "coco", "coco", progress=False)
+    document = json.loads((tmp_path / "coco" / "main_left.json").read_text())
+    categories = {c["name"] for c in document["categories"]}
+    assert {"ns1/link", "ns2/link", "ns1/base", "ns2/base"} <= categories
+    export(path, tmp_path / "ns.mcap", "mcap", progress=False)
+    frames = set()
+    with open(tmp_path / "ns.mcap", "rb") as f:
+        reader = make_reader(f, decoder_factories=[DecoderFactory()])
+        for _, _, _, message in reader.iter_decoded_messages(topics=["/tf"]):
+            frames.update(t.child_frame_id for t in message.transforms)
+    assert {"ns1/link", "ns2/link"} <= frames and "link" not in frames
+    # The original system's layout has no namespaces: the two links by their keys, '_' for '/'.
+    export(path, tmp_path / "orig.h5", "original-h5", progress=False)
+    (written,) = (tmp_path / "orig.h5").glob("*.hdf5")
+    with h5py.File(written) as f:
+        poses = f["physics_data/continuous_data/high_frequency_poses"]
+        assert {"ns1_link_pose", "ns2_link_pose"} <= set(poses)
+        assert {"pose_ns1_link", "pose_ns2_link"} <= set(f["vision_data/continuous_data"])

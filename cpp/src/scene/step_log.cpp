@@ -22,29 +22,16 @@ void push_pose(std::vector<double>& out, const Eigen::Isometry3d& pose) {
 
 void StepLogColumns::add(std::string name, int width, Recorder record) {
   if (width < 1 || !record) {
-    throw ArgumentError("step log column '" + object_->name() + "." + name +
+    throw ArgumentError("step log column '" + object_->key() + "." + name +
                         "' needs a width of at least 1 and a recorder");
   }
   fields_.push_back({std::move(name), width, std::move(record)});
 }
 
 StepLog::StepLog(std::vector<StepLogColumns> objects) : objects_(std::move(objects)) {
-  // Columns are named by the objects' declared names (recordings store them as names of their
-  // own, which cannot hold a namespace's '/'): two logged objects may not share one.
-  for (std::size_t a = 0; a < objects_.size(); ++a) {
-    for (std::size_t b = 0; b < a; ++b) {
-      const Object& x = objects_[a].object();
-      const Object& y = objects_[b].object();
-      if (x.name() == y.name()) {
-        throw ArgumentError("step log: " + y.describe() + " and " + x.describe() +
-                            " share the name '" + x.name() +
-                            "' its columns are named by; log one of them (namespaced names in "
-                            "step logs are not supported yet)");
-      }
-    }
-  }
+  // Columns are named by the objects' keys ("psm1/link.pose" under a namespace): unique.
   for (const StepLogColumns& o : objects_) {
-    const std::string& n = o.object().name();
+    const std::string n = o.object().key();
     if (o.pose()) columns_.push_back({n + ".pose", 16, {}});
     for (const StepLogColumns::Field& f : o.fields())
       columns_.push_back({n + "." + f.name, f.width, {}});

@@ -243,3 +243,16 @@ def test_exports_name_frames_and_categories_by_key(scene, tmp_path):
         poses = f["physics_data/continuous_data/high_frequency_poses"]
         assert {"ns1_link_pose", "ns2_link_pose"} <= set(poses)
         assert {"pose_ns1_link", "pose_ns2_link"} <= set(f["vision_data/continuous_data"])
+
+
+def test_a_reference_resolves_within_its_files_namespace_first(tmp_path):
+    # A later file under ns2 hangs a light on "BODY link": ns2's, though ns1 has a link too.
+    launch = write_scene(tmp_path)
+    (tmp_path / "lamp.yaml").write_text(
+        "namespace: /ambf/env/ns2/\nlights: [LIGHT lamp]\n"
+        "LIGHT lamp: {name: lamp, parent: BODY link, location: {x: 0, y: 0, z: 0.2}}\n"
+    )
+    sim = ambfplus.Simulator.from_launch(launch, models=[0, 1], extra=[tmp_path / "lamp.yaml"],
+                                         strict=True)  # fmt: skip
+    lamp = sim.world.get("ns2/lamp")
+    assert lamp.attached_to is not None and lamp.attached_to.key == "ns2/link"

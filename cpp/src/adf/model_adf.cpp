@@ -30,8 +30,9 @@ Object* find_object(World& world, const std::string& ref, const std::string& ns,
   for (const auto& [id, body] : own) {
     if (body->name() == remove_spaces(ref)) return body;
   }
-  std::vector<Object*> found = world.lookup(ref, kind);
-  if (found.empty()) found = world.lookup(ns + ref, kind);
+  // Within the file's namespace first (two namespaces may each have the name), then anywhere.
+  std::vector<Object*> found = world.lookup(ns + ref, kind);
+  if (found.empty()) found = world.lookup(ref, kind);
   if (!kind) {
     found.erase(std::remove_if(found.begin(), found.end(),
                                [](Object* o) { return o->kind() == ObjectKind::kJoint; }),

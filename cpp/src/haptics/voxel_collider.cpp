@@ -11,11 +11,21 @@ namespace {
 
 constexpr int B = 8;  // brick edge, voxels: 512 bits per brick
 
+// An AVX2 clone chosen at load time (an ifunc). Not under ThreadSanitizer: the loader runs the
+// clone's resolver before the sanitizer's runtime is set up, and the instrumented resolver then
+// crashes the process before main.
+#if defined(__SANITIZE_THREAD__)
+#define AMBFPLUS_AVX2_CLONES
+#else
+#define AMBFPLUS_AVX2_CLONES __attribute__((target_clones("avx2", "default")))
+#endif
+
 // Entry fraction (0..1) of a sphere of radius R swept from a along unit d for `length` into each
 // voxel sphere centred at (x, y, z)[i], 2 where it does not enter; as VoxelCollider::enter().
-__attribute__((target_clones("avx2", "default"))) void entry_fractions(
-    const double* x, const double* y, const double* z, std::size_t n, double ax, double ay,
-    double az, double dx, double dy, double dz, double length, double R, double* out) {
+AMBFPLUS_AVX2_CLONES void entry_fractions(const double* x, const double* y, const double* z,
+                                          std::size_t n, double ax, double ay, double az, double dx,
+                                          double dy, double dz, double length, double R,
+                                          double* out) {
   const double R2 = R * R, inv_length = length > 0 ? 1.0 / length : 0.0;
   // Still: touching blocks nothing. (One simple select per condition, so the loop has no branches
   // and vectorises.)

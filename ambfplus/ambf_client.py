@@ -351,16 +351,35 @@ class Client:
             self._world_handle = WorldHandle(self)
         return self._world_handle
 
+    def _keyed(self) -> dict:
+        """The objects AMBF's client lists, by its keys: the namespace below /ambf/env/ and the
+        name (``psm1/baselink``), the bare name in the root namespace (joints have no topic)."""
+        return {o.key: o for o in self._sim.world.objects if o.kind != "joint"}
+
     def get_obj_names(self) -> list:
-        return [o.qualified_name or o.name for o in self._sim.world.objects]
+        return list(self._keyed())
 
     def get_obj_handle(self, a_name: str):
-        """The handle of the object a name refers to (AMBF's lookup), or None with a message."""
-        try:
-            obj = self._sim.world.get(a_name)
-        except KeyError as error:
-            print(f"ambfplus.ambf_client: {error.args[0]}")
-            return None
+        """The handle of the object a name refers to, as AMBF's client finds it: a key; else the
+        one key that holds the name (``psm1/base`` finds ``psm1/baselink``; several: a message
+        listing them, and None); else the engine's own names (a full name ``/ambf/env/...``,
+        an ADF block ``BODY l1``). None with a message when nothing matches."""
+        keyed = self._keyed()
+        obj = keyed.get(a_name)
+        if obj is None:
+            found = [key for key in keyed if a_name in key]
+            if len(found) > 1:
+                print(f"ambfplus.ambf_client: '{a_name}' matches {len(found)} objects "
+                      f"({', '.join(found)}): name one of them")  # fmt: skip
+                return None
+            if found:
+                obj = keyed[found[0]]
+        if obj is None:
+            try:
+                obj = self._sim.world.get(a_name)
+            except KeyError as error:
+                print(f"ambfplus.ambf_client: {error.args[0]}")
+                return None
         handle = self._handles.get(obj.id)
         if handle is None:
             handle = _handle_for(self, obj)
@@ -1052,8 +1071,12 @@ COVERAGE: dict = {
     "Client.start": (_I, "starts the real-time thread (AMBF: its publishers)"),
     "Client.get_common_namespace": (_I, "the world's namespace"),
     "Client.get_world_handle": (_I, ""),
-    "Client.get_obj_names": (_I, "qualified names"),
-    "Client.get_obj_handle": (_I, "AMBF's lookup; None with a message when not found"),
+    "Client.get_obj_names": (_I, "AMBF's keys: namespace below /ambf/env/ + name, no joints"),
+    "Client.get_obj_handle": (
+        _I,
+        "AMBF's lookup: a key, else the one key holding the name (several: a message, None), "
+        "else a full name or ADF block",
+    ),
     "Client.get_obj_pose": (_I, "the handle's get_pose (AMBF's returns an absent attribute)"),
     "Client.set_obj_cmd": (_I, "wrench_command on the named body"),
     "Client.print_active_topics": (_I, "prints the object names (there are no topics)"),

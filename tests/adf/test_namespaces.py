@@ -256,3 +256,20 @@ def test_a_reference_resolves_within_its_files_namespace_first(tmp_path):
                                          strict=True)  # fmt: skip
     lamp = sim.world.get("ns2/lamp")
     assert lamp.attached_to is not None and lamp.attached_to.key == "ns2/link"
+
+
+def test_the_ambf_client_keys_and_finds_objects_as_ambf_does(scene, capsys):
+    from ambfplus.ambf_client import Client
+
+    sim, _, _ = scene
+    client = Client(simulator=sim)
+    names = client.get_obj_names()
+    assert {"ns1/link", "ns2/link", "ns1/base", "main_left"} <= set(names)
+    assert not [n for n in names if n.endswith("base-link")]  # joints have no topic in AMBF
+    assert client.get_obj_handle("ns2/link").get_name() == "/ambf/env/ns2/link"
+    # A unique part of a key finds it; a part two keys hold lists them and finds nothing.
+    assert client.get_obj_handle("s1/li").get_name() == "/ambf/env/ns1/link"
+    assert client.get_obj_handle("link") is None
+    assert "ns1/link, ns2/link" in capsys.readouterr().out
+    # Full names and ADF blocks still work.
+    assert client.get_obj_handle("/ambf/env/ns2/base").get_name() == "/ambf/env/ns2/base"

@@ -81,7 +81,7 @@ def test_ambf_client_script_moves_a_fixture_joint(fixtures):
     sim = launch(fixtures, [12])
     client = Client(simulator=sim)
     assert client.connect()
-    assert "/ambf/env/Mold_A" in client.get_obj_names()
+    assert "Mold_A" in client.get_obj_names()  # AMBF client keys: no /ambf/env/ prefix
     mold = client.get_obj_handle("Mold_A")
     assert mold.get_num_joints() == 6
     assert mold.get_joint_names()[4] == "Mold_A-MoldHinge"

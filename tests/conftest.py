@@ -117,6 +117,51 @@ def reference_dataset(dataset_spec, tmp_path_factory) -> Path:
     return out
 
 
+# A dataset of any scene (issue #34): the multi-arm AMBF scene of tests/helpers/multi_arm.py,
+# loaded from its launch file, driven by a Python episode script; its dataset made once per
+# session by one local worker, the reference for other worker counts, Ray and resumed runs.
+MULTI_ARM_SPEC = """\
+version: 1
+name: two arms
+episodes: 6
+seed: 11
+scene:
+  launch: scene/launch.yaml
+  models: [0, 1, 2, 3]
+  python_path: [scene]
+episode:
+  script: {script}
+capture: {{every: 50, frames: 10, passes: [rgb, depth, instance]}}
+appearance:
+  lights: {{count: 1, types: [directional], intensity: {{uniform: [0.4, 0.9]}}}}
+  background: {{uniform: [0.0, 0.2]}}
+  noise: {{rgb_sigma: 1.5}}
+"""
+
+
+@pytest.fixture(scope="session")
+def multi_arm_spec(tmp_path_factory) -> Path:
+    """The multi-arm scene's files and its dataset spec, written to a folder."""
+    from helpers.multi_arm import write_episode_script, write_multi_arm_scene
+
+    folder = tmp_path_factory.mktemp("multi_arm")
+    write_multi_arm_scene(folder / "scene")
+    script = write_episode_script(folder / "scene")
+    path = folder / "spec.yaml"
+    path.write_text(MULTI_ARM_SPEC.format(script=script))
+    return path
+
+
+@pytest.fixture(scope="session")
+def multi_arm_dataset(multi_arm_spec, tmp_path_factory) -> Path:
+    """The multi-arm spec's dataset, made by one local worker."""
+    from ambfplus.dataset import generate
+
+    out = tmp_path_factory.mktemp("multi_arm_reference") / "data"
+    generate(multi_arm_spec, out, workers=1, progress=False)
+    return out
+
+
 # Long measurements run only when asked for: `pytest -m benchmark`. (Fuzz-marked tests run
 # wherever atheris is installed, as in CI; `-m "not fuzz"` leaves them out.)
 OPT_IN_MARKS = ("benchmark",)

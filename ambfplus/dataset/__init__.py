@@ -7,22 +7,33 @@ resumable, exact and randomised.
         generate("spec.yaml", "out", workers=2)     # or ray="auto" (pip install "ambfplus[ray]")
         print(validate_dataset("out"))
 
-An episode is a pure function of (spec, base seed, episode index): ``sample_episode`` draws its
-anatomy, scenario, rig and look; ``run_episode`` renders and records it into one shard (an
-ordinary recording, ``ambfplus.open_recording``), the same bytes whichever worker, executor or
-number of workers made it (on the same renderer). The folder's layout, the manifest and the
-spec's keys: see ``generate``, ``manifest`` and ``spec``.
+A spec films the built-in drilling scene, or any scene (an AMBF launch file or a Python factory,
+driven by a Python episode script or waypoints: ``ambfplus.dataset.sources``).
+
+An episode is a pure function of (spec, base seed, episode index): ``sample_episode`` draws
+its anatomy (or scene), scenario, rig and look; ``run_episode`` renders and records it into one
+shard (an ordinary recording, ``ambfplus.open_recording``), the same bytes whichever worker,
+executor or number of workers made it (on the same renderer). The folder's layout, the manifest
+and the spec's keys: see ``generate``, ``manifest`` and ``spec``.
 """
 
 from .check import DatasetReport, dataset_info, format_info, is_dataset, validate_dataset
-from .driver import GenerateError, GenerateReport, check_anatomies, generate
+from .driver import GenerateError, GenerateReport, check_sources, generate
 from .episode import EpisodeError, StaleRunError, record_episode, run_episode, shard_name
 from .manifest import RUN_FIELDS, read_manifest, without_run_fields
 from .sampling import EpisodePlan, episode_seed, sample_episode
-from .spec import SCHEMA_TEXT, SCHEMA_VERSION, DatasetSpec, SpecError, load_spec, parse_spec
+from .spec import (
+    SCENE_SCHEMA_TEXT,
+    SCHEMA_TEXT,
+    SCHEMA_VERSION,
+    DatasetSpec,
+    SpecError,
+    load_spec,
+    parse_spec,
+)
 
 __all__ = [
-    "check_anatomies",
+    "check_sources",
     "DatasetReport",
     "dataset_info",
     "DatasetSpec",
@@ -41,6 +52,7 @@ __all__ = [
     "run_episode",
     "RUN_FIELDS",
     "sample_episode",
+    "SCENE_SCHEMA_TEXT",
     "SCHEMA_TEXT",
     "SCHEMA_VERSION",
     "shard_name",

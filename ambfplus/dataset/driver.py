@@ -81,7 +81,7 @@ def generate(
     none (False). Call it under ``if __name__ == "__main__":`` (local workers import
     the main module again)."""
     spec = spec if isinstance(spec, DatasetSpec) else load_spec(spec)
-    check_anatomies(spec)
+    check_sources(spec)
     executor = _executor(workers, ray, retries, timeout, ray_options or {})
     executor.connect()
     try:
@@ -100,11 +100,16 @@ def _executor(workers, ray, retries, timeout, ray_options) -> Executor:
     return LocalExecutor(workers, retries=retries, timeout=timeout)
 
 
-def check_anatomies(spec: DatasetSpec) -> None:
-    """Loads every anatomy file of the spec once, so that a bad one fails before any worker
-    starts (naming the file and the spec's entry)."""
+def check_sources(spec: DatasetSpec) -> None:
+    """Loads every anatomy file of the spec once, or builds its scene once (``scene``), so that
+    a bad one fails before any worker starts (naming the file and the spec's entry)."""
     from ..volumes import load_volume
 
+    if "scene" in spec.data:
+        from .sources import check_scene
+
+        check_scene(spec)
+        return
     for i, entry in enumerate(spec.data["anatomies"]):
         if "file" not in entry:
             continue

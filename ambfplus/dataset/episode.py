@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import NullDevice, ScriptedDevice, __version__, gl_info
+from ..labels import legend as object_legend
 from ..recording.schema import find_parts
 from ..scenes import DrillScript, anatomy_data, drilling_scene, record_session
 from ..stereo import StereoFrame
@@ -104,6 +105,9 @@ def record_episode(spec_data: dict, index: int, path, plan: EpisodePlan | None =
     """Builds episode `index` of a normalised spec and records it to `path` (a reproducible
     recording). Returns its summary: frames, label pixel counts, what was drawn."""
     plan = plan or sample_episode(spec_data, index)
+    if "scene" in spec_data:
+        return _record_scene_episode(spec_data, index, path, plan)
+    assert plan.camera_path is not None, "the built-in scene's episodes have a camera path"
     source = plan.scene["anatomy"]
     table = anatomy_data(source).label_table
     label_colors = jitter_label_colors(table, plan.label_color_jitter, plan.rngs["colors"])
@@ -129,11 +133,32 @@ def record_episode(spec_data: dict, index: int, path, plan: EpisodePlan | None =
         scripted = ScriptedDevice()
         scripted.set_callback(script, every=10)
         device = scripted
-    counter = _LabelCounter(table)
-    noise = _RgbNoise(plan.rgb_noise)
+    counter = _LabelCounter({label.id: label.name for label in table}, "label")
     sampled = plan.describe()
     sampled["camera_path"] = dataclasses.asdict(path_plan)
     sampled["label_colors"] = label_colors
+    return _record(spec_data, index, path, plan, scene, device, seconds, counter, sampled,
+                   camera_motion=motion)  # fmt: skip
+
+
+def _record_scene_episode(spec_data: dict, index: int, path, plan: EpisodePlan) -> dict:
+    """An episode of a spec with a scene: the scene built, the dataset's rig placed, driven by
+    the episode's script or waypoints. Its pixel counts are by object key (the instance pass:
+    namespaced objects under their ``ns/name`` keys)."""
+    from .sources import build_episode_scene
+
+    scene, controller = build_episode_scene(spec_data, plan)
+    seconds = plan.frames * plan.capture_every * scene.world.time_step
+    names = {int(i): e.get("key", e["name"]) for i, e in object_legend(scene.world).items()}
+    counter = _LabelCounter(names, "instance")
+    return _record(spec_data, index, path, plan, scene, None, seconds, counter, plan.describe(),
+                   controller=controller)  # fmt: skip
+
+
+def _record(spec_data, index, path, plan, scene, device, seconds, counter, sampled, **options):
+    """Records an episode's scene into a reproducible shard with its dataset metadata; returns
+    its summary for the manifest."""
+    noise = _RgbNoise(plan.rgb_noise)
     metadata = {
         "dataset": {
             "episode": index,
@@ -153,7 +178,6 @@ def record_episode(spec_data: dict, index: int, path, plan: EpisodePlan | None =
         seconds,
         capture_every=plan.capture_every,
         passes=plan.passes,
-        camera_motion=motion,
         metadata=metadata,
         transform=lambda pair: noise(counter(pair)),
         recorder_options={
@@ -161,6 +185,7 @@ def record_episode(spec_data: dict, index: int, path, plan: EpisodePlan | None =
             "created": REPRODUCIBLE_CREATED,
             "flush_interval_s": SHARD_FLUSH_INTERVAL_S,
         },
+        **options,
     )
     return {
         "frames": summary["frames"],
@@ -172,15 +197,17 @@ def record_episode(spec_data: dict, index: int, path, plan: EpisodePlan | None =
 
 
 class _LabelCounter:
-    """Pixels per anatomy label over every recorded label image (both views)."""
+    """Pixels per id of one pass over every recorded image of it (both views): anatomy labels
+    (the label pass) or objects (the instance pass), named by `names` ({id: name})."""
 
-    def __init__(self, table) -> None:
-        self.names = {label.id: label.name for label in table}
+    def __init__(self, names: dict[int, str], pass_name: str) -> None:
+        self.names = names
+        self.pass_name = pass_name
         self.counts: np.ndarray = np.zeros(1, dtype=np.int64)
 
     def __call__(self, pair: StereoFrame) -> StereoFrame:
         for frame in (pair.left, pair.right):
-            label = getattr(frame, "label", None)
+            label = getattr(frame, self.pass_name, None)
             if label is not None:
                 counts = np.bincount(np.asarray(label).ravel())
                 if len(counts) > len(self.counts):

@@ -27,6 +27,9 @@ STREAMS = (
     "background",
     "intrinsics",
     "noise",
+    # Streams added later come last, so that earlier streams keep their draws.
+    "scene",
+    "script",
 )
 # The drill's default look (ambfplus.scenes.METAL and HANDLE), jittered by appearance.drill.
 METAL_COLOR = (0.72, 0.74, 0.8)
@@ -91,21 +94,26 @@ class EpisodePlan:
     capture_every: int
     passes: list
     scene: dict
-    camera_path: CameraPath
+    camera_path: CameraPath | None
     label_color_jitter: float
     rgb_noise: dict
     rngs: dict = field(repr=False, default_factory=dict)
+    #: a spec with a scene: its episode (script, or waypoints with their values drawn)
+    episode: dict | None = None
 
     def describe(self) -> dict:
         """The drawn values (JSON) for the shard's metadata."""
-        return {
+        out = {
             "anatomy": self.anatomy,
             "scenario": {**self.scenario, "frames": self.frames},
-            "camera_path": asdict(self.camera_path),
+            "camera_path": None if self.camera_path is None else asdict(self.camera_path),
             "label_color_jitter": self.label_color_jitter,
             "rgb_noise": self.rgb_noise,
             "scene": self.scene,
         }
+        if self.episode is not None:
+            out["episode"] = self.episode
+        return out
 
 
 def sample_episode(spec: DatasetSpec | dict, index: int) -> EpisodePlan:
@@ -115,6 +123,8 @@ def sample_episode(spec: DatasetSpec | dict, index: int) -> EpisodePlan:
         raise IndexError(f"episode {index} is outside the spec's 0..{data['episodes'] - 1}")
     seed = episode_seed(data["seed"], index)
     rng = streams(seed)
+    if "scene" in data:
+        return _sample_scene_episode(data, index, seed, rng)
     anatomy_index = _pick(data["anatomies"], rng["anatomy"])
     anatomy_entry = data["anatomies"][anatomy_index]
     source = _anatomy_source(anatomy_entry, rng["anatomy"])
@@ -127,11 +137,7 @@ def sample_episode(spec: DatasetSpec | dict, index: int) -> EpisodePlan:
     width, height = draw(rig["resolution"], rng["rig"])
     fov_y = draw(rig["fov_y"], rng["rig"])
     appearance = data["appearance"]
-    intrinsics = appearance.get("intrinsics", {})
-    fov_scale = 1.0 + _symmetric(
-        draw(intrinsics.get("fov_y_jitter", 0.0), rng["intrinsics"]), rng["intrinsics"]
-    )
-    pp_jitter = draw(intrinsics.get("principal_point_jitter", 0.0), rng["intrinsics"])
+    fov_scale, principal_point_offset = _intrinsics(appearance, rng["intrinsics"])
     moving = scenario["kind"] in ("camera", "mixed")
     scene = {
         "anatomy": source,
@@ -142,18 +148,10 @@ def sample_episode(spec: DatasetSpec | dict, index: int) -> EpisodePlan:
         if rig["working_distance"] is None
         else draw(rig["working_distance"], rng["rig"]),
         "fov_y": fov_y * fov_scale,
-        "principal_point_offset": [_symmetric(pp_jitter, rng["intrinsics"]) for _ in range(2)],
+        "principal_point_offset": principal_point_offset,
         "background": draw(appearance.get("background", [0.0, 0.0, 0.0]), rng["background"]),
         "lights": _lights(appearance.get("lights"), rng["lights"]),
         **_materials(appearance, rng["materials"]),
-    }
-    sigma = draw(appearance.get("noise", {}).get("rgb_sigma", 0.0), rng["noise"])
-    noise = {
-        "model": "gaussian",
-        "sigma": float(sigma),
-        "unit": "8-bit levels",
-        "applies_to": "rgb only",
-        "seed": int(rng["noise"].integers(1 << 53)),
     }
     return EpisodePlan(
         index=index,
@@ -175,9 +173,93 @@ def sample_episode(spec: DatasetSpec | dict, index: int) -> EpisodePlan:
         label_color_jitter=float(
             draw(appearance.get("labels", {}).get("color_jitter", 0.0), rng["colors"])
         ),
-        rgb_noise=noise,
+        rgb_noise=_noise(appearance, rng["noise"]),
         rngs=rng,
     )
+
+
+def _noise(appearance: dict, rng: np.random.Generator) -> dict:
+    sigma = draw(appearance.get("noise", {}).get("rgb_sigma", 0.0), rng)
+    return {
+        "model": "gaussian",
+        "sigma": float(sigma),
+        "unit": "8-bit levels",
+        "applies_to": "rgb only",
+        "seed": int(rng.integers(1 << 53)),
+    }
+
+
+def _intrinsics(appearance: dict, rng: np.random.Generator) -> tuple[float, list[float]]:
+    """(field of view scale, principal point offset in pixels) of the intrinsics jitter."""
+    intrinsics = appearance.get("intrinsics", {})
+    fov_scale = 1.0 + _symmetric(draw(intrinsics.get("fov_y_jitter", 0.0), rng), rng)
+    pp_jitter = draw(intrinsics.get("principal_point_jitter", 0.0), rng)
+    return fov_scale, [_symmetric(pp_jitter, rng) for _ in range(2)]
+
+
+def _sample_scene_episode(data: dict, index: int, seed: int, rng: dict) -> EpisodePlan:
+    """An episode of a spec with a scene: the rig (None where the scene's stereo pair says),
+    the lights around the scene's ``lights_at``, and the episode's waypoint values drawn."""
+    scene = data["scene"]
+    rig_index = _pick(data["rigs"], rng["rig"])
+    rig = data["rigs"][rig_index]
+    frames = draw(data["capture"]["frames"], rng["scenario"])
+
+    def maybe(value):
+        return None if value is None else draw(value, rng["rig"])
+
+    resolution = maybe(rig["resolution"])
+    appearance = data["appearance"]
+    fov_scale, principal_point_offset = _intrinsics(appearance, rng["intrinsics"])
+    lights = _lights(appearance.get("lights"), rng["lights"])
+    for light in lights or []:
+        if "position" in light:
+            light["position"] = [p + c for p, c in zip(light["position"], scene["lights_at"])]
+    plan_scene = {
+        "width": None if resolution is None else int(resolution[0]),
+        "height": None if resolution is None else int(resolution[1]),
+        "baseline": maybe(rig["baseline"]),
+        "working_distance": maybe(rig["working_distance"]),
+        "fov_y": maybe(rig["fov_y"]),
+        "fov_y_scale": fov_scale,
+        "principal_point_offset": principal_point_offset,
+        "background": draw(appearance.get("background", [0.0, 0.0, 0.0]), rng["background"]),
+        "lights": lights,
+    }
+    episode = data["episode"]
+    kind = "script" if "script" in episode else "waypoints" if "waypoints" in episode else "still"
+    if kind == "waypoints":
+        episode = {"waypoints": [_drawn_waypoint(w, rng["motion"]) for w in episode["waypoints"]]}
+    return EpisodePlan(
+        index=index,
+        seed=seed,
+        anatomy={"index": 0, "name": scene["name"], "source": {"scene": scene}},
+        scenario={"index": 0, "kind": kind, "rig": rig_index},
+        frames=int(frames),
+        capture_every=int(data["capture"]["every"]),
+        passes=list(data["capture"]["passes"]),
+        scene=plan_scene,
+        camera_path=None,
+        label_color_jitter=0.0,
+        rgb_noise=_noise(appearance, rng["noise"]),
+        rngs=rng,
+        episode=dict(episode),
+    )
+
+
+def _drawn_waypoint(point: dict, rng: np.random.Generator) -> dict:
+    """A waypoint with every varying value drawn (in the spec's order)."""
+    out: dict = {"time": point["time"]}
+    for group in ("joints", "bodies", "cameras"):
+        if group not in point:
+            continue
+        out[group] = {}
+        for name, target in point[group].items():
+            if group == "joints":
+                out[group][name] = float(draw(target, rng))
+            else:
+                out[group][name] = {k: [float(c) for c in draw(v, rng)] for k, v in target.items()}
+    return out
 
 
 def _anatomy_source(entry: dict, rng: np.random.Generator) -> dict:

@@ -3,6 +3,10 @@ completely before anything runs. ``load_spec(path)`` returns a ``DatasetSpec``; 
 ``SpecError`` (a ``ConfigError``, so a ``ValueError``) naming the file, the key and what was
 expected.
 
+A spec films either the built-in drilling scene (``anatomies``, ``scenarios``) or any scene
+(``scene``: an AMBF launch file or a Python factory) driven by an ``episode`` script (a Python
+function or declarative waypoints); see ``ambfplus.dataset.sources``.
+
 A value that may vary is a fixed value, ``{uniform: [low, high]}`` (integers for integer keys,
 both ends included; ``low`` and ``high`` may be lists for vectors, one range per component) or
 ``{choice: [a, b, ...], weights: [...]}``. See ``SCHEMA_TEXT`` (and the README) for every key.
@@ -23,6 +27,7 @@ from ..config import (
     Where,
     anatomy,
     describe,
+    existing,
     fixed,
     integer,
     keys,
@@ -89,6 +94,50 @@ appearance:                     # optional; every entry may vary
   noise: {rgb_sigma: 0}         # Gaussian sensor noise on RGB, 8-bit levels (ground truth exact)
 """
 
+SCENE_SCHEMA_TEXT = """\
+# Any scene instead of the built-in one (no anatomies or scenarios then):
+scene:
+  launch: arms/launch.yaml      # an AMBF launch file, relative to the spec, or
+  factory: my_scenes:two_arms   # module:function returning a Simulator or World (given
+                                # params as keywords, and rng if it takes one)
+  models: [0, 1, 2]             # launch only: the model files' indices (AMBF's -l)
+  namespace_prefix: ""          # launch only
+  params: {}                    # factory only: keyword arguments
+  python_path: [.]              # folders (relative to the spec) factory and script import from
+  name: two_arms                # what the manifest calls the scene (default: file or function)
+  cameras: [stereoL, stereoR]   # the stereo pair the dataset's rig replaces and rides with
+                                # (default: stereoL and stereoR, or a stereo camera's two eyes)
+  view: {eye: [x, y, z], target: [x, y, z]}  # or: where a free rig stands (world frame)
+  lights_at: [0, 0, 0]          # the point appearance.lights shine at (world frame, metres)
+  logged: [psm1/tool, ...]      # objects the step log records (default: every body and joint)
+episode:                        # what moves (default: nothing but the scene's own physics)
+  script: my_scenes:drive       # module:function(sim, rng, appearance), called once before
+                                # the first step; it may return control(t), called every step
+  waypoints:                    # or: joint, body and camera waypoints over time
+    - time: 0.0                 # seconds, increasing; values may vary
+      joints: {psm1/baselink-yawlink: 0.2}              # joint controller targets
+      bodies: {needle: {position: [0, 0, 0.1], rpy: [0, 0, 0]}}
+      cameras: {rig: {eye: [0.3, 0, 0.2], target: [0, 0, 0]}}   # rig: the dataset's rig
+rigs:                           # with a scene, what a rig leaves out is the scene pair's
+  - resolution: [320, 240]
+"""
+SOURCE_KEYS = ("launch", "factory")
+SCENE_KEYS = SOURCE_KEYS + ("models", "namespace_prefix", "params", "python_path", "name",
+                            "cameras", "view", "lights_at", "logged")  # fmt: skip
+WAYPOINT_KEYS = ("joints", "bodies", "cameras")
+MAX_WAYPOINTS = 10_000
+WAYPOINTS_LIMIT = "an episode's waypoints are drawn and stored with its plan"
+# What a spec with a scene cannot use: the built-in scene's anatomy and drill.
+BUILT_IN_ONLY = {
+    "anatomies": "a scene brings its own objects",
+    "scenarios": "its episode script says what moves",
+}
+BUILT_IN_LOOKS = {
+    "labels": "label colours",
+    "material": "the anatomy's material",
+    "drill": "the drill's look",
+}
+
 
 class SpecError(ConfigError):
     """A dataset spec that cannot be used: names the file, the key and what was expected."""
@@ -137,12 +186,14 @@ def parse_spec(data, base: Path, source: str, text: str) -> DatasetSpec:
     """Checks a spec's parsed YAML and normalises it (see the module)."""
     where = Where(source, error=SpecError)
     mapping(data, where, "the spec")
+    with_scene = isinstance(data, dict) and "scene" in data
     keys(
         data,
         where,
-        required=("version", "episodes", "anatomies"),
-        optional=("name", "seed", "capture", "anatomies", "scenarios", "rigs", "appearance"),
-    )
+        required=("version", "episodes") if with_scene else ("version", "episodes", "anatomies"),
+        optional=("name", "seed", "capture", "anatomies", "scenarios", "rigs", "appearance",
+                  "scene", "episode"),
+    )  # fmt: skip
     version = data["version"]
     if version != SCHEMA_VERSION:
         raise where.error(
@@ -155,14 +206,29 @@ def parse_spec(data, base: Path, source: str, text: str) -> DatasetSpec:
                               maximum=MAX_EPISODES, limit=EPISODES_LIMIT)  # fmt: skip
     out["seed"] = integer(data.get("seed", 0), where.at("seed"), minimum=0, maximum=MAX_SEED)
     out["capture"] = _capture(data.get("capture", {}), where.at("capture"))
-    out["anatomies"] = _weighted_list(
-        data["anatomies"], where.at("anatomies"), lambda e, w: anatomy(e, w, base, _varying)
+    if with_scene:
+        for key, why in BUILT_IN_ONLY.items():
+            if key in data:
+                raise where.error(
+                    key, f"applies to the built-in drilling scene only, not to a scene ({why})"
+                )
+        out["scene"] = _scene(data["scene"], where.at("scene"), base)
+        out["episode"] = _episode(data.get("episode", {}), where.at("episode"))
+    else:
+        if "episode" in data:
+            raise where.error(
+                "episode", "an episode script drives a scene: give the spec a scene too"
+            )
+        out["anatomies"] = _weighted_list(
+            data["anatomies"], where.at("anatomies"), lambda e, w: anatomy(e, w, base, _varying)
+        )
+        out["scenarios"] = _weighted_list(
+            data.get("scenarios", [{"kind": "camera"}]), where.at("scenarios"), _scenario
+        )
+    out["rigs"] = _weighted_list(
+        data.get("rigs", [{}]), where.at("rigs"), lambda e, w: _rig(e, w, with_scene)
     )
-    out["scenarios"] = _weighted_list(
-        data.get("scenarios", [{"kind": "camera"}]), where.at("scenarios"), _scenario
-    )
-    out["rigs"] = _weighted_list(data.get("rigs", [{}]), where.at("rigs"), _rig)
-    out["appearance"] = _appearance(data.get("appearance", {}), where.at("appearance"))
+    out["appearance"] = _appearance(data.get("appearance", {}), where.at("appearance"), with_scene)
     return DatasetSpec(out, text, source)
 
 
@@ -283,36 +349,49 @@ def _scenario(entry: dict, where: Where) -> dict:
     return out
 
 
-def _rig(entry: dict, where: Where) -> dict:
-    keys(entry, where, optional=("baseline", "working_distance", "resolution", "fov_y"))
-    working = entry.get("working_distance", 0.25)
-    return {
-        "baseline": _varying(entry.get("baseline", 0.065), where.at("baseline"), positive),
-        "working_distance": None
-        if working is None
-        else _varying(working, where.at("working_distance"), positive),
-        "resolution": _varying(
-            entry.get("resolution", [640, 480]),
-            where.at("resolution"),
+RIG_DEFAULTS = {
+    "baseline": 0.065,
+    "working_distance": 0.25,
+    "resolution": [640, 480],
+    "fov_y": PAPER_FOV_Y,
+}
+
+
+def _rig(entry: dict, where: Where, with_scene: bool = False) -> dict:
+    """A rig entry. With a scene, what the entry leaves out is None (the scene's stereo pair's
+    value; a parallel rig for the working distance)."""
+    keys(entry, where, optional=tuple(RIG_DEFAULTS))
+    checks: dict[str, tuple[Callable, dict]] = {
+        "baseline": (positive, {}),
+        "working_distance": (positive, {}),
+        "resolution": (
             lambda v, w: integer(v, w, minimum=8, maximum=MAX_SIDE, limit=SIDE_LIMIT),
-            size=2,
-            integer=True,
+            {"size": 2, "integer": True},
         ),
-        "fov_y": _varying(
-            entry.get("fov_y", PAPER_FOV_Y),
-            where.at("fov_y"),
-            lambda v, w: number(v, w, minimum=0.01, maximum=3.0),
-        ),
+        "fov_y": (lambda v, w: number(v, w, minimum=0.01, maximum=3.0), {}),
     }
+    out = {}
+    for key, (check, options) in checks.items():
+        value = entry.get(key, None if with_scene else RIG_DEFAULTS[key])
+        out[key] = None if value is None else _varying(value, where.at(key), check, **options)
+    return out
 
 
-def _appearance(value, where: Where) -> dict:
+def _appearance(value, where: Where, with_scene: bool = False) -> dict:
     mapping(value, where, "appearance")
     keys(
         value,
         where,
         optional=("lights", "labels", "material", "drill", "background", "intrinsics", "noise"),
     )
+    if with_scene:
+        for key, what in BUILT_IN_LOOKS.items():
+            if key in value:
+                raise where.error(
+                    key,
+                    f"{what} apply to the built-in drilling scene only; a scene's looks come "
+                    "from its files, or its factory and episode script draw them from their rng",
+                )
     out = {}
     if "lights" in value:
         out["lights"] = _lights(value["lights"], where.at("lights"))
@@ -392,3 +471,140 @@ def _lights(value, where: Where) -> dict:
             value.get("distance", {"uniform": [0.15, 0.4]}), where.at("distance"), positive
         ),
     }
+
+
+def _function_reference(value, where: Where) -> str:
+    """``module:function`` (a dotted module path and a dotted attribute path)."""
+    if not isinstance(value, str):
+        raise where.error(None, f"expected module:function, got {describe(value)}")
+    module, colon, function = value.partition(":")
+    dotted = (module, function)
+    if not colon or not all(all(p.isidentifier() for p in part.split(".")) for part in dotted):
+        raise where.error(None, f"expected module:function (e.g. my_scenes:build), got {value!r}")
+    return value
+
+
+def _point(value, where: Where) -> list[float]:
+    return fixed(value, where, number, 3)
+
+
+def _scene(value, where: Where, base: Path) -> dict:
+    mapping(value, where, "scene")
+    keys(value, where, optional=SCENE_KEYS)
+    sources = [k for k in SOURCE_KEYS if k in value]
+    if len(sources) != 1:
+        raise where.error(
+            None, f"expected exactly one of {', '.join(SOURCE_KEYS)}, got {sorted(value) or 'none'}"
+        )
+    source = sources[0]
+    wrong = [k for k in (("params",) if source == "launch" else ("models", "namespace_prefix"))
+             if k in value]  # fmt: skip
+    if wrong:
+        raise where.error(wrong[0], f"does not apply to a scene made by {source}")
+    out: dict = {}
+    python_path = value.get("python_path", [])
+    if not isinstance(python_path, list):
+        raise where.error("python_path", f"expected a list of folders, got {describe(python_path)}")
+    out["python_path"] = [
+        str(existing(p, base, where.at("python_path").at(i))) for i, p in enumerate(python_path)
+    ]
+    if source == "launch":
+        path = existing(value["launch"], base, where.at("launch"))
+        out["launch"] = str(path)
+        models = value.get("models")
+        if models is not None:
+            if not isinstance(models, list):
+                raise where.error("models", f"expected a list of indices, got {describe(models)}")
+            models = [integer(m, where.at("models").at(i), minimum=0)
+                      for i, m in enumerate(models)]  # fmt: skip
+        out["models"] = models
+        prefix = value.get("namespace_prefix", "")
+        if not isinstance(prefix, str):
+            raise where.error("namespace_prefix", f"expected text, got {describe(prefix)}")
+        out["namespace_prefix"] = prefix
+        name = path.name.split(".")[0]
+        if name == "launch":  # AMBF projects name every launch file so: name their folder
+            name = path.parent.name or name
+    else:
+        out["factory"] = _function_reference(value["factory"], where.at("factory"))
+        params = value.get("params", {})
+        mapping(params, where.at("params"), "the factory's keyword arguments")
+        out["params"] = params
+        name = out["factory"]
+    out["name"] = str(value.get("name", name))
+    cameras = value.get("cameras")
+    if cameras is not None:
+        if (
+            not isinstance(cameras, list)
+            or len(cameras) != 2
+            or not all(isinstance(c, str) and c for c in cameras)
+        ):
+            raise where.error(
+                "cameras", f"expected two camera names [left, right], got {describe(cameras)}"
+            )
+        if "view" in value:
+            raise where.error("view", "give cameras or view, not both")
+    out["cameras"] = cameras
+    view = value.get("view")
+    if view is not None:
+        mapping(view, where.at("view"), "a view")
+        keys(view, where.at("view"), required=("eye", "target"))
+        view = {k: _point(view[k], where.at("view").at(k)) for k in ("eye", "target")}
+    out["view"] = view
+    out["lights_at"] = _point(value.get("lights_at", [0.0, 0.0, 0.0]), where.at("lights_at"))
+    logged = value.get("logged")
+    if logged is not None and (
+        not isinstance(logged, list) or not all(isinstance(n, str) and n for n in logged)
+    ):
+        raise where.error("logged", f"expected a list of object names, got {describe(logged)}")
+    out["logged"] = logged
+    return out
+
+
+def _episode(value, where: Where) -> dict:
+    mapping(value, where, "episode")
+    keys(value, where, optional=("script", "waypoints"))
+    if "script" in value and "waypoints" in value:
+        raise where.error(None, "expected one of script, waypoints, not both")
+    if "script" in value:
+        return {"script": _function_reference(value["script"], where.at("script"))}
+    if "waypoints" not in value:
+        return {}
+    waypoints = value["waypoints"]
+    if not isinstance(waypoints, list) or not waypoints:
+        raise where.error("waypoints", f"expected a non-empty list, got {describe(waypoints)}")
+    if len(waypoints) > MAX_WAYPOINTS:
+        raise where.error(
+            "waypoints",
+            f"expected at most {MAX_WAYPOINTS} waypoints, got {len(waypoints)} ({WAYPOINTS_LIMIT})",
+        )
+    out, last = [], -1.0
+    for i, point in enumerate(waypoints):
+        at = where.at("waypoints").at(i)
+        mapping(point, at, "a waypoint")
+        keys(point, at, required=("time",), optional=WAYPOINT_KEYS)
+        time = number(point["time"], at.at("time"), minimum=0)
+        if time <= last:
+            raise at.error("time", f"waypoint times must increase: {time} follows {last}")
+        last = time
+        entry: dict = {"time": time}
+        for group in WAYPOINT_KEYS:
+            if group not in point:
+                continue
+            targets = point[group]
+            mapping(targets, at.at(group), f"{group} by name")
+            entry[group] = {
+                str(name): _waypoint_target(group, target, at.at(group).at(name))
+                for name, target in targets.items()
+            }
+        out.append(entry)
+    return {"waypoints": out}
+
+
+def _waypoint_target(group: str, value, where: Where):
+    if group == "joints":
+        return _varying(value, where, number)
+    fields = ("position", "rpy") if group == "bodies" else ("eye", "target")
+    mapping(value, where, "a body's pose" if group == "bodies" else "a camera's view")
+    keys(value, where, required=fields[:1] if group == "bodies" else fields, optional=fields[1:])
+    return {k: _varying(value[k], where.at(k), number, size=3) for k in fields if k in value}

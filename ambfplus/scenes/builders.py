@@ -105,12 +105,13 @@ def _drill_over(world: World, volume, tip, metal: dict | None = None, handle: di
 
 
 @dataclass
-class Scene:
-    """A built scene: its world, the drill a device drives and how to bind one, the stereo rig
-    that films it, and the objects whose state a recording logs every step."""
+class FilmedScene:
+    """A built scene a recording films (``record_session``): its world, the stereo rig that
+    films it, the objects whose state the recording logs every step, and the drill a device
+    drives, if any (None: a dataset's scene of any kind, driven by its own script)."""
 
     world: World
-    drill: Drill
+    drill: Drill | None
     rig: StereoRig | None
     device_name: str
     device_options: dict
@@ -118,6 +119,16 @@ class Scene:
     spec: dict = field(default_factory=dict)  #: what build_scene rebuilds it from
     #: the point of the anatomy cameras look at (world frame, metres)
     target: tuple[float, float, float] = (0.0, 0.0, 0.006)
+    #: the simulator that owns the world, where the scene was loaded as one (kept alive here)
+    simulator: object = None
+
+
+@dataclass
+class Scene(FilmedScene):
+    """A built scene with the drill a device drives and how to bind one (device_name,
+    device_options)."""
+
+    drill: Drill
 
 
 def drilling_phantom(

@@ -34,7 +34,7 @@ from ..recording import Recorder, open_recording
 from ..recording.schema import RecordingError, recording_files
 from ..recording.values import step_problems
 from ..transforms import make_pose
-from .builders import Scene, build_scene
+from .builders import FilmedScene, build_scene
 
 PASSES = ("rgb", "depth", "label", "instance", "voxel", "segmentation")
 RIG = "rig"
@@ -46,7 +46,9 @@ def _serialisable_options(options: dict) -> dict:
     return {k: (v.key if hasattr(v, "key") else v) for k, v in options.items()}
 
 
-def _bind(scene: Scene, device: Device, options: dict | None = None):
+def _bind(scene: FilmedScene, device: Device, options: dict | None = None):
+    if scene.drill is None:
+        raise ValueError("the scene has no drill for a device to drive")
     options = dict(scene.device_options if options is None else options)
     if isinstance(options.get("reference"), str):
         options["reference"] = scene.world.get(options["reference"])
@@ -55,10 +57,12 @@ def _bind(scene: Scene, device: Device, options: dict | None = None):
 
 def drain(world, drill, recorder: Recorder | None) -> tuple[dict, dict, list]:
     """Hands the step log, removed voxels and events gathered so far to the recorder (if any)
-    and returns them; the launcher drains its live recording through this too."""
+    and returns them; the launcher drains its live recording through this too. Without a
+    drill (None), only the step log."""
     steps = world.take_step_log()
-    removed = drill.take_removed()
-    events = drill.take_events()
+    removed, events = (
+        ({"step": ()}, []) if drill is None else (drill.take_removed(), drill.take_events())
+    )
     if recorder is not None:
         if len(steps["step"]):
             recorder.add_steps(steps)
@@ -77,9 +81,9 @@ def _progress(report: Callable[[str], None] | None, done: int, total: int, start
 
 
 def record_session(
-    scene: Scene,
+    scene: FilmedScene,
     path,
-    device: Device,
+    device: Device | None,
     seconds: float,
     capture_every: int = 40,
     passes=PASSES,
@@ -89,18 +93,22 @@ def record_session(
     progress_every: float = 0.1,
     transform: Callable | None = None,
     recorder_options: dict | None = None,
+    controller: Callable[[float], None] | None = None,
 ) -> dict:
     """Runs the scene for `seconds` with `device` driving its drill and records it to `path`.
     camera_motion(time) -> (eye, target) aims the rig (its midpoint at eye) before each
     capture; transform(stereo_frame) -> stereo_frame changes each pair before it is recorded
-    (sensor noise, say); `recorder_options` go to ``Recorder``. Returns a summary
-    (steps, frames, voxels removed, events)."""
+    (sensor noise, say); `recorder_options` go to ``Recorder``. A scene no device drives
+    (`device` None; a dataset's scene) may have a `controller`, called with the time before
+    every step. Returns a summary (steps, frames, voxels removed, events)."""
     world, drill, rig = scene.world, scene.drill, scene.rig
-    binding = _bind(scene, device)
+    binding = None if device is None else _bind(scene, device)
     total = int(round(seconds / world.time_step))
     meta = {
         "scene": scene.spec,
-        "device": {
+        "device": None
+        if device is None
+        else {
             "name": scene.device_name,
             "kind": type(device).__name__,
             "options": _serialisable_options(scene.device_options),
@@ -112,13 +120,13 @@ def record_session(
         "seconds": seconds,
         **(metadata or {}),
     }
-    world.start_step_log(list(scene.logged) + [binding])
+    world.start_step_log(list(scene.logged) + ([] if binding is None else [binding]))
     removed = events = frames = 0
     started, next_report = time.perf_counter(), 0.0
     with Recorder(path, metadata=meta, **(recorder_options or {})) as recorder:
         recorder.set_legend(world)
         while world.step_index < total:
-            world.step(min(capture_every, total - world.step_index))
+            _step(world, min(capture_every, total - world.step_index), controller)
             if rig is None:
                 raise ValueError("record_session: the scene has no stereo rig to capture with")
             if camera_motion is not None:
@@ -134,6 +142,16 @@ def record_session(
                 next_report += progress_every
     world.stop_step_log()
     return {"steps": total, "frames": frames, "voxels_removed": removed, "events": events}
+
+
+def _step(world, count: int, controller: Callable[[float], None] | None) -> None:
+    """`count` steps, the controller (if any) called with the time before each."""
+    if controller is None:
+        world.step(count)
+        return
+    for _ in range(count):
+        controller(world.time)
+        world.step(1)
 
 
 def device_log(steps: dict, name: str) -> dict:
@@ -211,6 +229,11 @@ def replay(
             else []
         )
         recorded = rig_frames if compare_images else None
+        if meta.get("device") is None:
+            raise ValueError(
+                f"{path}: no device drove this recording's scene, so there is nothing to replay "
+                "(a dataset episode of a scene is made again by generating it)"
+            )
         spec = {"builder": meta["scene"]["builder"], "params": dict(meta["scene"]["params"])}
         params = spec["params"]
         for key, value in (("baseline", baseline), ("width", width), ("height", height)):

@@ -256,5 +256,30 @@ TEST(Object, CheckedPoseBoundsThePositionAndNamesWhoGaveIt) {
   EXPECT_THROW(checked_pose(m), ArgumentError);
 }
 
+TEST(World, RidersFollowWhenTheirParentIsPutOnABody) {
+  // A stereo camera's eyes ride on the camera; the camera is then put on a body (an AMBF world
+  // file's camera whose parent comes from a later model): the eyes move with it at once, not
+  // at the next step, so a capture before any step sees from the right place.
+  auto sim = engine::create_simulator();
+  World& world = sim->world();
+  RigidBodySpec frame = sphere("frame");
+  frame.pose(0, 3) = 1.0;
+  frame.pose(2, 3) = 0.5;
+  Object& body = world.default_model().add_body(frame);
+  CameraSpec spec;
+  spec.name = "main";
+  Object& camera = world.default_model().add_camera(spec);
+  spec.name = "main_left";
+  Object& eye = world.default_model().add_camera(spec);
+  Eigen::Isometry3d offset = Eigen::Isometry3d::Identity();
+  offset.translation() = Eigen::Vector3d(-0.025, 0.0, 0.0);
+  eye.attach_to(&camera, offset);
+  EXPECT_TRUE(eye.pose().translation().isApprox(Eigen::Vector3d(-0.025, 0.0, 0.0)));
+  camera.attach_to(&body, Eigen::Isometry3d::Identity());
+  EXPECT_TRUE(camera.pose().translation().isApprox(Eigen::Vector3d(1.0, 0.0, 0.5)));
+  EXPECT_TRUE(eye.pose().translation().isApprox(Eigen::Vector3d(0.975, 0.0, 0.5)))
+      << eye.pose().translation().transpose();
+}
+
 }  // namespace
 }  // namespace ambfplus

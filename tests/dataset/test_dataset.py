@@ -519,13 +519,13 @@ def test_an_episode_that_keeps_failing_stops_the_run_with_its_error(tmp_path, mo
         "version: 1\nepisodes: 2\ncapture: {every: 10, frames: 1}\n"
         "rigs: [{resolution: [32, 24]}]\nanatomies: [{file: ear.nrrd}]\n"
     )
-    checked = module.check_anatomies
+    checked = module.check_sources
 
     def check_then_spoil(data):  # the file goes bad after the spec was checked
         checked(data)
         ear.write_text("NRRD0004\ntype: nonsense\n\n")
 
-    monkeypatch.setattr(module, "check_anatomies", check_then_spoil)
+    monkeypatch.setattr(module, "check_sources", check_then_spoil)
     with pytest.raises(
         GenerateError,
         match=r"episode \d failed 2 times; the last time: (.|\n)*"
@@ -552,13 +552,13 @@ def test_the_progress_bar_reports_episodes_and_retries(tmp_path, monkeypatch):
     ear = tmp_path / "ear.nrrd"
     ambfplus.phantom(24).save_nrrd(ear)
     spec = {**BASE_SPEC, "anatomies": [{"file": str(ear)}]}
-    checked = module.check_anatomies
+    checked = module.check_sources
 
     def check_then_spoil(data):
         checked(data)
         ear.write_text("NRRD0004\ntype: nonsense\n\n")
 
-    monkeypatch.setattr(module, "check_anatomies", check_then_spoil)
+    monkeypatch.setattr(module, "check_sources", check_then_spoil)
     stream = io.StringIO()
     with pytest.raises(GenerateError):
         generate(spec, tmp_path / "failing", retries=1, progress=stream)

@@ -80,6 +80,18 @@ def test_ray_makes_the_same_shards_as_local_workers(
     assert environment["runs"][0]["address"] == cluster.address
 
 
+def test_ray_makes_the_same_shards_of_a_multi_arm_scene_as_local_workers(
+    cluster, multi_arm_spec, multi_arm_dataset, tmp_path
+):
+    # A dataset of any scene (an AMBF launch file driven by a Python episode script imported on
+    # each node from the spec's python_path) on the cluster: the same bytes as one local worker.
+    report = generate(multi_arm_spec, tmp_path / "ray", ray=cluster.address, progress=False)
+    assert report.generated == 6
+    assert manifest(tmp_path / "ray") == manifest(multi_arm_dataset)
+    assert shard_bytes(tmp_path / "ray") == shard_bytes(multi_arm_dataset)
+    assert validate_dataset(tmp_path / "ray", match_images=False).ok
+
+
 def test_ray_workers_killed_on_both_nodes_are_retried(
     cluster, dataset_spec, reference_dataset, tmp_path
 ):

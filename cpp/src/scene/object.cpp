@@ -73,6 +73,7 @@ void Object::attach_to(const Object* parent, const Eigen::Isometry3d& local) {
   attached_to_ = parent;
   local_ = local;
   follow_parent();
+  world().attachments().follow(*this);  // its own riders come along now, not at the next step
 }
 
 void Object::follow_parent() {

@@ -19,6 +19,15 @@ void Attachments::track(Object* object, bool attached) {
   }
 }
 
+void Attachments::follow(const Object& moved) {
+  for (Object* o : riders_) {
+    if (o->attached_to() == &moved) {
+      o->follow_parent();
+      follow(*o);  // parent cycles are refused by Object::attach_to
+    }
+  }
+}
+
 void Attachments::run(StepStage, const StepContext&) {
   for (Object* o : riders_) o->follow_parent();
 }

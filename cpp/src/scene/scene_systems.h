@@ -21,6 +21,9 @@ class Attachments : public System {
   void detach_all() override { riders_.clear(); }
   /// Starts or stops moving an object with its parent.
   void track(Object* object, bool attached);
+  /// Moves the objects riding on `moved`, and theirs in turn, to where it now is (an object
+  /// attached after its riders were: a camera's eyes when the camera is put on a body).
+  void follow(const Object& moved);
 
  private:
   std::vector<Object*> riders_;

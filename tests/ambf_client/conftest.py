@@ -9,11 +9,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers.multi_arm import LINK, forward_kinematics, grasp_blocks
 
 import ambfplus
 from ambfplus import ambf_client
 
-LINK = 0.2  # m, each link's length; a link's centre is half a link from its joint
 BASES = {"arm1": (0.0, 0.0, 0.5), "arm2": (1.0, 0.0, 0.5)}
 # The first arm's pose in the script: its jaw (the end of its last link) then lies just short of
 # the needle.
@@ -59,39 +59,9 @@ def arm_adf(prefix: str, extra: str = "") -> str:
     return textwrap.dedent(bodies) + textwrap.dedent(extra)
 
 
-GRASP = f"""
-ghost objects: [GHOST arm1_jaw]
-actuators: [ACTUATOR arm1_grip]
-GHOST arm1_jaw:
-  name: arm1_jaw
-  parent: BODY arm1_link2
-  shape: sphere
-  geometry: {{radius: 0.03}}
-  location: {{position: {{x: {LINK / 2}, y: 0.0, z: 0.0}}, orientation: {{r: 0, p: 0, y: 0}}}}
-ACTUATOR arm1_grip:
-  name: arm1_grip
-  type: Constraint
-  parent: BODY arm1_link2
-  location: {{position: {{x: {LINK / 2}, y: 0.0, z: 0.0}}, orientation: {{r: 0, p: 0, y: 0}}}}
-"""
-
-
-def forward_kinematics(base, q0: float, q1: float) -> dict:
-    """World positions of the links' centres and of the jaw, and the links' yaw, of a planar arm
-    posed at (q0, q1): computed here, independently of the engine."""
-
-    def along(angle: float, length: float) -> np.ndarray:
-        return length * np.array([np.cos(angle), np.sin(angle), 0.0])
-
-    base = np.asarray(base, dtype=float)
-    elbow = base + along(q0, LINK)
-    return {
-        "link1": base + along(q0, LINK / 2),
-        "link2": elbow + along(q0 + q1, LINK / 2),
-        "jaw": elbow + along(q0 + q1, LINK),
-        "yaw1": q0,
-        "yaw2": q0 + q1,
-    }
+GRASP = "ghost objects: [GHOST arm1_jaw]\nactuators: [ACTUATOR arm1_grip]\n" + grasp_blocks(
+    "arm1_jaw", "arm1_grip", "arm1_link2"
+)
 
 
 @pytest.fixture

@@ -82,34 +82,51 @@ def arm_model(ns: str) -> str:
       type: revolute
       controller: {{P: 5, I: 0, D: 0.4}}
     """)
-    blocks.append(f"""\
-    GHOST jaw:
-      name: jaw
-      parent: BODY link2
-      shape: sphere
-      geometry: {{radius: 0.03}}
-      location: {{position: {{x: {LINK / 2}, y: 0.0, z: 0.0}}, orientation: {{r: 0, p: 0, y: 0}}}}
-    ACTUATOR grip:
-      name: grip
-      type: Constraint
-      parent: BODY link2
-      location: {{position: {{x: {LINK / 2}, y: 0.0, z: 0.0}}, orientation: {{r: 0, p: 0, y: 0}}}}
-    """)
+    blocks.append(grasp_blocks("jaw", "grip", "link2"))
     return "".join(textwrap.dedent(block) for block in blocks)
 
 
-def jaw_position(base, q0: float, q1: float) -> np.ndarray:
-    """The end of a planar arm's last link posed at (q0, q1), computed here (not by the
-    engine)."""
+def grasp_blocks(jaw: str, grip: str, link: str) -> str:
+    """ADF blocks of a ghost (`jaw`, a sphere) and a grasping actuator (`grip`) at the far end
+    of body `link` (a link along x)."""
+    at = f"{{position: {{x: {LINK / 2}, y: 0.0, z: 0.0}}, orientation: {{r: 0, p: 0, y: 0}}}}"
+    return textwrap.dedent(
+        f"""\
+        GHOST {jaw}:
+          name: {jaw}
+          parent: BODY {link}
+          shape: sphere
+          geometry: {{radius: 0.03}}
+          location: {at}
+        ACTUATOR {grip}:
+          name: {grip}
+          type: Constraint
+          parent: BODY {link}
+          location: {at}
+        """
+    )
+
+
+def forward_kinematics(base, q0: float, q1: float) -> dict:
+    """World positions of the links' centres and of the jaw, and the links' yaw, of a planar arm
+    posed at (q0, q1): computed here, independently of the engine."""
 
     def along(angle: float, length: float) -> np.ndarray:
         return length * np.array([np.cos(angle), np.sin(angle), 0.0])
 
-    return np.asarray(base, dtype=float) + along(q0, LINK) + along(q0 + q1, LINK)
+    base = np.asarray(base, dtype=float)
+    elbow = base + along(q0, LINK)
+    return {
+        "link1": base + along(q0, LINK / 2),
+        "link2": elbow + along(q0 + q1, LINK / 2),
+        "jaw": elbow + along(q0 + q1, LINK),
+        "yaw1": q0,
+        "yaw2": q0 + q1,
+    }
 
 
 def needle_model() -> str:
-    jaw = jaw_position(BASES["arm1"], *ARM1_POSE)
+    jaw = forward_kinematics(BASES["arm1"], *ARM1_POSE)["jaw"]
     direction = np.array([np.cos(sum(ARM1_POSE)), np.sin(sum(ARM1_POSE)), 0.0])
     nx, ny, nz = jaw + NEEDLE_GAP * direction
     return textwrap.dedent(

@@ -4,6 +4,8 @@ legend beside its frames (``ambfplus.recording.Recorder.set_legend``)."""
 
 from __future__ import annotations
 
+from collections import Counter
+
 import numpy as np
 
 from ._core import Frame, World
@@ -60,3 +62,22 @@ def segmentation(frame: Frame, world: World, background=(0, 0, 0)) -> np.ndarray
                         table[label_id] = label["color"]
             image[on_volume] = table[labels[on_volume]]
     return image
+
+
+def legend_index(legend) -> dict[str, dict]:
+    """A recording legend's entries by the names its step-log columns and streams use: every
+    object's key (the legend's ``key``, under a namespace: ``psm1/link``; else its name), and
+    each declared name that one object alone has (streams name cameras by their names; two
+    namespaces' ``link`` are told apart by their keys only)."""
+    entries = list(legend.values())
+    declared = Counter(entry.get("name") for entry in entries)
+    out = {entry.get("name"): entry for entry in entries if declared[entry.get("name")] == 1}
+    for entry in entries:
+        out[entry.get("key") or entry.get("name")] = entry
+    return out
+
+
+def object_key(index: dict[str, dict], name: str) -> str:
+    """The key of the object a step-log column or stream names (``legend_index``)."""
+    entry = index.get(name) or {}
+    return entry.get("key") or name

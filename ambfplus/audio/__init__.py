@@ -21,6 +21,7 @@ import numpy as np
 
 from .._core import DRILL_SOUND_MAX_WARNINGS, render_drill_sound
 from ..fileio import write_bytes
+from ..labels import legend_index, object_key
 from ..recording.ticks import drill_columns, removed_ticks, tick_seconds
 
 __all__ = ["drill_ticks", "render_session", "render_wav", "write_wav"]
@@ -135,12 +136,16 @@ def render_wav(
     from ..recording import open_recording
 
     rec = recording if hasattr(recording, "steps") else open_recording(recording)
-    legend = {entry.get("name"): entry for entry in rec.legend.values()}
+    # By the names step-log columns use: keys (a drill under a namespace: 'psm1/drill').
+    legend = legend_index(rec.legend)
     if drill is None:
-        drills = [name for name, entry in legend.items() if entry.get("kind") == "drill"]
+        drills = sorted(
+            {object_key(legend, n) for n, e in legend.items() if e.get("kind") == "drill"}
+        )
         if len(drills) != 1:
             raise ValueError(f"{rec.path}: name the drill to render (drills: {drills})")
         drill = drills[0]
+    drill = object_key(legend, drill)
     volume = rec.removed.get("volume") or next(
         (name for name, entry in legend.items() if entry.get("kind") == "volume"), None
     )

@@ -160,25 +160,6 @@ LINK_FROM_OPTICAL = np.array(
 )
 
 
-def legend_index(legend) -> dict[str, dict]:
-    """A recording legend's entries by the names its step-log columns and streams use: every
-    object's key (the legend's ``key``, under a namespace: ``psm1/link``; else its name), and
-    each declared name that one object alone has (streams name cameras by their names; two
-    namespaces' ``link`` are told apart by their keys only)."""
-    entries = list(legend.values())
-    declared = [entry.get("name") for entry in entries]
-    out = {name: entry for name, entry in zip(declared, entries) if declared.count(name) == 1}
-    for entry in entries:
-        out[entry.get("key") or entry.get("name")] = entry
-    return out
-
-
-def object_key(index: dict[str, dict], name: str) -> str:
-    """The key of the object a step-log column or stream names (``legend_index``)."""
-    entry = index.get(name) or {}
-    return entry.get("key") or name
-
-
 def tf_frame(name: str, namespace: str = "") -> str:
     """The TF frame id of an object: its own name, under its namespace where it has one
     (``/ambf/env/`` + ``drill`` -> ``ambf/env/drill``), without a leading slash (tf2 refuses

@@ -57,8 +57,9 @@ from pathlib import Path
 
 import numpy as np
 
+from ..labels import legend_index
 from ..recording.values import FrameGate
-from ._common import ExportError, StepClock, export_conventions, legend_index, pose_vector
+from ._common import ExportError, StepClock, export_conventions, pose_vector
 
 CHUNK_SIZE = 500
 # The original's constant extrinsic: AMBF camera axes (x back, y right, z up; its clouds) to

@@ -75,6 +75,7 @@ from typing import Any
 import numpy as np
 
 from .. import __version__
+from ..labels import legend_index, object_key
 from ..recording.values import FrameGate
 from ._common import (
     LINK_FROM_OPTICAL,
@@ -82,10 +83,8 @@ from ._common import (
     StepClock,
     camera_frames,
     export_conventions,
-    legend_index,
     link_pose,
     nanoseconds,
-    object_key,
     quaternion_xyzw,
     require,
     tf_frame,

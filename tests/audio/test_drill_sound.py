@@ -242,6 +242,21 @@ def test_render_wav_writes_the_recordings_sound(tmp_path):
     assert len(pcm) == len(expected) == 2000 * 48
     assert np.abs(pcm / 32767 - expected).max() < 1 / 32767
     assert render_wav(path, tmp_path / "again.wav").read_bytes() == wav.read_bytes()
+    # A drill under a namespace: its step-log columns carry its key (psm1/drill); the render
+    # finds it by default, by key and by its declared name, and sounds the same.
+    key = f"psm1/{s.drill.name}"
+    steps = {
+        (key + name[len(s.drill.name) :] if name.startswith(s.drill.name + ".") else name): v
+        for name, v in s.steps.items()
+    }
+    spaced = tmp_path / "namespaced.h5"
+    with Recorder(spaced) as recorder:
+        recorder.set_legend({**legend, "1": {**legend["1"], "key": key}})
+        recorder.add_steps(steps)
+        recorder.add_removed(s.removed, volume=s.drill.volume.name)
+    for drill in (None, key, s.drill.name):
+        out = render_wav(spaced, tmp_path / f"ns_{drill is None}_{drill == key}.wav", drill=drill)
+        assert out.read_bytes() == wav.read_bytes(), drill
 
 
 def test_bad_ticks_are_refused():

@@ -159,8 +159,13 @@ Anatomy sample_anatomy(SplitMix& rng) {
 
 class Painter {
  public:
+  // Structures are never thinner than a voxel's half-diagonal (0.87 voxel), so that each holds
+  // a voxel centre, and every structure is present, at any resolution.
   Painter(VolumeData& v, bool mirror)
-      : v_(v), labels_(static_cast<std::uint8_t*>(v.label_data())), mirror_(mirror) {}
+      : v_(v),
+        labels_(static_cast<std::uint8_t*>(v.label_data())),
+        mirror_(mirror),
+        min_radius_(0.87 * kSizeMm / v.shape()[0]) {}
 
   // Sets `label` where inside(p) holds and allowed(old label) holds, over the box [lo, hi] (mm).
   void paint(V3 lo, V3 hi, const std::function<bool(const V3&)>& inside, std::uint8_t label,
@@ -219,6 +224,7 @@ class Painter {
   void tube(const std::vector<V3>& pts, double r, std::uint8_t label,
             const std::function<bool(const V3&)>& within = nullptr,
             const std::function<bool(std::uint8_t)>& allowed = nullptr) {
+    r = std::max(r, min_radius_);
     // The union of one capsule per segment, each over its own box.
     for (std::size_t s = 0; s + 1 < pts.size(); ++s) {
       const V3 &a = pts[s], &b = pts[s + 1];
@@ -230,6 +236,7 @@ class Painter {
   }
 
   void torus(const V3& centre, const V3& axis, double major, double minor, std::uint8_t label) {
+    minor = std::max(minor, min_radius_);
     const double reach = major + minor;
     paint(
         centre.array() - reach, centre.array() + reach,
@@ -237,8 +244,9 @@ class Painter {
   }
 
   // An axis-aligned ellipsoid.
-  void ellipsoid(const V3& c, const V3& radii, std::uint8_t label,
+  void ellipsoid(const V3& c, V3 radii, std::uint8_t label,
                  const std::function<bool(std::uint8_t)>& allowed = nullptr) {
+    radii = radii.cwiseMax(min_radius_);
     paint(
         c - radii, c + radii,
         [&](const V3& p) { return (p - c).cwiseQuotient(radii).squaredNorm() <= 1.0; }, label,
@@ -277,6 +285,7 @@ class Painter {
   VolumeData& v_;
   std::uint8_t* labels_;
   bool mirror_;
+  double min_radius_;
 };
 
 auto only(std::uint8_t label) {
@@ -471,12 +480,12 @@ void paint_cortex(Painter& paint, const Landmarks& m, const Anatomy& a) {
   paint.ellipsoid(V3(-6, -18, 6), V3(8, 8, 7.5), kBone, only(kEmpty));
   paint.tube({m.eac + V3(3, 6, 8), m.eac + V3(10, 6.5, 7.5), V3(24, m.eac.y() + 6, 13)}, 2.6, kBone,
              nullptr, only(kEmpty));
-  const V3 rim = m.eac + V3(-a.eac_radius * 0.8, a.eac_radius * 0.7, 8.2);
+  const V3 rim = m.eac + V3(2.0 - a.eac_radius * 0.75, 1.0 + a.eac_radius * 0.65, 8.2);
   paint.tube({rim, rim + V3(0.4, -0.3, 1.2)}, 0.7, kBone, nullptr, only(kEmpty));
 }
 
 // Pneumatisation: the antrum and a seeded number of air cells in the mastoid, behind the canal
-// and below the tegmen, never through the outer cortex.
+// and below the tegmen, under an outer cortex about 3 mm thick.
 void paint_air_cells(Painter& paint, const Skull& skull, SplitMix& rng, const Landmarks& m,
                      const Anatomy& a) {
   paint.sphere(m.antrum, 2.8, kEmpty, only(kBone));
@@ -489,7 +498,7 @@ void paint_air_cells(Painter& paint, const Skull& skull, SplitMix& rng, const La
     radii.push_back(rng.uniform(0.7, a.air_cell_max_radius));
   }
   paint.spheres(
-      centres, radii, kEmpty, [&](const V3& p) { return skull.within(p, 0.9); }, only(kBone));
+      centres, radii, kEmpty, [&](const V3& p) { return skull.within(p, 0.84); }, only(kBone));
 }
 
 // External auditory canal from the tympanic membrane out to the lateral surface, and the
@@ -498,8 +507,9 @@ void paint_canal_and_joint(Painter& paint, const Skull& skull, const Landmarks& 
                            const Anatomy& a) {
   const double s = a.tmj_scale;
   paint.ellipsoid(m.eac + V3(13.5, 0, 0), V3(4.5, 7, 6.5) * s, kTmj, any_of({kBone, kEmpty}));
+  // The lateral (cartilaginous) part turns forwards to its opening.
   const std::vector<V3> canal = {m.eac + V3(1.5, 0.5, -7), m.eac + V3(0.5, 0, -3),
-                                 m.eac + V3(-0.8, 0.4, 4), m.eac + V3(-0.5, 1.0, 12)};
+                                 m.eac + V3(1.5, 0.4, 4), m.eac + V3(2.0, 1.0, 12)};
   paint.tube(canal, a.eac_radius, kEac, [&](const V3& p) { return skull.within(p, 1.01); });
 }
 
@@ -571,7 +581,8 @@ void paint_inner_ear(Painter& paint, const Landmarks& m, const Anatomy& a) {
 }
 
 // Facial nerve (labyrinthine and tympanic segments, second genu, mastoid segment down to the
-// stylomastoid foramen) and the chorda tympani leaving it across the middle ear.
+// stylomastoid foramen) and the chorda tympani leaving it anterolaterally, which leaves the
+// facial recess between them, and crossing the middle ear.
 void paint_facial_nerve(Painter& paint, const Landmarks& m, const Anatomy& a) {
   const V3 v = m.vestibule;
   const V3 d = a.facial_shift;
@@ -582,7 +593,7 @@ void paint_facial_nerve(Painter& paint, const Landmarks& m, const Anatomy& a) {
       genu + V3(-0.3, -6, 1.5),   genu + V3(-0.5, -14.5, 3.0)};  // mastoid
   paint.tube(facial, a.facial_radius, kFacialNerve);
   const V3 branch = genu + V3(-0.3, -9, 2.2);
-  paint.tube({branch, branch + V3(1.5, 5, 0.2), m.eac + V3(1.5, 3.5, -11.8),
+  paint.tube({branch, branch + V3(2.5, 4.5, 1.5), m.eac + V3(1.5, 3.5, -11.8),
               m.eac + V3(7, 1.5, -14), m.eac + V3(13, -2, -17)},
              0.35, kChordaTympani);
 }

@@ -322,9 +322,10 @@ class ScriptedTrainee:
 
 # The phantom's lateral surface (volume z, metres) and the drill's burrs (scenes.drilling_phantom).
 PHANTOM_SURFACE = 0.0140
-# Where trainees drill the phantom unless told otherwise: the mastoid behind the ear canal (whose
-# skin the drill may not cut), 12 mm square about 4 mm behind and 2 mm above the origin.
-PHANTOM_REGION = TrainingRegion(center=(-0.004, 0.002))
+# Where trainees drill the phantom unless told otherwise: the mastoid behind and below the ear
+# canal (whose skin the drill may not cut), 12 mm square about 4 mm behind and 6 mm below the
+# origin.
+PHANTOM_REGION = TrainingRegion(center=(-0.004, -0.006))
 DRILL_BURRS = (0.001, 0.002, 0.004, 0.006)
 
 

@@ -2687,9 +2687,9 @@ def openxr_built() -> bool:
     """
     True when this build has OpenXR sessions (OpenXR's headers were there at build time).
     """
-def phantom(resolution: typing.SupportsInt | typing.SupportsIndex = 128, seed: typing.SupportsInt | typing.SupportsIndex = 0) -> VolumeData:
+def phantom(resolution: typing.SupportsInt | typing.SupportsIndex = 128, seed: typing.SupportsInt | typing.SupportsIndex = 0, side: str = 'right') -> VolumeData:
     """
-    The built-in procedural temporal bone (48 mm cube, lateral face towards +z).
+    The built-in procedural temporal bone (48 mm cube, lateral face towards +z; side "right" or "left"), labelled like the original system's segmented ear.
     """
 def plugin_search_path() -> list[str]:
     """

@@ -467,12 +467,14 @@ void define_volume(py::module_& m) {
 
   m.def(
       "phantom",
-      [](int resolution, std::uint32_t seed) {
+      [](int resolution, std::uint32_t seed, const std::string& side) {
+        const PhantomSide s = parse_phantom_side(side);
         py::gil_scoped_release release;
-        return make_temporal_bone_phantom(resolution, seed);
+        return make_temporal_bone_phantom(resolution, seed, s);
       },
-      py::arg("resolution") = 128, py::arg("seed") = 0,
-      "The built-in procedural temporal bone (48 mm cube, lateral face towards +z).");
+      py::arg("resolution") = 128, py::arg("seed") = 0, py::arg("side") = "right",
+      "The built-in procedural temporal bone (48 mm cube, lateral face towards +z; side "
+      "\"right\" or \"left\"), labelled like the original system's segmented ear.");
 
   m.def(
       "read_label_table",

@@ -142,7 +142,7 @@ def run_demo(out: Path, width: int, height: int, resolution: int, every: int) ->
     print(f"ambfplus {__version__}: {gl_info()['renderer']}", flush=True)
     scene = drilling_phantom(resolution=resolution, width=width, height=height)
     device = ScriptedDevice()
-    sites = [(0.0, 0.0), (0.006, 0.004), (-0.006, 0.004)]
+    sites = [(0.0, 0.0), (-0.006, 0.004), (-0.003, -0.006)]
     start = scene.drill.goal[:3, 3]
     waypoints, seconds = plunge_script(scene.drill.volume, sites, start, scene.drill.burr_radius)
     device.set_waypoints(waypoints)

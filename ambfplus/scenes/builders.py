@@ -78,9 +78,9 @@ def demo_scene(width: int = 640, height: int = 480, resolution: int = 192):
     world.add_light("key", "directional", direction=(-0.3, 0.4, -1.0), intensity=0.8)
     world.add_light("fill", "point", position=(0.15, -0.2, 0.3), intensity=0.3)
     world.add_volume("anatomy", phantom(resolution), pose=np.eye(4))
-    add_drill(world, tip=(0.004, -0.002, 0.0125), direction=(-0.3, 0.45, 1.0))
+    add_drill(world, tip=(-0.002, 0.001, 0.0145), direction=(-0.3, 0.45, 1.0))
     camera = world.add_camera("camera", width, height, PAPER_FOV_Y, 0.01, 10.0)
-    camera.look_at(eye=(0.035, -0.075, 0.13), target=(0.0, 0.0, 0.004))
+    camera.look_at(eye=(0.035, -0.075, 0.132), target=(0.0, 0.0, 0.006))
     return world, camera
 
 
@@ -118,7 +118,7 @@ class FilmedScene:
     logged: list = field(default_factory=list)
     spec: dict = field(default_factory=dict)  #: what build_scene rebuilds it from
     #: the point of the anatomy cameras look at (world frame, metres)
-    target: tuple[float, float, float] = (0.0, 0.0, 0.006)
+    target: tuple[float, float, float] = (0.0, 0.0, 0.008)
     #: the simulator that owns the world, where the scene was loaded as one (kept alive here)
     simulator: object = None
 
@@ -141,13 +141,13 @@ def drilling_phantom(
 ) -> Scene:
     """The built-in temporal-bone phantom (48 mm across) under the paper's stereo rig (65 mm
     baseline, f = 1135 px at 640x480, off-axis with zero disparity at 250 mm), with the 6 mm burr
-    of a drill 10 mm above its lateral face (z = 12 mm) and drill meshes riding on it. A device
+    of a drill 10 mm above its lateral face (z = 14 mm) and drill meshes riding on it. A device
     named "hand" drives the drill in world axes at scale 1: button 0 spins the burr."""
     world = World()
     for light in DEFAULT_LIGHTS:
         world.add_light(**light)
     volume = world.add_volume("anatomy", phantom(resolution, seed), pose=np.eye(4))
-    drill, bodies = _drill_over(world, volume, tip=(0.0, 0.0, 0.022))
+    drill, bodies = _drill_over(world, volume, tip=(0.0, 0.0, 0.024))
     rig = StereoRig(
         world, "rig", baseline=baseline, width=width, height=height, fov_y=paper_fov(height),
         near=0.01, far=2.0, working_distance=working_distance,
@@ -288,7 +288,7 @@ def _load_anatomy(anatomy: dict) -> VolumeData:
 def orbit_view(t: float, distance: float = 0.25) -> tuple[np.ndarray, np.ndarray]:
     """(eye, target) of a camera circling above the phantom's lateral face: one turn of 40
     degrees amplitude every 8 s, looking at its centre from `distance`."""
-    target = np.array([0.0, 0.0, 0.006])
+    target = np.array([0.0, 0.0, 0.008])
     azimuth = math.radians(-100.0 + 40.0 * math.sin(2 * math.pi * t / 8.0))
     elevation = math.radians(55.0 + 10.0 * math.sin(2 * math.pi * t / 5.0))
     direction = np.array(

@@ -83,8 +83,9 @@ class DrillScript:
     scene binds its device) and buttons (bit 0 spins the burr).
 
     It rests at the start until told to plunge: ``plunge(now, count)`` schedules `count` cycles,
-    each over a random site of the lateral face: move above it, spin up, sink 1.5-3.5 mm into
-    the bone, sweep 2-5 mm sideways, pull out. ``rest(now)`` brings the drill back to its start.
+    each over a random site of the lateral face whose surface the drill may cut (bone, not the
+    ear canal): move above it, spin up, sink 1.5-3.5 mm into the bone, sweep 2-5 mm sideways,
+    pull out. ``rest(now)`` brings the drill back to its start.
     ``busy_until`` is the time the last scheduled motion ends."""
 
     def __init__(self, volume, drill_start, burr_radius: float, rng: np.random.Generator):
@@ -93,6 +94,7 @@ class DrillScript:
         self.burr_radius = float(burr_radius)
         self.rng = rng
         self.waypoints: list[tuple[float, np.ndarray, int]] = [(0.0, np.zeros(3), 0)]
+        self._removable = {label.id for label in volume.data.label_table if label.removable}
 
     @property
     def busy_until(self) -> float:
@@ -136,8 +138,8 @@ class DrillScript:
         for _ in range(count):
             x, y = self.rng.uniform(-DRILL_AREA, DRILL_AREA, size=2)
             hit = self.volume.raycast((x, y, 0.05), (0.0, 0.0, -1.0))
-            if hit is None:
-                continue
+            if hit is None or hit["label"] not in self._removable:
+                continue  # the burr cuts bone only (not the ear canal's skin, say)
             surface = float(hit["position"][2])
             above = np.array([x, y, surface + self.burr_radius + 0.003]) - self.start
             sink = self.rng.uniform(0.0015, 0.0035)

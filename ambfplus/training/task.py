@@ -19,7 +19,7 @@ loaded ``Task`` holds metres.
     protect:                             # structures that must not be touched
       - {structure: Facial_Nerve, margin: 1.0}   # a label name or id, or a list; margin mm
     expose:                              # structures to skeletonise (optional)
-      - {structure: Sinus_Dura, thickness: 1.0, reach: 2.0}  # residual bone mm; the surface
+      - {structure: Sinus_+_Dura, thickness: 1.0, reach: 2.0}  # residual bone mm; the surface
                                          # considered lies within `reach` mm of the target
     burrs: [2, 4, 6]                     # burr diameters allowed, mm (default: any)
     time_limit: 600                      # seconds (default: none)

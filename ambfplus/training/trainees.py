@@ -321,7 +321,11 @@ class ScriptedTrainee:
 
 
 # The phantom's lateral surface (volume z, metres) and the drill's burrs (scenes.drilling_phantom).
-PHANTOM_SURFACE = 0.0126
+PHANTOM_SURFACE = 0.0140
+# Where trainees drill the phantom unless told otherwise: the mastoid behind and below the ear
+# canal (whose skin the drill may not cut), 12 mm square about 4 mm behind and 6 mm below the
+# origin.
+PHANTOM_REGION = TrainingRegion(center=(-0.004, -0.006))
 DRILL_BURRS = (0.001, 0.002, 0.004, 0.006)
 
 
@@ -363,7 +367,7 @@ def _trainee_on_phantom(
         drill.burr_radius,
         np.random.default_rng(seed),
         protect=fields,
-        region=region or TrainingRegion(),
+        region=region or PHANTOM_REGION,
     )
     trainee.plan(seconds)
     device = ScriptedDevice()

@@ -102,7 +102,7 @@ def launcher_image(work: Path) -> None:
         target: {labels: [Bone]}
         protect:
           - {structure: Facial_Nerve, margin: 1.0}
-          - {structure: Sinus_Dura, margin: 1.0}
+          - {structure: Sinus_+_Dura, margin: 1.0}
         """)
     )
     display = ":77"

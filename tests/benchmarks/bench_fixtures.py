@@ -29,7 +29,7 @@ import numpy as np
 import ambfplus
 from ambfplus.scenes import drilling_phantom
 
-STRUCTURES = ["Sinus_Dura", "Facial_Nerve", "Chorda_Tympani", "Bony_Labyrinth", "ICA"]
+STRUCTURES = ["Sinus_+_Dura", "Facial_Nerve", "Chorda_Tympani", "Bony_Labyrinth", "ICA"]
 
 
 def _baselines():
@@ -93,7 +93,7 @@ def drill_distance_fields(args):
     from ambfplus.training import drill_phantom, novice_like  # noqa: PLC0415
 
     seconds = 4.0 if args.quick else 10.0
-    protect = [("facial nerve", "Facial_Nerve", 0.001), ("dura", "Sinus_Dura", 0.001)]
+    protect = [("facial nerve", "Facial_Nerve", 0.001), ("dura", "Sinus_+_Dura", 0.001)]
     session = drill_phantom(novice_like, 11, seconds, protect)
     cpu = 1e6 * np.asarray(session.drill.tick_cpu_seconds)
     for name, value in (
@@ -115,7 +115,7 @@ def drill_distance_fields(args):
 def distance_field_build(args):
     for n in (256,) if args.quick else (256, 512):
         data = ambfplus.phantom(n)
-        for name, labels in (("Sinus_Dura", ["Sinus_Dura"]), ("all critical", STRUCTURES)):
+        for name, labels in (("Sinus_+_Dura", ["Sinus_+_Dura"]), ("all critical", STRUCTURES)):
             rounds = []
             for _ in range(3):
                 started = time.process_time()

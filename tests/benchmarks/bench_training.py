@@ -58,7 +58,7 @@ from ambfplus.training import (
 RESOLUTION = 128
 PROTECT = (
     Protect("facial nerve", ("Facial_Nerve",), 0.001),
-    Protect("sinus and dura", ("Sinus_Dura",), 0.0008),
+    Protect("sinus and dura", ("Sinus_+_Dura",), 0.0008),
     Protect("chorda tympani", ("Chorda_Tympani",), 0.0005),
 )
 PROTECT_LABELS = [(p.name, p.labels[0], p.margin) for p in PROTECT]

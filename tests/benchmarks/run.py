@@ -183,6 +183,18 @@ def volume(args) -> Iterator[dict]:
     t0 = time.perf_counter()
     data = ambfplus.phantom(512)
     yield {"bench": "phantom_512", "value": round(time.perf_counter() - t0, 4), "unit": "s"}
+    builds = []
+    for seed in range(3 if args.quick else 10):
+        t0 = time.perf_counter()
+        ambfplus.phantom(256, seed, side=("right", "left")[seed % 2])
+        builds.append(time.perf_counter() - t0)
+    yield {
+        "bench": "phantom_256",
+        "value": round(float(np.median(builds)), 4),
+        "max": round(max(builds), 4),
+        "unit": "s",
+        "what": f"phantom(256, seed) median over {len(builds)} seeds, both sides",
+    }
 
     world = ambfplus.World()
     vol = world.add_volume("phantom", data)

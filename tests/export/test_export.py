@@ -609,9 +609,10 @@ def test_events_become_diagnostics(tmp_path):
         recorder.set_legend(scene.world)
         scene.world.step(5)
         recorder.add_stereo("rig", scene.rig.capture(("rgb", "depth")))
-        recorder.add_events([{"step": 5, "kind": "critical", "label": 3, "voxel": (4, 5, 6)}])
+        # Label 10 is the facial nerve (the original system's ids).
+        recorder.add_events([{"step": 5, "kind": "critical", "label": 10, "voxel": (4, 5, 6)}])
         recorder.add_removed({"step": np.array([5]), "voxel": np.array([[4, 5, 6]]),
-                              "label": np.array([3])}, volume="anatomy")  # fmt: skip
+                              "label": np.array([10])}, volume="anatomy")  # fmt: skip
     export(path, tmp_path / "e.mcap", "mcap", progress=False)
     events = [m for m in read_with_mcap(tmp_path / "e.mcap") if m[0] == "/drilling/events"]
     assert len(events) == 1

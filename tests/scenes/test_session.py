@@ -17,7 +17,7 @@ def session(tmp_path_factory):
     """1.5 s of the phantom scene at 320x240: a scripted plunge and a sideways cut, the rig
     circling; a stereo frame every 100 steps."""
     path = tmp_path_factory.mktemp("session") / "s.h5"
-    scene = drilling_phantom(resolution=80, width=320, height=240)
+    scene = drilling_phantom(resolution=96, width=320, height=240)
     device = plunge_and_cut(scene)
     summary = record_session(
         scene, path, device, seconds=1.5, capture_every=100, camera_motion=orbit_view

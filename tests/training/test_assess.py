@@ -34,18 +34,19 @@ TASK = {
     "version": 1,
     "name": "Small mastoidectomy",
     "anatomy": {"phantom": {"resolution": RESOLUTION, "seed": 0}},
-    "target": {"labels": ["Bone"], "box": {"min": [-10, -8, 7.5], "max": [1, 8, 13]}},
+    "target": {"labels": ["Bone"], "box": {"min": [-10, -8, 9], "max": [1, 8, 15]}},
     "protect": [
         {"structure": "Facial_Nerve", "margin": 1.0},
-        {"structure": "Sinus_Dura", "margin": 0.5},
+        {"structure": "Sinus_+_Dura", "margin": 0.5},
     ],
-    "expose": [{"structure": "Sinus_Dura", "thickness": 1.0}],
+    "expose": [{"structure": "Sinus_+_Dura", "thickness": 1.0}],
     "burrs": [4, 6],
     "time_limit": 60,
     # A 10 s session removes a few percent of any target: completion is not judged here.
     "thresholds": {"min_target_fraction": 0.0},
 }
 SECONDS = 10.0
+FACIAL_NERVE = 10  # the phantom's label id (the original system's)
 
 
 @pytest.fixture(scope="module")
@@ -62,19 +63,20 @@ def sessions(tmp_path_factory):
 
 
 class Plunge:
-    """A hand that moves 16 mm back from a point along the drill's shaft, then plunges the
-    spinning burr to it along the shaft (so that the shaft follows the hole)."""
+    """A hand that moves 20 mm back from a point along the drill's shaft (above the lateral
+    surface), then plunges the spinning burr to it along the shaft (so that the shaft follows
+    the hole)."""
 
     def __init__(self, drill_pose, point, speed=0.004):
         self.start, self.point, self.speed = drill_pose[:3, 3], np.asarray(point), speed
         self.axis = drill_pose[:3, 0]  # the shaft, from the burr up
-        self.above = self.point + 0.016 * self.axis
+        self.above = self.point + 0.020 * self.axis
 
     def __call__(self, t):
         if t < 0.5:
             p = self.start + (self.above - self.start) * t / 0.5
             return {"position": tuple(p - self.start), "buttons": 0}
-        depth = min((t - 0.5) * self.speed, 0.016)
+        depth = min((t - 0.5) * self.speed, 0.020)
         p = self.above - depth * self.axis
         return {"position": tuple(p - self.start), "buttons": 1}
 
@@ -83,24 +85,25 @@ class Plunge:
 def test_a_breach_of_the_facial_nerve_is_flagged(tmp_path, sessions):
     task, _ = sessions
     scene = drilling_phantom(resolution=RESOLUTION, width=160, height=120)
+    scene.drill.burr = 2  # the 4 mm burr: through 17 mm of mastoid to the nerve in time
     data = scene.drill.volume.data
     labels = np.asarray(data.labels)
-    nerve = np.argwhere(labels == 3)
+    nerve = np.argwhere(labels == FACIAL_NERVE)
     top = nerve[np.argmax(nerve[:, 2])]  # the nerve's highest voxel, under the lateral face
     point = np.array(data.voxel_center(*top)) - np.array([0, 0, 0.001])
     device = ambfplus.ScriptedDevice()
     device.set_callback(Plunge(np.array(scene.drill.pose), point), every=10)
     path = tmp_path / "breach.h5"
-    record_session(scene, path, device, 7.0, capture_every=200, passes=("depth",))
+    record_session(scene, path, device, 8.0, capture_every=200, passes=("depth",))
     result = assess(path, task)
     breaches = [v for v in result.data["violations"] if v["kind"] == "breach"]
     assert [b["structure"] for b in breaches] == ["Facial_Nerve"]
-    nerve_cut = result.data["metrics"]["removed_by_label"][3]
+    nerve_cut = result.data["metrics"]["removed_by_label"][FACIAL_NERVE]
     assert breaches[0]["voxels"] == nerve_cut > 0
     # The time is when the first nerve voxel went, as the recording's removed voxels say.
     with ambfplus.recording.open_recording(path) as rec:
         removed, steps = rec.removed, rec.steps
-    first = int(removed["step"][np.flatnonzero(removed["label"] == 3)[0]])
+    first = int(removed["step"][np.flatnonzero(removed["label"] == FACIAL_NERVE)[0]])
     assert breaches[0]["step"] == first
     assert breaches[0]["time"] == pytest.approx(
         steps["time"][np.searchsorted(steps["step"], first)]

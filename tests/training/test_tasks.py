@@ -17,7 +17,7 @@ GOOD = {
     "anatomy": {"phantom": {"resolution": 32, "seed": 0}},
     "target": {"labels": ["Bone"], "box": {"min": [-5, -5, 0], "max": [5, 5, 20]}},
     "protect": [{"structure": "Facial_Nerve", "margin": 1.0}],
-    "expose": [{"structure": "Sinus_Dura", "thickness": 0.5}],
+    "expose": [{"structure": "Sinus_+_Dura", "thickness": 0.5}],
     "burrs": [2, 4],
     "time_limit": 300,
 }

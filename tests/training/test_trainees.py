@@ -12,7 +12,7 @@ from ambfplus.training import Protect, drill_phantom, expert_like, novice_like, 
 RESOLUTION = 96
 PROTECT = (
     Protect("facial nerve", ("Facial_Nerve",), 0.001),
-    Protect("sinus and dura", ("Sinus_Dura",), 0.0008),
+    Protect("sinus and dura", ("Sinus_+_Dura",), 0.0008),
     Protect("chorda tympani", ("Chorda_Tympani",), 0.0005),
 )
 

@@ -38,18 +38,12 @@ def test_phantom_is_deterministic_and_labelled():
     c = ambfplus.phantom(64, seed=8)
     assert not np.array_equal(np.asarray(a.labels), np.asarray(c.labels))
     names = {label.name for label in a.label_table}
-    assert {
-        "Bone",
-        "Sinus_Dura",
-        "Facial_Nerve",
-        "Bony_Labyrinth",
-        "Malleus",
-        "Incus",
-        "Stapes",
-        "EAC",
-        "ICA",
-        "Chorda_Tympani",
-    } == names
+    # The original system's labels (its labels.csv), so tasks and scripts run on both.
+    assert names == {
+        "Bone", "Malleus", "Incus", "Stapes", "Bony_Labyrinth", "IAC", "Superior_Vestibular_Nerve",
+        "Inferior_Vestibular_Nerve", "Cochlear_Nerve", "Facial_Nerve", "Chorda_Tympani", "ICA",
+        "Sinus_+_Dura", "Vestibular_Aqueduct", "TMJ", "EAC",
+    }  # fmt: skip
     counts = ambfplus.phantom(128).label_counts()
     assert (counts[1:] > 0).all(), "every structure is present at 128^3"
     assert np.allclose(a.dimensions, 0.048)
@@ -146,7 +140,7 @@ def test_sphere_surface_depth_matches_the_analytic_sphere():
 
 
 def test_labels_seen_agree_with_a_cpu_ray_cast():
-    data = ambfplus.phantom(96, seed=2)
+    data = ambfplus.phantom(96, seed=3)
     pose = ambfplus.make_pose((0.01, 0.02, -0.01), rpy=(0.2, -0.1, 0.4))
     _, volume, camera = render_world(data, pose)
     frame = camera.capture()
@@ -232,7 +226,7 @@ def test_more_edits_than_the_history_keeps_upload_little_and_render_as_a_full_up
     camera.capture()
     rng = np.random.default_rng(11)
     start, removed = data.revision, 0
-    for centre in rng.uniform(-0.006, 0.006, (20000, 3)) + (0.0, 0.0, 0.012):
+    for centre in rng.uniform(-0.006, 0.006, (60000, 3)) + (0.0, 0.0, 0.012):
         removed += volume.remove_sphere(tuple(centre), 0.0003)
         if data.revision - start > 4500:
             break

@@ -5,7 +5,6 @@
 // gl_FragCoord.w is not 1/z because the clipped vertices carry a homogeneous scale).
 
 #include "lighting.glsl"
-#include "supersample.glsl"
 
 #ifndef SHADE
 #define SHADE 1
@@ -29,9 +28,6 @@ layout(location = 4) out int o_voxel;  // volume voxels only
 layout(location = 5) out vec4 o_segmentation;
 
 void main() {
-#ifdef SUPERSAMPLE
-  if (outside_supersample_mask()) discard;
-#endif
   vec3 p = v_position.xyz / v_position.w;
   o_depth = p.z;
   o_label = 0u;

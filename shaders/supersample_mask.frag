@@ -1,5 +1,5 @@
 #version 450 core
-// Marks the pixels whose k x k samples may differ: where a neighbour (of the 8) shows another
+// Supersampling: marks the pixels whose k x k samples may differ: where a neighbour (of the 8) shows another
 // object or label, a depth more than 1% apart, or a colour more than u_contrast apart in a
 // channel (shadow edges, textures, highlights). The passes it reads are exact per pixel.
 

@@ -1,6 +1,7 @@
 #version 450 core
 // The box filter of supersampling: each marked pixel becomes the mean of its k x k samples;
-// the others keep the colour of their one sample at the pixel centre.
+// the others keep the colour of their one sample at the pixel centre. Drawn as the points of
+// the blocks sampled.
 
 uniform sampler2D u_samples;            // the k x k larger image
 uniform usampler2D u_supersample_mask;  // 1 where a pixel is supersampled

@@ -10,7 +10,6 @@
 // negative gradient. VolumeData::raycast on the CPU is the same algorithm without the skipping.
 
 #include "lighting.glsl"
-#include "supersample.glsl"
 
 #ifndef SHADE
 #define SHADE 1
@@ -27,6 +26,12 @@ in vec3 v_voxel;
 
 uniform vec3 u_shape;
 uniform vec3 u_eye;                // camera position, voxel units
+#ifdef FROM_PIXELS
+// Supersampling draws points over the pixels to sample: each fragment's ray goes through its
+// own sub-pixel centre.
+uniform mat4 u_voxel_from_clip;
+uniform vec2 u_viewport;
+#endif
 #ifdef ORTHOGRAPHIC
 uniform vec3 u_ray_dir;            // parallel rays (a directional light's shadow map), unit
 uniform float u_ray_back;          // how far behind the box face rays start, voxels
@@ -117,13 +122,14 @@ uint nearest_label(vec3 u, out ivec3 voxel) {
 }
 
 void main() {
-#ifdef SUPERSAMPLE
-  if (outside_supersample_mask()) discard;
-#endif
   inv_shape = 1.0 / u_shape;
 #ifdef ORTHOGRAPHIC
   vec3 dir = u_ray_dir;
   vec3 eye = v_voxel - u_ray_back * dir;
+#elif defined(FROM_PIXELS)
+  vec3 eye = u_eye;
+  vec4 through = u_voxel_from_clip * vec4(gl_FragCoord.xy / u_viewport * 2.0 - 1.0, 0.5, 1.0);
+  vec3 dir = normalize(through.xyz / through.w - eye);
 #else
   vec3 eye = u_eye;
   vec3 dir = normalize(v_voxel - eye);

@@ -64,7 +64,10 @@ void release_supersampling(RenderTarget& t) {
   glDeleteTextures(2, t.samples);
   glDeleteFramebuffers(1, &t.mask_framebuffer);
   glDeleteTextures(1, &t.mask);
+  glDeleteVertexArrays(1, &t.points_vao);
+  glDeleteBuffers(1, &t.points_buffer);
   t.factor = 0;
+  t.stencil = 0;
 }
 
 void release_target(RenderTarget& t) {
@@ -525,6 +528,14 @@ void SceneRenderer::draw_surfaces(const Snapshot& s, Program& program,
                                   unsigned passes, const SurfacePass& pass) {
   const Eigen::Isometry3d view_from_world = view.inverse();
   const LightSet& lights = *s.lights;
+  if (!pass.meshes) {
+    if (pass.volumes) {
+      for (const Snapshot::Volume& v : s.volumes) {
+        v.gpu->draw(v, view, projection, passes, lights, pass);
+      }
+    }
+    return;
+  }
   const Eigen::Matrix4f projection_f = to_float(projection);
   glUniformMatrix4fv(program.uniform("u_projection"), 1, GL_FALSE, projection_f.data());
   glUniform1f(program.uniform("u_ambient"), kAmbient);
@@ -575,6 +586,7 @@ void SceneRenderer::draw_surfaces(const Snapshot& s, Program& program,
   glBindTexture(GL_TEXTURE_2D, 0);
   glBindVertexArray(0);
   // Volumes after the meshes: their rays write depth, so each pixel keeps the nearer surface.
+  if (!pass.volumes) return;
   for (const Snapshot::Volume& v : s.volumes) {
     v.gpu->draw(v, view, projection, passes, lights, pass);
   }
@@ -773,7 +785,7 @@ void SceneRenderer::supersample(const Snapshot& s, RenderTarget& target,
     release_supersampling(target);
     target.factor = k;
     glGenTextures(2, target.samples);
-    const GLenum formats[2] = {GL_RGBA8, GL_DEPTH_COMPONENT32F};
+    const GLenum formats[2] = {GL_RGBA8, GL_DEPTH32F_STENCIL8};
     for (int i = 0; i < 2; ++i) {
       glBindTexture(GL_TEXTURE_2D, target.samples[i]);
       glTexStorage2D(GL_TEXTURE_2D, 1, formats[i], w, h);
@@ -784,8 +796,8 @@ void SceneRenderer::supersample(const Snapshot& s, RenderTarget& target,
     glBindFramebuffer(GL_FRAMEBUFFER, target.samples_framebuffer);
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, target.samples[0],
                            0);
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, target.samples[1],
-                           0);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_TEXTURE_2D,
+                           target.samples[1], 0);
     const GLenum samples_status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
     glGenTextures(1, &target.mask);
     glBindTexture(GL_TEXTURE_2D, target.mask);
@@ -796,6 +808,14 @@ void SceneRenderer::supersample(const Snapshot& s, RenderTarget& target,
     glGenFramebuffers(1, &target.mask_framebuffer);
     glBindFramebuffer(GL_FRAMEBUFFER, target.mask_framebuffer);
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, target.mask, 0);
+    glGenVertexArrays(1, &target.points_vao);
+    glGenBuffers(1, &target.points_buffer);
+    glBindVertexArray(target.points_vao);
+    glBindBuffer(GL_ARRAY_BUFFER, target.points_buffer);
+    glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, 0, nullptr);
+    glEnableVertexAttribArray(0);
+    glBindVertexArray(0);
+    glBindBuffer(GL_ARRAY_BUFFER, 0);
     if (samples_status != GL_FRAMEBUFFER_COMPLETE ||
         glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
       release_supersampling(target);
@@ -804,8 +824,7 @@ void SceneRenderer::supersample(const Snapshot& s, RenderTarget& target,
     }
     check_gl("creating a supersampled target");
   }
-  // Where to supersample, from the exact passes and the shaded colour of the pixel centres.
-  constexpr int kMaskUnit = 7;
+  // Which pixels to sample, from the exact passes and the shaded colour of the pixel centres.
   glBindFramebuffer(GL_FRAMEBUFFER, target.mask_framebuffer);
   glViewport(0, 0, target.width, target.height);
   glDisable(GL_DEPTH_TEST);
@@ -817,44 +836,102 @@ void SceneRenderer::supersample(const Snapshot& s, RenderTarget& target,
     glBindTexture(GL_TEXTURE_2D, target.textures[i]);
     glUniform1i(mask.uniform(inputs[i]), i);
   }
-  // A step of 0.1 in a channel (26 of 255) is an edge worth supersampling.
+  // A step of 0.1 in a channel (26 of 255) is an edge worth sampling.
   glUniform1f(mask.uniform("u_contrast"), 0.1f);
   glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
-
-  // The k x k samples of those pixels.
-  glBindFramebuffer(GL_FRAMEBUFFER, target.samples_framebuffer);
-  glViewport(0, 0, w, h);
-  glEnable(GL_DEPTH_TEST);
-  const GLfloat clear_color[4] = {s.background[0], s.background[1], s.background[2], 1.0f};
-  const GLfloat clear_depth = 0.0f;
-  glClearBufferfv(GL_COLOR, 0, clear_color);
-  glClearBufferfv(GL_DEPTH, 0, &clear_depth);
   for (int i = 0; i < 4; ++i) {
     glActiveTexture(static_cast<GLenum>(GL_TEXTURE0 + i));
     glBindTexture(GL_TEXTURE_2D, 0);
   }
-  SurfacePass samples = shading;
-  samples.defines += "#define SUPERSAMPLE 1\n";
-  samples.setup = [&](Program& program) {
-    if (shading.setup) shading.setup(program);
-    glActiveTexture(GL_TEXTURE0 + kMaskUnit);
-    glBindTexture(GL_TEXTURE_2D, target.mask);
-    glActiveTexture(GL_TEXTURE0);
-    glUniform1i(program.uniform("u_supersample_mask"), kMaskUnit);
-    glUniform1i(program.uniform("u_supersample_factor"), k);
+  glActiveTexture(GL_TEXTURE0);
+  // Those pixels, as points: only their samples are shaded.
+  supersample_mask_.resize(std::size_t(target.width) * target.height);
+  glReadBuffer(GL_COLOR_ATTACHMENT0);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glPixelStorei(GL_PACK_ROW_LENGTH, 0);
+  glReadPixels(0, 0, target.width, target.height, GL_RED_INTEGER, GL_UNSIGNED_BYTE,
+               supersample_mask_.data());
+  // One point per 2 x 2 block of pixels with one to sample: a software rasteriser shades
+  // blocks of 4 x 4 samples together, so isolated pixels would leave most of its lanes idle.
+  supersample_points_.clear();
+  const auto marked = [&](int x, int y) {
+    return x < target.width && y < target.height &&
+           supersample_mask_[std::size_t(y) * target.width + x] != 0;
   };
-  Program& program = Context::get().program(
-      "mesh.vert", "mesh.frag", s.lights->defines() + "#define SHADE 1\n" + samples.defines);
+  for (int y = 0; y < target.height; y += 2) {
+    for (int x = 0; x < target.width; x += 2) {
+      if (marked(x, y) || marked(x + 1, y) || marked(x, y + 1) || marked(x + 1, y + 1)) {
+        supersample_points_.insert(supersample_points_.end(), {float(x + 1), float(y + 1)});
+      }
+    }
+  }
+  const auto points = static_cast<GLsizei>(supersample_points_.size() / 2);
+  glEnable(GL_DEPTH_TEST);
+  if (points == 0) {
+    glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
+    return;
+  }
+  glBindBuffer(GL_ARRAY_BUFFER, target.points_buffer);
+  glBufferData(GL_ARRAY_BUFFER, supersample_points_.size() * sizeof(float),
+               supersample_points_.data(), GL_STREAM_DRAW);
+  glBindBuffer(GL_ARRAY_BUFFER, 0);
+
+  glBindFramebuffer(GL_FRAMEBUFFER, target.samples_framebuffer);
+  glViewport(0, 0, w, h);
+  glEnable(GL_PROGRAM_POINT_SIZE);
+  glBindVertexArray(target.points_vao);
+  // The points set their samples to the background at the far plane and mark them in the
+  // stencil with this capture's value (other samples keep older values): nothing is cleared,
+  // and meshes are shaded at the marked samples only.
+  target.stencil = target.stencil % 255 + 1;
+  if (target.stencil == 1) glClearBufferfi(GL_DEPTH_STENCIL, 0, 0.0f, 0);
+  glEnable(GL_STENCIL_TEST);
+  glStencilFunc(GL_ALWAYS, target.stencil, 0xff);
+  glStencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
+  glDepthFunc(GL_ALWAYS);
+  Program& marker =
+      Context::get().program("supersample_points.vert", "supersample_marker.frag", "");
+  marker.use();
+  glUniform2f(marker.uniform("u_size"), float(target.width), float(target.height));
+  glUniform1f(marker.uniform("u_point_size"), float(2 * k));
+  glUniform4f(marker.uniform("u_background"), s.background[0], s.background[1], s.background[2],
+              1.0f);
+  glDrawArrays(GL_POINTS, 0, points);
+  glBindVertexArray(0);
+  glDepthFunc(GL_GREATER);
+  glStencilFunc(GL_EQUAL, target.stencil, 0xff);
+  glStencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
+  auto point_uniforms = [&](Program& program) {
+    glUniform2f(program.uniform("u_size"), float(target.width), float(target.height));
+    glUniform1f(program.uniform("u_point_size"), float(2 * k));
+  };
+  SurfacePass meshes = shading;
+  meshes.volumes = false;
+  Program& program =
+      Context::get().program("mesh.vert", "mesh.frag", s.lights->defines() + "#define SHADE 1\n");
   program.use();
-  draw_surfaces(s, program, s.camera_pose, s.projection, kPassRgb, samples);
+  draw_surfaces(s, program, s.camera_pose, s.projection, kPassRgb, meshes);
+  glDisable(GL_STENCIL_TEST);
+  // Volumes cast one ray per sample, from the points.
+  SurfacePass volumes = shading;
+  volumes.meshes = false;
+  volumes.points_vao = target.points_vao;
+  volumes.points = points;
+  volumes.setup = [&](Program& p) {
+    if (shading.setup) shading.setup(p);
+    point_uniforms(p);
+  };
+  draw_surfaces(s, program, s.camera_pose, s.projection, kPassRgb, volumes);
 
   // Their means replace the marked pixels' colours.
+  constexpr int kMaskUnit = 7;
   glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
   const GLenum colour_only[1] = {GL_COLOR_ATTACHMENT0};
   glDrawBuffers(1, colour_only);
   glViewport(0, 0, target.width, target.height);
   glDisable(GL_DEPTH_TEST);
-  Program& resolve = Context::get().program("overlay.vert", "supersample_resolve.frag", "");
+  Program& resolve =
+      Context::get().program("supersample_points.vert", "supersample_resolve.frag", "");
   resolve.use();
   glActiveTexture(GL_TEXTURE0);
   glBindTexture(GL_TEXTURE_2D, target.samples[0]);
@@ -863,7 +940,12 @@ void SceneRenderer::supersample(const Snapshot& s, RenderTarget& target,
   glBindTexture(GL_TEXTURE_2D, target.mask);
   glUniform1i(resolve.uniform("u_supersample_mask"), kMaskUnit);
   glUniform1i(resolve.uniform("u_supersample_factor"), k);
-  glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+  glUniform2f(resolve.uniform("u_size"), float(target.width), float(target.height));
+  glUniform1f(resolve.uniform("u_point_size"), 2.0f);
+  glBindVertexArray(target.points_vao);
+  glDrawArrays(GL_POINTS, 0, points);
+  glBindVertexArray(0);
+  glDisable(GL_PROGRAM_POINT_SIZE);
   glBindTexture(GL_TEXTURE_2D, 0);
   glActiveTexture(GL_TEXTURE0);
   glBindTexture(GL_TEXTURE_2D, 0);

@@ -56,8 +56,10 @@ struct RenderTarget {
   // Supersampling of the rgb pass (made when first asked for, remade for another factor): the
   // k x k larger colour and depth test, and the mask of the pixels supersampled.
   int factor = 0;
-  GLuint samples_framebuffer = 0, samples[2] = {0, 0};
+  GLuint samples_framebuffer = 0, samples[2] = {0, 0};  // colour, depth and stencil
   GLuint mask_framebuffer = 0, mask = 0;
+  GLuint points_vao = 0, points_buffer = 0;  // the pixels to sample, as points
+  int stencil = 0;  // the stencil value marking this capture's samples (1..255)
 };
 
 /// A light's shadow map (kept across captures while what casts shadows stays put).
@@ -76,6 +78,11 @@ struct SurfacePass {
   std::string defines;
   std::function<void(Program&)> setup;  // after the program's own uniforms
   bool orthographic = false;            // volumes: parallel rays along the view's z
+  bool meshes = true, volumes = true;   // what is drawn
+  // Volumes drawn as these points (supersampling: one per pixel to sample, k x k sub-pixels
+  // wide) rather than as their boxes; 0 for none.
+  GLuint points_vao = 0;
+  GLsizei points = 0;
 };
 
 /// What one camera sees at one step: everything a draw needs, copied out of the world while its
@@ -198,12 +205,14 @@ class SceneRenderer : public Renderer {
   void overlay(const Snapshot& snapshot, GLenum attachment, ShaderOf shader_of);
 
   World& world_;
-  std::map<const MeshData*, GpuMesh> meshes_;  // each keeps its source alive: no address reuse
-  std::map<int, GpuMesh> soft_meshes_;         // by soft body id; vertices change every frame
-  std::vector<float> soft_scratch_;            // positions then normals of one soft body
-  std::map<int, RenderTarget> targets_;        // by camera id
-  std::map<std::string, GLuint> textures_;     // by image file
-  std::map<int, ShadowMap> shadow_maps_;       // by light id
+  std::map<const MeshData*, GpuMesh> meshes_;   // each keeps its source alive: no address reuse
+  std::map<int, GpuMesh> soft_meshes_;          // by soft body id; vertices change every frame
+  std::vector<float> soft_scratch_;             // positions then normals of one soft body
+  std::map<int, RenderTarget> targets_;         // by camera id
+  std::map<std::string, GLuint> textures_;      // by image file
+  std::map<int, ShadowMap> shadow_maps_;        // by light id
+  std::vector<std::uint8_t> supersample_mask_;  // scratch: the pixels to supersample
+  std::vector<float> supersample_points_;       // scratch: their coordinates
   mutable std::mutex volumes_mutex_;  // volumes_ grows during takes, which may overlap draws
   std::map<int, std::unique_ptr<GpuVolume>> volumes_;  // by volume id
   // Ids of objects that left the world, and whether a mesh may have lost its last body;

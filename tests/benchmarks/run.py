@@ -392,15 +392,18 @@ def stereo(args) -> Iterator[dict]:
         }
     # Shadows (the fixture's lights and their shadow quality) and 2 x 2 supersampling, against
     # everything off, rounds alternating so that machine noise hits both alike. The shadow maps
-    # are kept while nothing that casts moves; "moving" nudges a body before each pair, so each
-    # pair draws them again (what a drilling session pays while the bone changes).
+    # are kept while nothing that casts moves; "redrawn" nudges the drill in view before each
+    # pair, so each pair draws them again (what a session pays while the drill moves).
     lights = [(light.name, light.shadow_quality) for light in sim.world.lights]
-    body = next(b for b in sim.world.bodies if b.name != "world")
+    seen = rig.left.capture(passes=["instance"]).instance
+    body = max(sim.world.bodies, key=lambda b: int((seen == b.id).sum()))  # the drill in view
     pose = body.pose.copy()
+
+    nudges = iter(range(1, 1_000_000))
 
     def nudged(passes) -> None:
         moved = pose.copy()
-        moved[0, 3] += 1e-7
+        moved[0, 3] += 1e-7 * next(nudges)  # a new place each time: no map is reused
         body.pose = moved
         rig.capture(passes)
         body.pose = pose

@@ -492,9 +492,9 @@ class World:
         """
         Adds a rigid body: shape is box (size = full extents), sphere (radius), cylinder, capsule or cone (radius, height along axis, z unless axis='x' or 'y'; a capsule's height includes its caps), plane (z = 0, infinite) or mesh (mesh = file, scale; the default when mesh is given); pose is a 4x4 world-from-body matrix. Physics (mass > 0 moves under gravity; 0 is static): inertia, inertial_offset (4x4), friction, rolling_friction, restitution, linear_damping, angular_damping, kinematic, gravity ((x, y, z) m/s^2: its own instead of the world's), collision (False: none), collision_mesh, collision_type (concave, convex_mesh, convex_hull, point_cloud), collision_shapes ([{shape, size/radius/height/axis, pose}]), margin, groups ([0..31]), axis.
         """
-    def add_camera(self, name: str, width: typing.SupportsInt | typing.SupportsIndex = 640, height: typing.SupportsInt | typing.SupportsIndex = 480, fov_y: typing.SupportsFloat | typing.SupportsIndex = 0.7, near: typing.SupportsFloat | typing.SupportsIndex = 0.1, far: typing.SupportsFloat | typing.SupportsIndex = 10.0, *, pose: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"] | None = None, background: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex] = [0.0, 0.0, 0.0]) -> Camera:
+    def add_camera(self, name: str, width: typing.SupportsInt | typing.SupportsIndex = 640, height: typing.SupportsInt | typing.SupportsIndex = 480, fov_y: typing.SupportsFloat | typing.SupportsIndex = 0.7, near: typing.SupportsFloat | typing.SupportsIndex = 0.1, far: typing.SupportsFloat | typing.SupportsIndex = 10.0, *, pose: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"] | None = None, background: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex] = [0.0, 0.0, 0.0], shadows: bool = False, antialiasing: typing.SupportsInt | typing.SupportsIndex = 1) -> Camera:
         """
-        Adds a pinhole camera (OpenCV frame: x right, y down, z forward); fov_y is the vertical field of view in radians, near and far the clipping distances in metres.
+        Adds a pinhole camera (OpenCV frame: x right, y down, z forward); fov_y is the vertical field of view in radians, near and far the clipping distances in metres. shadows and antialiasing (supersampling per axis, 1..4) change the rgb pass only.
         """
     def add_drill(self, name: str, volume: Volume, **kwargs) -> Drill:
         """
@@ -554,9 +554,9 @@ class World:
           passive (bool): left out of its root body's joints, not controlled
           ignore_inter_collision (bool): parent and child do not collide
         """
-    def add_light(self, name: str, type: LightType | str = 'directional', *, position: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] = ..., direction: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] = ..., color: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex] = [1.0, 1.0, 1.0], intensity: typing.SupportsFloat | typing.SupportsIndex = 1.0, spot_cutoff: typing.SupportsFloat | typing.SupportsIndex = 0.7, spot_exponent: typing.SupportsFloat | typing.SupportsIndex = 0.7, attenuation: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] = ...) -> Light:
+    def add_light(self, name: str, type: LightType | str = 'directional', *, position: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] = ..., direction: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] = ..., color: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex] = [1.0, 1.0, 1.0], intensity: typing.SupportsFloat | typing.SupportsIndex = 1.0, spot_cutoff: typing.SupportsFloat | typing.SupportsIndex = 0.7, spot_exponent: typing.SupportsFloat | typing.SupportsIndex = 0.7, attenuation: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] = ..., shadow_quality: typing.SupportsInt | typing.SupportsIndex = 3) -> Light:
         """
-        Adds a directional, point or spot light shining along direction. A world without lights is lit by a headlight at each camera.
+        Adds a directional, point or spot light shining along direction. A world without lights is lit by a headlight at each camera. shadow_quality: 0 casts no shadow, 1..5 shadow maps of 256 to 4096 texels a side (drawn by cameras with shadows on).
         """
     def add_model(self, name: str) -> Model:
         """
@@ -780,9 +780,9 @@ class Model:
         """
         Adds a rigid body: shape is box (size = full extents), sphere (radius), cylinder, capsule or cone (radius, height along axis, z unless axis='x' or 'y'; a capsule's height includes its caps), plane (z = 0, infinite) or mesh (mesh = file, scale; the default when mesh is given); pose is a 4x4 world-from-body matrix. Physics (mass > 0 moves under gravity; 0 is static): inertia, inertial_offset (4x4), friction, rolling_friction, restitution, linear_damping, angular_damping, kinematic, gravity ((x, y, z) m/s^2: its own instead of the world's), collision (False: none), collision_mesh, collision_type (concave, convex_mesh, convex_hull, point_cloud), collision_shapes ([{shape, size/radius/height/axis, pose}]), margin, groups ([0..31]), axis.
         """
-    def add_camera(self, name: str, width: typing.SupportsInt | typing.SupportsIndex = 640, height: typing.SupportsInt | typing.SupportsIndex = 480, fov_y: typing.SupportsFloat | typing.SupportsIndex = 0.7, near: typing.SupportsFloat | typing.SupportsIndex = 0.1, far: typing.SupportsFloat | typing.SupportsIndex = 10.0, *, pose: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"] | None = None, background: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex] = [0.0, 0.0, 0.0]) -> Camera:
+    def add_camera(self, name: str, width: typing.SupportsInt | typing.SupportsIndex = 640, height: typing.SupportsInt | typing.SupportsIndex = 480, fov_y: typing.SupportsFloat | typing.SupportsIndex = 0.7, near: typing.SupportsFloat | typing.SupportsIndex = 0.1, far: typing.SupportsFloat | typing.SupportsIndex = 10.0, *, pose: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"] | None = None, background: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex] = [0.0, 0.0, 0.0], shadows: bool = False, antialiasing: typing.SupportsInt | typing.SupportsIndex = 1) -> Camera:
         """
-        Adds a pinhole camera (OpenCV frame: x right, y down, z forward); fov_y is the vertical field of view in radians, near and far the clipping distances in metres.
+        Adds a pinhole camera (OpenCV frame: x right, y down, z forward); fov_y is the vertical field of view in radians, near and far the clipping distances in metres. shadows and antialiasing (supersampling per axis, 1..4) change the rgb pass only.
         """
     def add_drill(self, name: str, volume: Volume, **kwargs) -> Drill:
         """
@@ -842,9 +842,9 @@ class Model:
           passive (bool): left out of its root body's joints, not controlled
           ignore_inter_collision (bool): parent and child do not collide
         """
-    def add_light(self, name: str, type: LightType | str = 'directional', *, position: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] = ..., direction: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] = ..., color: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex] = [1.0, 1.0, 1.0], intensity: typing.SupportsFloat | typing.SupportsIndex = 1.0, spot_cutoff: typing.SupportsFloat | typing.SupportsIndex = 0.7, spot_exponent: typing.SupportsFloat | typing.SupportsIndex = 0.7, attenuation: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] = ...) -> Light:
+    def add_light(self, name: str, type: LightType | str = 'directional', *, position: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] = ..., direction: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] = ..., color: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex] = [1.0, 1.0, 1.0], intensity: typing.SupportsFloat | typing.SupportsIndex = 1.0, spot_cutoff: typing.SupportsFloat | typing.SupportsIndex = 0.7, spot_exponent: typing.SupportsFloat | typing.SupportsIndex = 0.7, attenuation: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"] = ..., shadow_quality: typing.SupportsInt | typing.SupportsIndex = 3) -> Light:
         """
-        Adds a directional, point or spot light shining along direction. A world without lights is lit by a headlight at each camera.
+        Adds a directional, point or spot light shining along direction. A world without lights is lit by a headlight at each camera. shadow_quality: 0 casts no shadow, 1..5 shadow maps of 256 to 4096 texels a side (drawn by cameras with shadows on).
         """
     def add_sensor(self, name: str, parent: RigidBody, **kwargs) -> ProximitySensor:
         """
@@ -968,6 +968,14 @@ class Camera(Object):
         Places the camera at eye looking at target, with image up along up.
         """
     @property
+    def antialiasing(self) -> int:
+        """
+        the rgb pass's supersampling per axis: 1 is off, k (2..4) averages k x k samples in pixels at edges and contrasts; ground-truth passes stay one exact sample per pixel centre
+        """
+    @antialiasing.setter
+    def antialiasing(self, arg1: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @property
     def far(self) -> float:
         ...
     @property
@@ -1024,6 +1032,14 @@ class Camera(Object):
         what an ADF asked it to publish: image/depth flags and intervals (every n-th render), depth noise (mean, std_dev, bias) or None
         """
     @property
+    def shadows(self) -> bool:
+        """
+        whether the rgb pass draws the shadows of lights with a shadow_quality above 0 (directional and spot); ground-truth passes never change
+        """
+    @shadows.setter
+    def shadows(self, arg1: bool) -> None:
+        ...
+    @property
     def width(self) -> int:
         ...
 class Light(Object):
@@ -1038,6 +1054,14 @@ class Light(Object):
         ...
     @property
     def intensity(self) -> float:
+        ...
+    @property
+    def shadow_quality(self) -> int:
+        """
+        AMBF's `shadow quality`: 0 casts no shadow, 1..5 shadow maps of 256 to 4096 texels a side (directional and spot lights)
+        """
+    @shadow_quality.setter
+    def shadow_quality(self, arg1: typing.SupportsInt | typing.SupportsIndex) -> None:
         ...
     @property
     def type(self) -> str:

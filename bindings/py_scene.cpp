@@ -195,10 +195,11 @@ Joint& add_joint(Model& model, const std::string& name, RigidBody& parent, Rigid
 
 Camera& add_camera(Model& model, const std::string& name, int width, int height, double fov_y,
                    double near, double far, std::optional<Mat4> pose,
-                   const std::vector<double>& background) {
-  OptionMap o{{"width", width}, {"height", height},
-              {"fov_y", fov_y}, {"near", near},
-              {"far", far},     {"background", OptionValue::from_numbers(background)}};
+                   const std::vector<double>& background, bool shadows, int antialiasing) {
+  OptionMap o{{"width", width},     {"height", height},
+              {"fov_y", fov_y},     {"near", near},
+              {"far", far},         {"background", OptionValue::from_numbers(background)},
+              {"shadows", shadows}, {"antialiasing", antialiasing}};
   if (pose) o.push_back({"pose", mat(*pose)});
   return model.add_camera(make_spec(name, camera_options(), o));
 }
@@ -206,11 +207,12 @@ Camera& add_camera(Model& model, const std::string& name, int width, int height,
 Light& add_light(Model& model, const std::string& name, const KindOrName<LightSpec::Type>& type,
                  const Vec3& position, const Vec3& direction, const std::vector<double>& color,
                  double intensity, double spot_cutoff, double spot_exponent,
-                 const Vec3& attenuation) {
-  const OptionMap o{{"type", to_option(type)},        {"position", vec(position)},
-                    {"direction", vec(direction)},    {"color", OptionValue::from_numbers(color)},
-                    {"intensity", intensity},         {"spot_cutoff", spot_cutoff},
-                    {"spot_exponent", spot_exponent}, {"attenuation", vec(attenuation)}};
+                 const Vec3& attenuation, int shadow_quality) {
+  const OptionMap o{{"type", to_option(type)},         {"position", vec(position)},
+                    {"direction", vec(direction)},     {"color", OptionValue::from_numbers(color)},
+                    {"intensity", intensity},          {"spot_cutoff", spot_cutoff},
+                    {"spot_exponent", spot_exponent},  {"attenuation", vec(attenuation)},
+                    {"shadow_quality", shadow_quality}};
   return model.add_light(make_spec(name, light_options(), o));
 }
 
@@ -329,37 +331,40 @@ void def_adders(Class& cls, GetModel get_model) {
           "add_camera",
           [get_model](Self& self, const std::string& name, int width, int height, double fov_y,
                       double near, double far, std::optional<Mat4> pose,
-                      const std::vector<double>& background) {
+                      const std::vector<double>& background, bool shadows, int antialiasing) {
             Model& model = get_model(self);
             auto lock = lock_holding_gil(model.world());  // see the thread-safety contract
-            return handle(
-                &add_camera(model, name, width, height, fov_y, near, far, pose, background),
-                model.world());
+            return handle(&add_camera(model, name, width, height, fov_y, near, far, pose,
+                                      background, shadows, antialiasing),
+                          model.world());
           },
           py::arg("name"), py::arg("width") = 640, py::arg("height") = 480, py::arg("fov_y") = 0.7,
           py::arg("near") = 0.1, py::arg("far") = 10.0, py::kw_only(), py::arg("pose") = py::none(),
-          py::arg("background") = std::vector<double>{0.0, 0.0, 0.0},
+          py::arg("background") = std::vector<double>{0.0, 0.0, 0.0}, py::arg("shadows") = false,
+          py::arg("antialiasing") = 1,
           "Adds a pinhole camera (OpenCV frame: x right, y down, z forward); fov_y is the "
-          "vertical field of view in radians, near and far the clipping distances in metres.")
+          "vertical field of view in radians, near and far the clipping distances in metres. "
+          "shadows and antialiasing (supersampling per axis, 1..4) change the rgb pass only.")
       .def(
           "add_light",
           [get_model](Self& self, const std::string& name, const KindOrName<LightSpec::Type>& type,
                       const Vec3& position, const Vec3& direction, const std::vector<double>& color,
                       double intensity, double spot_cutoff, double spot_exponent,
-                      const Vec3& attenuation) {
+                      const Vec3& attenuation, int shadow_quality) {
             Model& model = get_model(self);
             auto lock = lock_holding_gil(model.world());  // see the thread-safety contract
             return handle(&add_light(model, name, type, position, direction, color, intensity,
-                                     spot_cutoff, spot_exponent, attenuation),
+                                     spot_cutoff, spot_exponent, attenuation, shadow_quality),
                           model.world());
           },
           py::arg("name"), py::arg("type") = "directional", py::kw_only(),
           py::arg("position") = Vec3(0, 0, 0), py::arg("direction") = Vec3(0, 0, -1),
           py::arg("color") = std::vector<double>{1.0, 1.0, 1.0}, py::arg("intensity") = 1.0,
           py::arg("spot_cutoff") = 0.7, py::arg("spot_exponent") = 0.7,
-          py::arg("attenuation") = Vec3(1, 0, 0),
+          py::arg("attenuation") = Vec3(1, 0, 0), py::arg("shadow_quality") = 3,
           "Adds a directional, point or spot light shining along direction. A world without "
-          "lights is lit by a headlight at each camera.")
+          "lights is lit by a headlight at each camera. shadow_quality: 0 casts no shadow, "
+          "1..5 shadow maps of 256 to 4096 texels a side (drawn by cameras with shadows on).")
       .def(
           "add_volume",
           [get_model](Self& self, const std::string& name, std::shared_ptr<VolumeData> data,
@@ -946,7 +951,14 @@ void define_camera(py::class_<Camera, Object, std::shared_ptr<Camera>>& camera) 
       .def_property(
           "principal_point", [](Camera& c) { return c.principal_point(); },
           [](Camera& c, const Eigen::Vector2d& p) { c.set_principal_point(p.x(), p.y()); },
-          "(cx, cy) in pixels; (W/2, H/2) unless moved (an off-axis camera)");
+          "(cx, cy) in pixels; (W/2, H/2) unless moved (an off-axis camera)")
+      .def_property("shadows", &Camera::shadows, &Camera::set_shadows,
+                    "whether the rgb pass draws the shadows of lights with a shadow_quality "
+                    "above 0 (directional and spot); ground-truth passes never change")
+      .def_property("antialiasing", &Camera::antialiasing, &Camera::set_antialiasing,
+                    "the rgb pass's supersampling per axis: 1 is off, k (2..4) averages k x k "
+                    "samples in pixels at edges and contrasts; ground-truth passes stay one "
+                    "exact sample per pixel centre");
 }
 
 void define_volume_object(py::class_<Volume, Object, std::shared_ptr<Volume>>& volume) {
@@ -1034,7 +1046,10 @@ void define_light(py::class_<Light, Object, std::shared_ptr<Light>>& light) {
   light.def_property_readonly("type", [](Light& l) { return light_type_name(l.type()); })
       .def_property_readonly("direction", &Light::direction)
       .def_property_readonly("color", &Light::color)
-      .def_property_readonly("intensity", &Light::intensity);
+      .def_property_readonly("intensity", &Light::intensity)
+      .def_property("shadow_quality", &Light::shadow_quality, &Light::set_shadow_quality,
+                    "AMBF's `shadow quality`: 0 casts no shadow, 1..5 shadow maps of 256 to "
+                    "4096 texels a side (directional and spot lights)");
 }
 
 void define_state_lock(py::module_& m) {

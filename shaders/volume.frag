@@ -26,6 +26,16 @@ in vec3 v_voxel;
 
 uniform vec3 u_shape;
 uniform vec3 u_eye;                // camera position, voxel units
+#ifdef FROM_PIXELS
+// Supersampling draws points over the pixels to sample: each fragment's ray goes through its
+// own sub-pixel centre.
+uniform mat4 u_voxel_from_clip;
+uniform vec2 u_viewport;
+#endif
+#ifdef ORTHOGRAPHIC
+uniform vec3 u_ray_dir;            // parallel rays (a directional light's shadow map), unit
+uniform float u_ray_back;          // how far behind the box face rays start, voxels
+#endif
 uniform mat4 u_clip_from_voxel;
 uniform mat4 u_camera_from_voxel;
 uniform mat3 u_normal_from_voxel;  // camera-frame normals from voxel-unit gradients
@@ -113,10 +123,20 @@ uint nearest_label(vec3 u, out ivec3 voxel) {
 
 void main() {
   inv_shape = 1.0 / u_shape;
-  vec3 dir = normalize(v_voxel - u_eye);
+#ifdef ORTHOGRAPHIC
+  vec3 dir = u_ray_dir;
+  vec3 eye = v_voxel - u_ray_back * dir;
+#elif defined(FROM_PIXELS)
+  vec3 eye = u_eye;
+  vec4 through = u_voxel_from_clip * vec4(gl_FragCoord.xy / u_viewport * 2.0 - 1.0, 0.5, 1.0);
+  vec3 dir = normalize(through.xyz / through.w - eye);
+#else
+  vec3 eye = u_eye;
+  vec3 dir = normalize(v_voxel - eye);
+#endif
   vec3 inv_dir = 1.0 / dir;
-  vec3 a = (vec3(0.0) - u_eye) * inv_dir;
-  vec3 b = (u_shape - u_eye) * inv_dir;
+  vec3 a = (vec3(0.0) - eye) * inv_dir;
+  vec3 b = (u_shape - eye) * inv_dir;
   vec3 near_t = min(a, b);
   vec3 far_t = max(a, b);
   float t_enter = max(max(near_t.x, near_t.y), max(near_t.z, 0.0));
@@ -133,7 +153,7 @@ void main() {
   ivec3 brick_shape = textureSize(u_bricks, 0);
   float bs = float(u_brick_size);
   while (!hit && t <= t_exit && budget > 0) {
-    vec3 p = u_eye + t * dir;
+    vec3 p = eye + t * dir;
     ivec3 brick = clamp(ivec3(floor(p / bs)), ivec3(0), brick_shape - 1);
     uint dist = texelFetch(u_bricks, brick, 0).r;
     --budget;
@@ -141,17 +161,17 @@ void main() {
       // Every brick within dist - 1 of this one is empty: leave that cube in one jump.
       vec3 lo = vec3(brick - ivec3(dist - 1u)) * bs;
       vec3 hi = vec3(brick + ivec3(dist)) * bs;
-      float t_jump = exit_distance(u_eye, inv_dir, lo, hi);
+      float t_jump = exit_distance(eye, inv_dir, lo, hi);
       m_below = max(m, int(floor((t_jump - t_enter) / dt)));
       m = m_below + 1;
       t = t_enter + float(m) * dt;
       continue;
     }
-    float t_brick = min(exit_distance(u_eye, inv_dir, vec3(brick) * bs, vec3(brick + 1) * bs),
+    float t_brick = min(exit_distance(eye, inv_dir, vec3(brick) * bs, vec3(brick + 1) * bs),
                         t_exit);
     // At least one sample per visit, so rounding at a brick face cannot stall the ray.
     do {
-      if (field(u_eye + t * dir) >= u_level) {
+      if (field(eye + t * dir) >= u_level) {
         hit = true;
         break;
       }
@@ -163,7 +183,7 @@ void main() {
   }
 #else
   for (; t <= t_exit && budget > 0; --budget) {
-    if (field(u_eye + t * dir) >= u_level) {
+    if (field(eye + t * dir) >= u_level) {
       hit = true;
       break;
     }
@@ -184,7 +204,7 @@ void main() {
     float lo = t_enter + float(m_below) * dt, hi = t;
     for (int i = 0; i < 4; ++i) {
       float mid = 0.5 * (lo + hi);
-      if (field(u_eye + mid * dir) >= u_level) {
+      if (field(eye + mid * dir) >= u_level) {
         hi = mid;
       } else {
         lo = mid;
@@ -192,10 +212,14 @@ void main() {
     }
     t = hi;
   }
-  vec3 u = u_eye + t * dir;
+  vec3 u = eye + t * dir;
 
   vec4 camera = u_camera_from_voxel * vec4(u, 1.0);
   vec4 clip = u_clip_from_voxel * vec4(u, 1.0);
+#ifdef DEPTH_ONLY
+  gl_FragDepth = clip.z / clip.w;
+  return;
+#endif
 
   // The gradient from the four corners of a tetrahedron around the hit (it points inwards).
   const float h = NORMAL_SPAN;

@@ -208,7 +208,8 @@ class HmdView:
             focal, cx, cy = (v * scale for v in hmd.eye_intrinsics(eye))
             fov_y = 2 * math.atan(height / (2 * focal))
             camera = world.add_camera(f"{name}_{eye}", width, height, fov_y=fov_y,
-                                      near=base.near, far=base.far)  # fmt: skip
+                                      near=base.near, far=base.far, shadows=base.shadows,
+                                      antialiasing=base.antialiasing)  # fmt: skip
             camera.principal_point = (cx, cy)
             self.cameras.append(camera)
         self.update()
@@ -273,6 +274,8 @@ class XrView:
                         fov_y=g[2],
                         near=self.base.near,
                         far=self.base.far,
+                        shadows=self.base.shadows,
+                        antialiasing=self.base.antialiasing,
                     )  # fmt: skip
                     for side, g in zip(("left", "right"), shapes)
                 ]

@@ -41,6 +41,17 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--ns", default="", help="namespace prefix")
     p.add_argument("--plugins", default="", help="simulator plugins, comma separated")
     p.add_argument("--camera", help="the camera to show (default: the world's first)")
+    p.add_argument("--shadows", type=boolean, default=True,
+                   help="shadows of the lights with a 'shadow quality' in what the cameras show "
+                   "and record (default true)")  # fmt: skip
+    p.add_argument(
+        "--antialiasing",
+        type=int,
+        default=2,
+        choices=range(1, 5),
+        metavar="K",
+        help="supersample the cameras' rgb K x K at edges, 1 = off (default 2)",
+    )
     p.add_argument("--width", type=int, help="window width (default 1536, an HMD's screen)")
     p.add_argument("--height", type=int, help="window height (default 540, an HMD's screen)")
     p.add_argument("--stereo", choices=STEREO_MODES, default="off",

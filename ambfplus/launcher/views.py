@@ -21,7 +21,14 @@ def _view_of(world, camera, width: int, height: int, name: str, x: float = 0.0):
     offset[0, 3] = x
     with world.lock():
         view = world.add_camera(
-            name, width, height, fov_y=camera.fov_y, near=camera.near, far=camera.far
+            name,
+            width,
+            height,
+            fov_y=camera.fov_y,
+            near=camera.near,
+            far=camera.far,
+            shadows=camera.shadows,
+            antialiasing=camera.antialiasing,
         )
         view.attach_to(camera, offset)
         view.pose = camera.pose @ offset

@@ -79,7 +79,9 @@ CameraPlan plan_camera(const Doc& doc, const std::string& base_ns, const std::st
                           "mouse control multipliers",
                           "publish frequency",
                           "passive",
-                          "plugins"});
+                          "plugins",
+                          "shadows",
+                          "antialiasing"});
   CameraPlan plan;
   plan.id = id;
   plan.ns = block_ns(doc, ctx, base_ns, id, n);
@@ -118,6 +120,14 @@ CameraPlan plan_camera(const Doc& doc, const std::string& base_ns, const std::st
   }
   if (pub.image_interval < 1 || pub.depth_interval < 1) {
     fail(doc, n, id, "publish intervals must be >= 1");
+  }
+  // ambfplus's own keys: the rgb pass's shadows and supersampling (ground truth never changes).
+  if (n["shadows"]) plan.spec.shadows = boolean(doc, n["shadows"], id, "shadows");
+  if (n["antialiasing"]) {
+    plan.spec.antialiasing = integer(doc, n["antialiasing"], id, "antialiasing");
+    if (plan.spec.antialiasing < 1 || plan.spec.antialiasing > kMaxAntialiasing) {
+      fail(doc, n["antialiasing"], id, "'antialiasing' must be 1 (off) to 4 samples per axis");
+    }
   }
   if (const YAML::Node stereo = mapping(doc, n, "stereo", id)) {
     plan.eye_separation = number_or(doc, stereo, "eye separation", id, 0.0);
@@ -169,9 +179,13 @@ LightPlan plan_light(const Doc& doc, const std::string& base_ns, const std::stri
                      static_cast<float>(number_or(doc, a, "linear", id, 0.0)),
                      static_cast<float>(number_or(doc, a, "quadratic", id, 0.0))};
   }
+  // AMBF's scale: 0 casts no shadow (also when the key is absent), 1..5 ever larger maps.
+  s.shadow_quality = 0;
   if (n["shadow quality"]) {
-    const int q = integer(doc, n["shadow quality"], id, "shadow quality");
-    if (q < 0 || q > 5) fail(doc, n["shadow quality"], id, "'shadow quality' must be 0 to 5");
+    s.shadow_quality = integer(doc, n["shadow quality"], id, "shadow quality");
+    if (s.shadow_quality < 0 || s.shadow_quality > kMaxShadowQuality) {
+      fail(doc, n["shadow quality"], id, "'shadow quality' must be 0 to 5");
+    }
   }
   plan.plugins = read_plugins(doc, n["plugins"], id);
   return plan;
@@ -231,7 +245,6 @@ void warn_not_applied(const Doc& doc, Context& ctx) {
                 "the launcher's mouse controls keep their own scales");
   d.not_applied(doc, "cameras", {"multipass"}, "cameras render every object in one pass here");
   d.not_applied(doc, "cameras", {"visible"}, "cameras are not drawn as objects here");
-  d.not_applied(doc, "lights", {"shadow quality"}, "the engine draws no shadows");
 }
 
 }  // namespace

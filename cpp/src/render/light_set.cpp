@@ -12,7 +12,21 @@ void push3(std::vector<float>& v, const Eigen::Vector3f& x) {
 }
 }  // namespace
 
-LightSet::LightSet(const World& world, const Eigen::Isometry3d& camera_from_world) {
+LightSet::LightSet(const World& world, const Eigen::Isometry3d& camera_from_world, bool shadows) {
+  // The map index of a light that casts shadows, -1 for one that does not.
+  auto shadow_of = [&](const Light& light) {
+    const bool casts = light.type() != LightSpec::Type::kPoint && light.shadow_quality() > 0;
+    if (!shadows || !casts || casters.size() >= std::size_t(kMaxShadowMaps)) return -1;
+    ShadowCaster c;
+    c.light_id = light.id();
+    c.directional = light.type() == LightSpec::Type::kDirectional;
+    c.position = light.pose().translation();
+    c.direction = light.direction();
+    c.cutoff = light.spot_cutoff();
+    c.size = light.shadow_map_size();
+    casters.push_back(c);
+    return static_cast<int>(casters.size()) - 1;
+  };
   for (const Light* light : world.objects_of_kind<Light>()) {
     const Eigen::Vector3f p = (camera_from_world * light->pose().translation()).cast<float>();
     const Eigen::Vector3f d = (camera_from_world.linear() * light->direction()).cast<float>();
@@ -24,6 +38,7 @@ LightSet::LightSet(const World& world, const Eigen::Isometry3d& camera_from_worl
     switch (light->type()) {
       case LightSpec::Type::kDirectional:
         ++directional;
+        dir_shadow.push_back(shadow_of(*light));
         push3(dir_direction, d);
         push3(dir_color, c);
         break;
@@ -35,6 +50,7 @@ LightSet::LightSet(const World& world, const Eigen::Isometry3d& camera_from_worl
         break;
       case LightSpec::Type::kSpot:
         ++spot;
+        spot_shadow.push_back(shadow_of(*light));
         push3(spot_position, p);
         push3(spot_direction, d);
         push3(spot_color, c);
@@ -46,6 +62,7 @@ LightSet::LightSet(const World& world, const Eigen::Isometry3d& camera_from_worl
   }
   if (directional + point + spot == 0) {
     directional = 1;
+    dir_shadow.push_back(-1);
     push3(dir_direction, Eigen::Vector3f(0, 0, 1));
     push3(dir_color, Eigen::Vector3f::Constant(0.85f));
   }
@@ -53,7 +70,8 @@ LightSet::LightSet(const World& world, const Eigen::Isometry3d& camera_from_worl
 
 std::string LightSet::defines() const {
   return "#define DIRECTIONAL_LIGHTS " + std::to_string(directional) + "\n#define POINT_LIGHTS " +
-         std::to_string(point) + "\n#define SPOT_LIGHTS " + std::to_string(spot) + "\n";
+         std::to_string(point) + "\n#define SPOT_LIGHTS " + std::to_string(spot) + "\n" +
+         (casters.empty() ? "" : "#define SHADOW_MAPS " + std::to_string(casters.size()) + "\n");
 }
 
 void LightSet::upload(Program& program) const {
@@ -75,6 +93,29 @@ void LightSet::upload(Program& program) const {
   vec3s("u_spot_attenuation", spot_attenuation);
   floats("u_spot_cos_cutoff", spot_cos_cutoff);
   floats("u_spot_exponent", spot_exponent);
+  if (!casters.empty()) {
+    glUniform1iv(program.uniform("u_directional_shadow"), static_cast<GLsizei>(dir_shadow.size()),
+                 dir_shadow.data());
+    if (!spot_shadow.empty()) {
+      glUniform1iv(program.uniform("u_spot_shadow"), static_cast<GLsizei>(spot_shadow.size()),
+                   spot_shadow.data());
+    }
+  }
+}
+
+void ShadowUniforms::upload(Program& program) const {
+  const auto n = static_cast<GLsizei>(textures.size());
+  if (n == 0) return;
+  std::vector<GLint> units(textures.size());
+  for (GLsizei i = 0; i < n; ++i) {
+    units[i] = kShadowMapUnit + i;
+    glActiveTexture(static_cast<GLenum>(GL_TEXTURE0 + units[i]));
+    glBindTexture(GL_TEXTURE_2D, textures[i]);
+  }
+  glActiveTexture(GL_TEXTURE0);
+  glUniform1iv(program.uniform("u_shadow_maps"), n, units.data());
+  glUniformMatrix4fv(program.uniform("u_shadow_from_camera"), n, GL_FALSE, from_camera.data());
+  glUniform2fv(program.uniform("u_shadow_texel"), n, texel.data());
 }
 
 }  // namespace ambfplus::render

@@ -4,8 +4,10 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "ambfplus/errors.h"
@@ -56,15 +58,34 @@ void release_mesh(GpuMesh& m) {
   if (m.texcoords != 0) glDeleteBuffers(1, &m.texcoords);
 }
 
+void release_supersampling(RenderTarget& t) {
+  if (t.factor == 0) return;
+  glDeleteFramebuffers(1, &t.samples_framebuffer);
+  glDeleteTextures(2, t.samples);
+  glDeleteFramebuffers(1, &t.mask_framebuffer);
+  glDeleteTextures(1, &t.mask);
+  glDeleteVertexArrays(1, &t.points_vao);
+  glDeleteBuffers(1, &t.points_buffer);
+  t.factor = 0;
+  t.stencil = 0;
+}
+
 void release_target(RenderTarget& t) {
   glDeleteFramebuffers(1, &t.framebuffer);
-  glDeleteRenderbuffers(RenderTarget::kBuffers, t.renderbuffers);
+  glDeleteTextures(RenderTarget::kBuffers, t.textures);
+  release_supersampling(t);
+}
+
+void release_shadow_map(ShadowMap& m) {
+  glDeleteFramebuffers(1, &m.framebuffer);
+  glDeleteTextures(1, &m.texture);
 }
 
 }  // namespace
 
 void SceneRenderer::release_all() {
-  if ((meshes_.empty() && soft_meshes_.empty() && targets_.empty() && volumes_.empty()) ||
+  if ((meshes_.empty() && soft_meshes_.empty() && targets_.empty() && volumes_.empty() &&
+       shadow_maps_.empty()) ||
       !Context::exists()) {
     return;
   }
@@ -74,6 +95,7 @@ void SceneRenderer::release_all() {
     for (auto& entry : meshes_) release_mesh(entry.second);
     for (auto& entry : soft_meshes_) release_mesh(entry.second);
     for (auto& entry : targets_) release_target(entry.second);
+    for (auto& entry : shadow_maps_) release_shadow_map(entry.second);
     for (auto& entry : textures_) {
       if (entry.second != 0) glDeleteTextures(1, &entry.second);
     }
@@ -86,6 +108,7 @@ void SceneRenderer::release_all() {
   soft_meshes_.clear();
   targets_.clear();
   textures_.clear();
+  shadow_maps_.clear();
 }
 
 void SceneRenderer::object_removed(Object& object) {
@@ -112,6 +135,10 @@ void SceneRenderer::release_unused() {
     if (auto m = soft_meshes_.find(id); m != soft_meshes_.end()) {
       release_mesh(m->second);
       soft_meshes_.erase(m);
+    }
+    if (auto m = shadow_maps_.find(id); m != shadow_maps_.end()) {
+      release_shadow_map(m->second);
+      shadow_maps_.erase(m);
     }
   }
   // A mesh only this renderer still holds is drawn by no body any more.
@@ -212,8 +239,10 @@ void SceneRenderer::take(const Camera& camera, unsigned passes, Snapshot& s) {
   s.background = camera.background();
   s.preprocessing = camera.preprocessing_shader();
   s.passes = passes;
+  s.shadows = camera.shadows() && (passes & kPassRgb);
+  s.antialiasing = camera.antialiasing();
   s.time = world_.time();
-  s.lights.emplace(world_, camera.pose().inverse());
+  s.lights.emplace(world_, camera.pose().inverse(), s.shadows);
   for (const RigidBody* body : world_.objects_of_kind<RigidBody>()) {
     if (body->visual_mesh()->indices.empty() || !body->material().visible) continue;
     s.bodies.push_back({body->visual_mesh(), body->pose(), body->material(),
@@ -258,6 +287,11 @@ GpuMesh& SceneRenderer::mesh_for(const std::shared_ptr<const MeshData>& source) 
   GpuMesh g;
   g.position_size = mesh->position_size;
   g.source = source;
+  if (mesh->position_size == 3) {
+    for (std::size_t i = 0; i + 2 < mesh->positions.size(); i += 3) {
+      g.bounds.extend(Eigen::Vector3f(mesh->positions.data() + i).cast<double>());
+    }
+  }
   glGenVertexArrays(1, &g.vao);
   glGenBuffers(3, g.buffers);
   glBindVertexArray(g.vao);
@@ -397,22 +431,26 @@ RenderTarget& SceneRenderer::target_for(const Snapshot& snapshot) {
   t.width = snapshot.width;
   t.height = snapshot.height;
   glGenFramebuffers(1, &t.framebuffer);
-  glGenRenderbuffers(RenderTarget::kBuffers, t.renderbuffers);
+  glGenTextures(RenderTarget::kBuffers, t.textures);
   const GLenum formats[RenderTarget::kBuffers] = {
       GL_RGBA8, GL_R32F, GL_R16UI, GL_R32I, GL_R32I, GL_RGBA8, GL_DEPTH_COMPONENT32F};
   glBindFramebuffer(GL_FRAMEBUFFER, t.framebuffer);
+  // Textures, so that supersampling can read the passes that find edges.
   for (int i = 0; i < RenderTarget::kBuffers; ++i) {
-    glBindRenderbuffer(GL_RENDERBUFFER, t.renderbuffers[i]);
-    glRenderbufferStorage(GL_RENDERBUFFER, formats[i], t.width, t.height);
+    glBindTexture(GL_TEXTURE_2D, t.textures[i]);
+    glTexStorage2D(GL_TEXTURE_2D, 1, formats[i], t.width, t.height);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     const GLenum attachment = i + 1 < RenderTarget::kBuffers
                                   ? static_cast<GLenum>(GL_COLOR_ATTACHMENT0 + i)
                                   : static_cast<GLenum>(GL_DEPTH_ATTACHMENT);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, attachment, GL_RENDERBUFFER, t.renderbuffers[i]);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, attachment, GL_TEXTURE_2D, t.textures[i], 0);
   }
+  glBindTexture(GL_TEXTURE_2D, 0);
   const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
   if (status != GL_FRAMEBUFFER_COMPLETE) {
     glDeleteFramebuffers(1, &t.framebuffer);
-    glDeleteRenderbuffers(RenderTarget::kBuffers, t.renderbuffers);
+    glDeleteTextures(RenderTarget::kBuffers, t.textures);
     throw RenderError("camera '" + snapshot.camera_name + "': off-screen framebuffer of " +
                       std::to_string(t.width) + "x" + std::to_string(t.height) +
                       " is incomplete (status 0x" + std::to_string(status) + ")");
@@ -423,9 +461,15 @@ RenderTarget& SceneRenderer::target_for(const Snapshot& snapshot) {
 
 void SceneRenderer::draw(const Snapshot& s) {
   const unsigned passes = s.passes;
-  const Eigen::Isometry3d camera_from_world = s.camera_pose.inverse();
   const LightSet& lights = *s.lights;
   for (const Snapshot::Volume& v : s.volumes) v.gpu->upload();
+  const bool supersampled = (passes & kPassRgb) && s.antialiasing > 1;
+  // Supersampling finds edges in the object ids, labels and depth: they are drawn for it.
+  const unsigned drawn = supersampled ? passes | kPassDepth | kPassLabel | kPassInstance : passes;
+  // Shadow maps first: they leave their own framebuffer bound.
+  const ShadowUniforms shadows = shadow_maps(s);
+  SurfacePass shading;
+  shading.setup = [&shadows](Program& program) { shadows.upload(program); };
   // Shading is the costly part: without an rgb pass the shaders skip it.
   const std::string defines =
       lights.defines() + ((passes & kPassRgb) ? "#define SHADE 1\n" : "#define SHADE 0\n");
@@ -436,8 +480,7 @@ void SceneRenderer::draw(const Snapshot& s) {
   // Only the passes asked for are written (pass i on attachment i).
   GLenum draw_buffers[kRenderedPassCount];
   for (int i = 0; i < kRenderedPassCount; ++i) {
-    draw_buffers[i] =
-        (passes & (1u << i)) ? static_cast<GLenum>(GL_COLOR_ATTACHMENT0 + i) : GL_NONE;
+    draw_buffers[i] = (drawn & (1u << i)) ? static_cast<GLenum>(GL_COLOR_ATTACHMENT0 + i) : GL_NONE;
   }
   glDrawBuffers(kRenderedPassCount, draw_buffers);
   glViewport(0, 0, target.width, target.height);
@@ -465,10 +508,39 @@ void SceneRenderer::draw(const Snapshot& s) {
   glClearBufferfv(GL_DEPTH, 0, &clear_depth);
 
   program.use();
-  const Eigen::Matrix4f projection = to_float(s.projection);
-  glUniformMatrix4fv(program.uniform("u_projection"), 1, GL_FALSE, projection.data());
+  draw_surfaces(s, program, s.camera_pose, s.projection, passes, shading);
+  if (supersampled) supersample(s, target, shading);
+  // Users' shaders colour their meshes; the camera's preprocessing shader its segmentation.
+  if (passes & kPassRgb) {
+    overlay(s, GL_COLOR_ATTACHMENT0, [](const Material&, const std::optional<ShaderSpec>& own) {
+      return own ? &*own : nullptr;
+    });
+  }
+  if ((passes & kPassSegmentation) && s.preprocessing && !s.preprocessing->builtin()) {
+    overlay(s, GL_COLOR_ATTACHMENT5,
+            [&](const Material&, const std::optional<ShaderSpec>&) { return &*s.preprocessing; });
+  }
+  check_gl("drawing the scene");
+}
+
+void SceneRenderer::draw_surfaces(const Snapshot& s, Program& program,
+                                  const Eigen::Isometry3d& view, const Eigen::Matrix4d& projection,
+                                  unsigned passes, const SurfacePass& pass) {
+  const Eigen::Isometry3d view_from_world = view.inverse();
+  const LightSet& lights = *s.lights;
+  if (!pass.meshes) {
+    if (pass.volumes) {
+      for (const Snapshot::Volume& v : s.volumes) {
+        v.gpu->draw(v, view, projection, passes, lights, pass);
+      }
+    }
+    return;
+  }
+  const Eigen::Matrix4f projection_f = to_float(projection);
+  glUniformMatrix4fv(program.uniform("u_projection"), 1, GL_FALSE, projection_f.data());
   glUniform1f(program.uniform("u_ambient"), kAmbient);
   lights.upload(program);
+  if (pass.setup) pass.setup(program);
   const GLint u_model_view = program.uniform("u_model_view");
   const GLint u_normal_matrix = program.uniform("u_normal_matrix");
   const GLint u_color = program.uniform("u_color");
@@ -476,7 +548,6 @@ void SceneRenderer::draw(const Snapshot& s) {
   const GLint u_shininess = program.uniform("u_shininess");
   const GLint u_instance = program.uniform("u_instance");
   const GLint u_segmentation_color = program.uniform("u_segmentation_color");
-
   const GLint u_textured = program.uniform("u_textured");
   auto draw = [&](const GpuMesh& mesh, const Eigen::Isometry3d& model_view, const Material& m,
                   int id, GLuint texture) {
@@ -505,28 +576,381 @@ void SceneRenderer::draw(const Snapshot& s) {
   };
   for (const Snapshot::Body& body : s.bodies) {
     // Composed in double, then rounded once, to keep depth exact far from the origin.
-    draw(mesh_for(body.mesh), camera_from_world * body.pose, body.material, body.id,
+    draw(mesh_for(body.mesh), view_from_world * body.pose, body.material, body.id,
          (passes & kPassRgb) ? texture_for(body.texture) : 0);
   }
   // Soft bodies: their nodes are in the world frame.
   for (const Snapshot::Soft& soft : s.softs) {
-    draw(soft_mesh_for(soft), camera_from_world, soft.material, soft.id, 0);
+    draw(soft_mesh_for(soft), view_from_world, soft.material, soft.id, 0);
   }
   glBindTexture(GL_TEXTURE_2D, 0);
   glBindVertexArray(0);
   // Volumes after the meshes: their rays write depth, so each pixel keeps the nearer surface.
-  for (const Snapshot::Volume& v : s.volumes) v.gpu->draw(v, s);
-  // Users' shaders colour their meshes; the camera's preprocessing shader its segmentation.
-  if (passes & kPassRgb) {
-    overlay(s, GL_COLOR_ATTACHMENT0, [](const Material&, const std::optional<ShaderSpec>& own) {
-      return own ? &*own : nullptr;
-    });
+  if (!pass.volumes) return;
+  for (const Snapshot::Volume& v : s.volumes) {
+    v.gpu->draw(v, view, projection, passes, lights, pass);
   }
-  if ((passes & kPassSegmentation) && s.preprocessing && !s.preprocessing->builtin()) {
-    overlay(s, GL_COLOR_ATTACHMENT5,
-            [&](const Material&, const std::optional<ShaderSpec>&) { return &*s.preprocessing; });
+}
+
+namespace {
+
+// The light's frame (z along the light, origin at a spot light's position) from the world.
+Eigen::Isometry3d light_from_world(const ShadowCaster& c) {
+  const Eigen::Vector3d z = c.direction.normalized();
+  const Eigen::Vector3d helper =
+      std::abs(z.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+  const Eigen::Vector3d x = helper.cross(z).normalized();
+  Eigen::Isometry3d world_from_light = Eigen::Isometry3d::Identity();
+  world_from_light.linear().col(0) = x;
+  world_from_light.linear().col(1) = z.cross(x);
+  world_from_light.linear().col(2) = z;
+  world_from_light.translation() = c.directional ? Eigen::Vector3d::Zero() : c.position;
+  return world_from_light.inverse();
+}
+
+void hash_into(std::size_t& key, const void* data, std::size_t bytes) {
+  const std::size_t h =
+      std::hash<std::string_view>()(std::string_view(static_cast<const char*>(data), bytes));
+  key ^= h + 0x9e3779b97f4a7c15ull + (key << 6) + (key >> 2);
+}
+
+template <typename T>
+void hash_value(std::size_t& key, const T& value) {
+  hash_into(key, &value, sizeof(T));
+}
+
+}  // namespace
+
+ShadowUniforms SceneRenderer::shadow_maps(const Snapshot& s) {
+  ShadowUniforms out;
+  const LightSet& lights = *s.lights;
+  if (lights.casters.empty()) return out;
+  // What casts shadows, in the world frame: its bounds and a key of everything drawn.
+  Eigen::AlignedBox3d bounds;
+  std::size_t scene_key = 0;
+  auto extend = [&](const Eigen::AlignedBox3d& box, const Eigen::Isometry3d& pose) {
+    if (box.isEmpty()) return;
+    for (int corner = 0; corner < 8; ++corner) {
+      bounds.extend(pose * box.corner(static_cast<Eigen::AlignedBox3d::CornerType>(corner)));
+    }
+  };
+  for (const Snapshot::Body& body : s.bodies) {
+    const GpuMesh& mesh = mesh_for(body.mesh);
+    extend(mesh.bounds, body.pose);
+    hash_value(scene_key, body.mesh.get());
+    hash_into(scene_key, body.pose.matrix().data(), 16 * sizeof(double));
   }
-  check_gl("drawing the scene");
+  for (const Snapshot::Soft& soft : s.softs) {
+    for (std::size_t i = 0; i + 2 < soft.positions.size(); i += 3) {
+      bounds.extend(Eigen::Vector3f(soft.positions.data() + i).cast<double>());
+    }
+    hash_value(scene_key, soft.id);
+    hash_into(scene_key, soft.positions.data(), soft.positions.size() * sizeof(float));
+  }
+  for (const Snapshot::Volume& v : s.volumes) {
+    const Eigen::Vector3d half = v.gpu->data()->dimensions() / 2;
+    extend(Eigen::AlignedBox3d(-half, half), v.pose);
+    hash_value(scene_key, v.gpu);
+    hash_value(scene_key, v.gpu->generation());
+    hash_value(scene_key, v.iso);
+    hash_into(scene_key, v.pose.matrix().data(), 16 * sizeof(double));
+  }
+  const Eigen::Isometry3d world_from_camera = s.camera_pose;
+  for (const ShadowCaster& c : lights.casters) {
+    std::size_t key = scene_key;
+    hash_value(key, c.directional);
+    hash_into(key, c.position.data(), 3 * sizeof(double));
+    hash_into(key, c.direction.data(), 3 * sizeof(double));
+    hash_value(key, c.cutoff);
+    hash_value(key, c.size);
+    ShadowMap& map = shadow_maps_[c.light_id];
+    if (map.size != c.size) {
+      release_shadow_map(map);
+      map = ShadowMap{};
+      map.size = c.size;
+      glGenTextures(1, &map.texture);
+      glBindTexture(GL_TEXTURE_2D, map.texture);
+      glTexStorage2D(GL_TEXTURE_2D, 1, GL_DEPTH_COMPONENT32F, c.size, c.size);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+      // Reversed depth: a point is lit when it is at least as near the light as the map says.
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_FUNC, GL_GEQUAL);
+      glBindTexture(GL_TEXTURE_2D, 0);
+      glGenFramebuffers(1, &map.framebuffer);
+      glBindFramebuffer(GL_FRAMEBUFFER, map.framebuffer);
+      glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, map.texture, 0);
+      glDrawBuffer(GL_NONE);
+      glReadBuffer(GL_NONE);
+      if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+        throw RenderError("shadow map of " + std::to_string(c.size) + "x" + std::to_string(c.size) +
+                          " texels is incomplete");
+      }
+      map.key = key + 1;  // drawn below
+    }
+    const Eigen::Isometry3d light = light_from_world(c);
+    if (map.key != key) {
+      map.key = key;
+      // The light's view fitted around what casts shadows (reversed depth, as the cameras').
+      Eigen::AlignedBox3d box;
+      if (!bounds.isEmpty()) {
+        for (int corner = 0; corner < 8; ++corner) {
+          box.extend(light * bounds.corner(static_cast<Eigen::AlignedBox3d::CornerType>(corner)));
+        }
+      }
+      Eigen::Matrix4d p = Eigen::Matrix4d::Zero();
+      bool visible = !box.isEmpty();
+      if (visible && c.directional) {
+        const Eigen::Vector3d pad = 0.01 * box.sizes() + Eigen::Vector3d::Constant(1e-4);
+        const Eigen::Vector3d lo = box.min() - pad, hi = box.max() + pad;
+        p(0, 0) = 2 / (hi.x() - lo.x());
+        p(0, 3) = -(hi.x() + lo.x()) / (hi.x() - lo.x());
+        p(1, 1) = 2 / (hi.y() - lo.y());
+        p(1, 3) = -(hi.y() + lo.y()) / (hi.y() - lo.y());
+        p(2, 2) = -1 / (hi.z() - lo.z());
+        p(2, 3) = hi.z() / (hi.z() - lo.z());
+        p(3, 3) = 1;
+        map.texel = {std::max(hi.x() - lo.x(), hi.y() - lo.y()) / c.size, 0.0};
+      } else if (visible) {
+        const double far = box.max().z() * 1.01;
+        const double near = std::max(box.min().z(), far * 1e-4);
+        visible = far > 0;
+        // The cone, up to 85 degrees off the axis.
+        const double t = std::tan(std::min(c.cutoff, 85.0 * M_PI / 180.0));
+        p(0, 0) = 1 / t;
+        p(1, 1) = 1 / t;
+        p(2, 2) = -near / (far - near);
+        p(2, 3) = near * far / (far - near);
+        p(3, 2) = 1;
+        map.texel = {0.0, 2 * t / c.size};
+      }
+      map.clip_from_world = p * light.matrix();
+      glBindFramebuffer(GL_FRAMEBUFFER, map.framebuffer);
+      glViewport(0, 0, c.size, c.size);
+      glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+      glEnable(GL_DEPTH_TEST);
+      glDepthFunc(GL_GREATER);
+      glDepthMask(GL_TRUE);
+      glDisable(GL_CULL_FACE);
+      glDisable(GL_BLEND);
+      glFrontFace(GL_CW);
+      const GLfloat far_depth = 0.0f;
+      glClearBufferfv(GL_DEPTH, 0, &far_depth);
+      if (visible) {
+        // Casters drawn a little farther from the light than they are, against self-shadowing.
+        glEnable(GL_POLYGON_OFFSET_FILL);
+        glPolygonOffset(-1.0f, -1.0f);
+        Program& depth = Context::get().program("mesh.vert", "shadow.frag", "");
+        depth.use();
+        const Eigen::Matrix4f projection = to_float(p);
+        glUniformMatrix4fv(depth.uniform("u_projection"), 1, GL_FALSE, projection.data());
+        const GLint u_model_view = depth.uniform("u_model_view");
+        auto cast = [&](const GpuMesh& mesh, const Eigen::Isometry3d& model_view) {
+          if (mesh.index_count == 0 || mesh.position_size != 3) return;
+          const Eigen::Matrix4f mv = to_float(model_view.matrix());
+          glUniformMatrix4fv(u_model_view, 1, GL_FALSE, mv.data());
+          glBindVertexArray(mesh.vao);
+          glDrawElements(GL_TRIANGLES, mesh.index_count, GL_UNSIGNED_INT, nullptr);
+        };
+        for (const Snapshot::Body& body : s.bodies) cast(mesh_for(body.mesh), light * body.pose);
+        for (const Snapshot::Soft& soft : s.softs) cast(soft_mesh_for(soft), light);
+        glBindVertexArray(0);
+        glDisable(GL_POLYGON_OFFSET_FILL);
+        SurfacePass depth_only;
+        depth_only.defines = "#define DEPTH_ONLY 1\n";
+        depth_only.orthographic = c.directional;
+        for (const Snapshot::Volume& v : s.volumes) {
+          v.gpu->draw(v, light.inverse(), p, 0, lights, depth_only);
+        }
+      }
+      check_gl("drawing a shadow map");
+    }
+    const Eigen::Matrix4f from_camera =
+        (map.clip_from_world * world_from_camera.matrix()).cast<float>();
+    out.textures.push_back(map.texture);
+    out.from_camera.insert(out.from_camera.end(), from_camera.data(), from_camera.data() + 16);
+    out.texel.push_back(static_cast<float>(map.texel.x()));
+    out.texel.push_back(static_cast<float>(map.texel.y()));
+  }
+  return out;
+}
+
+void SceneRenderer::supersample(const Snapshot& s, RenderTarget& target,
+                                const SurfacePass& shading) {
+  const int k = s.antialiasing;
+  const int w = target.width * k, h = target.height * k;
+  if (target.factor != k) {
+    release_supersampling(target);
+    target.factor = k;
+    glGenTextures(2, target.samples);
+    const GLenum formats[2] = {GL_RGBA8, GL_DEPTH32F_STENCIL8};
+    for (int i = 0; i < 2; ++i) {
+      glBindTexture(GL_TEXTURE_2D, target.samples[i]);
+      glTexStorage2D(GL_TEXTURE_2D, 1, formats[i], w, h);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    }
+    glGenFramebuffers(1, &target.samples_framebuffer);
+    glBindFramebuffer(GL_FRAMEBUFFER, target.samples_framebuffer);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, target.samples[0],
+                           0);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_TEXTURE_2D,
+                           target.samples[1], 0);
+    const GLenum samples_status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+    glGenTextures(1, &target.mask);
+    glBindTexture(GL_TEXTURE_2D, target.mask);
+    glTexStorage2D(GL_TEXTURE_2D, 1, GL_R8UI, target.width, target.height);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glGenFramebuffers(1, &target.mask_framebuffer);
+    glBindFramebuffer(GL_FRAMEBUFFER, target.mask_framebuffer);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, target.mask, 0);
+    glGenVertexArrays(1, &target.points_vao);
+    glGenBuffers(1, &target.points_buffer);
+    glBindVertexArray(target.points_vao);
+    glBindBuffer(GL_ARRAY_BUFFER, target.points_buffer);
+    glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, 0, nullptr);
+    glEnableVertexAttribArray(0);
+    glBindVertexArray(0);
+    glBindBuffer(GL_ARRAY_BUFFER, 0);
+    if (samples_status != GL_FRAMEBUFFER_COMPLETE ||
+        glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+      release_supersampling(target);
+      throw RenderError("camera '" + s.camera_name + "': the supersampled image of " +
+                        std::to_string(w) + "x" + std::to_string(h) + " cannot be made");
+    }
+    check_gl("creating a supersampled target");
+  }
+  // Which pixels to sample, from the exact passes and the shaded colour of the pixel centres.
+  glBindFramebuffer(GL_FRAMEBUFFER, target.mask_framebuffer);
+  glViewport(0, 0, target.width, target.height);
+  glDisable(GL_DEPTH_TEST);
+  Program& mask = Context::get().program("overlay.vert", "supersample_mask.frag", "");
+  mask.use();
+  const char* inputs[4] = {"u_rgb", "u_depth", "u_label", "u_instance"};
+  for (int i = 0; i < 4; ++i) {
+    glActiveTexture(static_cast<GLenum>(GL_TEXTURE0 + i));
+    glBindTexture(GL_TEXTURE_2D, target.textures[i]);
+    glUniform1i(mask.uniform(inputs[i]), i);
+  }
+  // A step of 0.1 in a channel (26 of 255) is an edge worth sampling.
+  glUniform1f(mask.uniform("u_contrast"), 0.1f);
+  glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+  for (int i = 0; i < 4; ++i) {
+    glActiveTexture(static_cast<GLenum>(GL_TEXTURE0 + i));
+    glBindTexture(GL_TEXTURE_2D, 0);
+  }
+  glActiveTexture(GL_TEXTURE0);
+  // Those pixels, as points: only their samples are shaded.
+  supersample_mask_.resize(std::size_t(target.width) * target.height);
+  glReadBuffer(GL_COLOR_ATTACHMENT0);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glPixelStorei(GL_PACK_ROW_LENGTH, 0);
+  glReadPixels(0, 0, target.width, target.height, GL_RED_INTEGER, GL_UNSIGNED_BYTE,
+               supersample_mask_.data());
+  // One point per 2 x 2 block of pixels with one to sample: a software rasteriser shades
+  // blocks of 4 x 4 samples together, so isolated pixels would leave most of its lanes idle.
+  supersample_points_.clear();
+  const auto marked = [&](int x, int y) {
+    return x < target.width && y < target.height &&
+           supersample_mask_[std::size_t(y) * target.width + x] != 0;
+  };
+  for (int y = 0; y < target.height; y += 2) {
+    for (int x = 0; x < target.width; x += 2) {
+      if (marked(x, y) || marked(x + 1, y) || marked(x, y + 1) || marked(x + 1, y + 1)) {
+        supersample_points_.insert(supersample_points_.end(), {float(x + 1), float(y + 1)});
+      }
+    }
+  }
+  const auto points = static_cast<GLsizei>(supersample_points_.size() / 2);
+  glEnable(GL_DEPTH_TEST);
+  if (points == 0) {
+    glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
+    return;
+  }
+  glBindBuffer(GL_ARRAY_BUFFER, target.points_buffer);
+  glBufferData(GL_ARRAY_BUFFER, supersample_points_.size() * sizeof(float),
+               supersample_points_.data(), GL_STREAM_DRAW);
+  glBindBuffer(GL_ARRAY_BUFFER, 0);
+
+  glBindFramebuffer(GL_FRAMEBUFFER, target.samples_framebuffer);
+  glViewport(0, 0, w, h);
+  glEnable(GL_PROGRAM_POINT_SIZE);
+  glBindVertexArray(target.points_vao);
+  // The points set their samples to the background at the far plane and mark them in the
+  // stencil with this capture's value (other samples keep older values): nothing is cleared,
+  // and meshes are shaded at the marked samples only.
+  target.stencil = target.stencil % 255 + 1;
+  if (target.stencil == 1) glClearBufferfi(GL_DEPTH_STENCIL, 0, 0.0f, 0);
+  glEnable(GL_STENCIL_TEST);
+  glStencilFunc(GL_ALWAYS, target.stencil, 0xff);
+  glStencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
+  glDepthFunc(GL_ALWAYS);
+  Program& marker =
+      Context::get().program("supersample_points.vert", "supersample_marker.frag", "");
+  marker.use();
+  glUniform2f(marker.uniform("u_size"), float(target.width), float(target.height));
+  glUniform1f(marker.uniform("u_point_size"), float(2 * k));
+  glUniform4f(marker.uniform("u_background"), s.background[0], s.background[1], s.background[2],
+              1.0f);
+  glDrawArrays(GL_POINTS, 0, points);
+  glBindVertexArray(0);
+  glDepthFunc(GL_GREATER);
+  glStencilFunc(GL_EQUAL, target.stencil, 0xff);
+  glStencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
+  auto point_uniforms = [&](Program& program) {
+    glUniform2f(program.uniform("u_size"), float(target.width), float(target.height));
+    glUniform1f(program.uniform("u_point_size"), float(2 * k));
+  };
+  SurfacePass meshes = shading;
+  meshes.volumes = false;
+  Program& program =
+      Context::get().program("mesh.vert", "mesh.frag", s.lights->defines() + "#define SHADE 1\n");
+  program.use();
+  draw_surfaces(s, program, s.camera_pose, s.projection, kPassRgb, meshes);
+  glDisable(GL_STENCIL_TEST);
+  // Volumes cast one ray per sample, from the points.
+  SurfacePass volumes = shading;
+  volumes.meshes = false;
+  volumes.points_vao = target.points_vao;
+  volumes.points = points;
+  volumes.setup = [&](Program& p) {
+    if (shading.setup) shading.setup(p);
+    point_uniforms(p);
+  };
+  draw_surfaces(s, program, s.camera_pose, s.projection, kPassRgb, volumes);
+
+  // Their means replace the marked pixels' colours.
+  constexpr int kMaskUnit = 7;
+  glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
+  const GLenum colour_only[1] = {GL_COLOR_ATTACHMENT0};
+  glDrawBuffers(1, colour_only);
+  glViewport(0, 0, target.width, target.height);
+  glDisable(GL_DEPTH_TEST);
+  Program& resolve =
+      Context::get().program("supersample_points.vert", "supersample_resolve.frag", "");
+  resolve.use();
+  glActiveTexture(GL_TEXTURE0);
+  glBindTexture(GL_TEXTURE_2D, target.samples[0]);
+  glUniform1i(resolve.uniform("u_samples"), 0);
+  glActiveTexture(GL_TEXTURE0 + kMaskUnit);
+  glBindTexture(GL_TEXTURE_2D, target.mask);
+  glUniform1i(resolve.uniform("u_supersample_mask"), kMaskUnit);
+  glUniform1i(resolve.uniform("u_supersample_factor"), k);
+  glUniform2f(resolve.uniform("u_size"), float(target.width), float(target.height));
+  glUniform1f(resolve.uniform("u_point_size"), 2.0f);
+  glBindVertexArray(target.points_vao);
+  glDrawArrays(GL_POINTS, 0, points);
+  glBindVertexArray(0);
+  glDisable(GL_PROGRAM_POINT_SIZE);
+  glBindTexture(GL_TEXTURE_2D, 0);
+  glActiveTexture(GL_TEXTURE0);
+  glBindTexture(GL_TEXTURE_2D, 0);
+  glEnable(GL_DEPTH_TEST);
+  check_gl("supersampling the rgb pass");
 }
 
 template <typename ShaderOf>

@@ -3,12 +3,15 @@
 #include <epoxy/gl.h>
 
 #include <array>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
+
+#include <Eigen/Geometry>
 
 #include "ambfplus/capture/frame.h"
 #include "ambfplus/render/renderer.h"
@@ -31,7 +34,8 @@ struct VolumeUpload;
 /// A mesh in GPU buffers.
 struct GpuMesh {
   GLuint vao = 0;
-  GLuint legacy_vao = 0;  // AMBF's attribute layout, made when a legacy shader first draws it
+  Eigen::AlignedBox3d bounds;  // of the mesh's finite vertices (empty when none or homogeneous)
+  GLuint legacy_vao = 0;       // AMBF's attribute layout, made when a legacy shader first draws it
   GLuint buffers[3] = {0, 0, 0};  // positions, normals, indices
   GLuint texcoords = 0;           // u, v per vertex; 0 when the mesh has none
   GLsizei index_count = 0;
@@ -46,9 +50,39 @@ struct RenderTarget {
   GLuint framebuffer = 0;
   // colour (RGBA8), depth (R32F), label (R16UI), instance (R32I), voxel (R32I), segmentation
   // (RGBA8), depth test (D32F)
-  GLuint renderbuffers[kBuffers] = {};
+  GLuint textures[kBuffers] = {};
   int width = 0;
   int height = 0;
+  // Supersampling of the rgb pass (made when first asked for, remade for another factor): the
+  // k x k larger colour and depth test, and the mask of the pixels supersampled.
+  int factor = 0;
+  GLuint samples_framebuffer = 0, samples[2] = {0, 0};  // colour, depth and stencil
+  GLuint mask_framebuffer = 0, mask = 0;
+  GLuint points_vao = 0, points_buffer = 0;  // the pixels to sample, as points
+  int stencil = 0;  // the stencil value marking this capture's samples (1..255)
+};
+
+/// A light's shadow map (kept across captures while what casts shadows stays put).
+struct ShadowMap {
+  GLuint texture = 0, framebuffer = 0;
+  int size = 0;
+  std::size_t key = 0;                                        // what it was drawn of
+  Eigen::Matrix4d clip_from_world = Eigen::Matrix4d::Zero();  // the light's clip space
+  Eigen::Vector2d texel = Eigen::Vector2d::Zero();  // a texel's size, x + y * clip w (metres)
+};
+
+/// How one drawing of a snapshot's surfaces differs from the camera's main one: extra shader
+/// defines and uniforms (shadow maps, the supersampling mask), or parallel rays (a directional
+/// light's shadow map).
+struct SurfacePass {
+  std::string defines;
+  std::function<void(Program&)> setup;  // after the program's own uniforms
+  bool orthographic = false;            // volumes: parallel rays along the view's z
+  bool meshes = true, volumes = true;   // what is drawn
+  // Volumes drawn as these points (supersampling: one per pixel to sample, k x k sub-pixels
+  // wide) rather than as their boxes; 0 for none.
+  GLuint points_vao = 0;
+  GLsizei points = 0;
 };
 
 /// What one camera sees at one step: everything a draw needs, copied out of the world while its
@@ -86,6 +120,8 @@ struct Snapshot {
   std::array<float, 3> background{};
   std::optional<ShaderSpec> preprocessing;
   unsigned passes = 0;
+  bool shadows = false;
+  int antialiasing = 1;
   double time = 0.0;
   std::optional<LightSet> lights;  // in the camera frame
   std::vector<Body> bodies;
@@ -143,6 +179,15 @@ class SceneRenderer : public Renderer {
   /// fills frame.
   void snapshot(const Camera& camera, unsigned passes, const PoseRequest& poses, Snapshot& snapshot,
                 Frame& frame);
+  /// Draws the snapshot's meshes and volumes with `program` (the mesh shader, in use, its
+  /// per-camera uniforms set) from the view (pose, projection), for the passes.
+  void draw_surfaces(const Snapshot& snapshot, Program& program, const Eigen::Isometry3d& view,
+                     const Eigen::Matrix4d& projection, unsigned passes, const SurfacePass& pass);
+  /// Brings the shadow maps of the snapshot's shadow casters up to date (drawn again only when
+  /// what they show changed) and gives their uniforms for the snapshot's camera.
+  ShadowUniforms shadow_maps(const Snapshot& snapshot);
+  /// Supersamples the rgb pass of the last draw where its passes show edges or contrast.
+  void supersample(const Snapshot& snapshot, RenderTarget& target, const SurfacePass& shading);
   /// Frees what objects that left the world used (needs a Context::Scope).
   void release_unused();
   void release_all();
@@ -160,11 +205,14 @@ class SceneRenderer : public Renderer {
   void overlay(const Snapshot& snapshot, GLenum attachment, ShaderOf shader_of);
 
   World& world_;
-  std::map<const MeshData*, GpuMesh> meshes_;  // each keeps its source alive: no address reuse
-  std::map<int, GpuMesh> soft_meshes_;         // by soft body id; vertices change every frame
-  std::vector<float> soft_scratch_;            // positions then normals of one soft body
-  std::map<int, RenderTarget> targets_;        // by camera id
-  std::map<std::string, GLuint> textures_;     // by image file
+  std::map<const MeshData*, GpuMesh> meshes_;   // each keeps its source alive: no address reuse
+  std::map<int, GpuMesh> soft_meshes_;          // by soft body id; vertices change every frame
+  std::vector<float> soft_scratch_;             // positions then normals of one soft body
+  std::map<int, RenderTarget> targets_;         // by camera id
+  std::map<std::string, GLuint> textures_;      // by image file
+  std::map<int, ShadowMap> shadow_maps_;        // by light id
+  std::vector<std::uint8_t> supersample_mask_;  // scratch: the pixels to supersample
+  std::vector<float> supersample_points_;       // scratch: their coordinates
   mutable std::mutex volumes_mutex_;  // volumes_ grows during takes, which may overlap draws
   std::map<int, std::unique_ptr<GpuVolume>> volumes_;  // by volume id
   // Ids of objects that left the world, and whether a mesh may have lost its last body;

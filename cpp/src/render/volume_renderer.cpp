@@ -329,6 +329,7 @@ void GpuVolume::upload() {
     pending.swap(pending_);
   }
   if (pending.empty()) return;
+  ++generation_;
   const auto start = std::chrono::steady_clock::now();
   const bool created = vao_ == 0;
   if (created) create_textures();
@@ -366,26 +367,46 @@ VolumeUpload GpuVolume::last_upload() const {
   return last_upload_;
 }
 
-void GpuVolume::draw(const Snapshot::Volume& volume, const Snapshot& snapshot) {
-  const unsigned passes = snapshot.passes;
-  const LightSet& lights = *snapshot.lights;
+void GpuVolume::draw(const Snapshot::Volume& volume, const Eigen::Isometry3d& view,
+                     const Eigen::Matrix4d& projection, unsigned passes, const LightSet& lights,
+                     const SurfacePass& pass) {
   const std::string defines =
       lights.defines() + "#define EMPTY_SPACE_SKIPPING " + (volume.skipping ? "1" : "0") + "\n" +
       ((passes & kPassRgb) ? "#define SHADE 1\n" : "#define SHADE 0\n") +
+      (pass.orthographic ? "#define ORTHOGRAPHIC 1\n" : "") +
+      (pass.points_vao != 0 ? "#define FROM_PIXELS 1\n" : "") + pass.defines +
       (std::getenv("AMBFPLUS_DEBUG_VOLUME_STEPS") ? "#define DEBUG_STEPS 1\n" : "");
-  Program& program = Context::get().program("volume.vert", "volume.frag", defines);
+  Program& program = Context::get().program(
+      pass.points_vao != 0 ? "supersample_points.vert" : "volume.vert", "volume.frag", defines);
   program.use();
   const Eigen::Vector3d s = data_->voxel_size();
   Eigen::Matrix4d volume_from_voxel = Eigen::Matrix4d::Identity();
   volume_from_voxel.topLeftCorner<3, 3>() = s.asDiagonal();
   volume_from_voxel.topRightCorner<3, 1>() = -data_->dimensions() / 2;
   const Eigen::Matrix4d camera_from_voxel =
-      snapshot.camera_pose.inverse().matrix() * volume.pose.matrix() * volume_from_voxel;
-  const Eigen::Matrix4d clip_from_voxel = snapshot.projection * camera_from_voxel;
-  const Eigen::Vector3d eye = (camera_from_voxel.inverse() * Eigen::Vector4d(0, 0, 0, 1)).head<3>();
+      view.inverse().matrix() * volume.pose.matrix() * volume_from_voxel;
+  const Eigen::Matrix4d clip_from_voxel = projection * camera_from_voxel;
+  const Eigen::Matrix4d voxel_from_camera = camera_from_voxel.inverse();
+  const Eigen::Vector3d eye = (voxel_from_camera * Eigen::Vector4d(0, 0, 0, 1)).head<3>();
   const Eigen::Matrix3d normal_from_voxel =
       camera_from_voxel.topLeftCorner<3, 3>().inverse().transpose();
   const auto& n = data_->shape();
+  if (pass.orthographic) {
+    // Rays along the view's z, starting behind the box by more than its diagonal.
+    const Eigen::Vector3d dir = (voxel_from_camera * Eigen::Vector4d(0, 0, 1, 0)).head<3>();
+    const Eigen::Vector3d dir_unit = dir.normalized();
+    glUniform3f(program.uniform("u_ray_dir"), float(dir_unit.x()), float(dir_unit.y()),
+                float(dir_unit.z()));
+    glUniform1f(program.uniform("u_ray_back"),
+                float(2.0 * Eigen::Vector3d(n[0], n[1], n[2]).norm() + 1.0));
+  }
+  if (pass.points_vao != 0) {
+    const Eigen::Matrix4f voxel_from_clip = clip_from_voxel.inverse().cast<float>();
+    glUniformMatrix4fv(program.uniform("u_voxel_from_clip"), 1, GL_FALSE, voxel_from_clip.data());
+    GLint viewport[4];
+    glGetIntegerv(GL_VIEWPORT, viewport);
+    glUniform2f(program.uniform("u_viewport"), float(viewport[2]), float(viewport[3]));
+  }
   const Eigen::Matrix4f clip_f = clip_from_voxel.cast<float>();
   const Eigen::Matrix4f camera_f = camera_from_voxel.cast<float>();
   const Eigen::Matrix3f normal_f = normal_from_voxel.cast<float>();
@@ -415,6 +436,14 @@ void GpuVolume::draw(const Snapshot::Volume& volume, const Snapshot& snapshot) {
     glUniform1i(program.uniform(units[u].name), u);
   }
   glActiveTexture(GL_TEXTURE0);
+  if (pass.setup) pass.setup(program);
+  if (pass.points_vao != 0) {
+    glBindVertexArray(pass.points_vao);
+    glDrawArrays(GL_POINTS, 0, pass.points);
+    glBindVertexArray(0);
+    check_gl("ray casting a volume's samples");
+    return;
+  }
   // One fragment per covered pixel, also with the camera inside the box: draw the back faces.
   glEnable(GL_CULL_FACE);
   glCullFace(GL_FRONT);

@@ -54,8 +54,14 @@ class GpuVolume {
   /// Sends what was staged to the GPU (creating the textures the first time).
   void upload();
   /// Ray casts a snapshot's volume into the bound framebuffer, after the meshes and
-  /// depth-tested, for the snapshot's passes (shading only with rgb).
-  void draw(const Snapshot::Volume& volume, const Snapshot& snapshot);
+  /// depth-tested, seen from view (world from the view's OpenCV-like frame) through projection,
+  /// for the passes (shading only with rgb), changed as pass says.
+  void draw(const Snapshot::Volume& volume, const Eigen::Isometry3d& view,
+            const Eigen::Matrix4d& projection, unsigned passes, const LightSet& lights,
+            const SurfacePass& pass);
+  /// Counts the uploads that changed what the GPU holds (a shadow map drawn of an older count
+  /// is out of date).
+  std::int64_t generation() const { return generation_; }
   VolumeUpload last_upload() const;
   const std::shared_ptr<VolumeData>& data() const { return data_; }
 
@@ -109,6 +115,7 @@ class GpuVolume {
   std::vector<std::uint8_t> brick_max_;
   std::vector<std::uint8_t> distances_;
   double distance_level_ = -1;
+  std::int64_t generation_ = 0;
 };
 
 }  // namespace ambfplus::render

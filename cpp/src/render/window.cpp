@@ -38,8 +38,8 @@ void draw_through_lens(const render::RenderTarget& target, const LensDistortion&
     texture[1] = static_cast<GLuint>(target.width);
     texture[2] = static_cast<GLuint>(target.height);
   }
-  glCopyImageSubData(target.renderbuffers[0], GL_RENDERBUFFER, 0, 0, 0, 0, texture[0],
-                     GL_TEXTURE_2D, 0, 0, 0, 0, target.width, target.height, 1);
+  glCopyImageSubData(target.textures[0], GL_TEXTURE_2D, 0, 0, 0, 0, texture[0], GL_TEXTURE_2D, 0, 0,
+                     0, 0, target.width, target.height, 1);
   std::array<float, 2> centre{0.5f, 0.5f};
   if (!lens.centres.empty()) {
     centre = lens.centres[std::min(static_cast<std::size_t>(view), lens.centres.size() - 1)];

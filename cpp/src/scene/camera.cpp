@@ -18,6 +18,8 @@ Camera::Camera(Model& model, const CameraSpec& spec, int id)
       far_(spec.far),
       cx_(spec.width / 2.0),
       cy_(spec.height / 2.0),
+      shadows_(spec.shadows),
+      antialiasing_(spec.antialiasing),
       background_(spec.background),
       publish_(spec.publish) {
   spec.validate();
@@ -71,6 +73,15 @@ void Camera::set_fov_y(double fov_y) {
                         std::to_string(fov_y));
   }
   fov_y_ = fov_y;
+}
+
+void Camera::set_antialiasing(int k) {
+  if (k < 1 || k > kMaxAntialiasing) {
+    throw ArgumentError("camera '" + name() + "': antialiasing must be 1 (off) to " +
+                        std::to_string(kMaxAntialiasing) + " samples per axis, got " +
+                        std::to_string(k));
+  }
+  antialiasing_ = k;
 }
 
 void Camera::set_passes(unsigned passes) {

@@ -51,6 +51,11 @@ void CameraSpec::validate() const {
                         std::to_string(near) + ", far " + std::to_string(far));
   }
   check_rgb(background, "camera '" + name + "'", "background");
+  if (antialiasing < 1 || antialiasing > kMaxAntialiasing) {
+    throw ArgumentError(who + "antialiasing must be 1 (off) to " +
+                        std::to_string(kMaxAntialiasing) + " samples per axis, got " +
+                        std::to_string(antialiasing));
+  }
   if (publish.image_interval < 1 || publish.depth_interval < 1) {
     throw ArgumentError(who + "publish intervals must be >= 1");
   }
@@ -73,6 +78,10 @@ const OptionTable<CameraSpec>& camera_options() {
             [](S& s, V v, K k) { s.pose = v.matrix4(k); }},
           O{"background", "tuple[float, float, float]", "RGB in 0..1 where nothing is hit",
             [](S& s, V v, K k) { s.background = rgb(v, k); }},
+          O{"shadows", "bool", "lights with a shadow_quality cast shadows in rgb",
+            [](S& s, V v, K k) { s.shadows = v.boolean(k); }},
+          O{"antialiasing", "int", "rgb supersampling per axis, 1 (off) to 4",
+            [](S& s, V v, K k) { s.antialiasing = v.integer(k); }},
       });
   return table;
 }
@@ -112,6 +121,11 @@ void LightSpec::validate() const {
   require_non_negative(spot_cutoff, who, "spot cutoff");
   require_non_negative(spot_exponent, who, "spot exponent");
   for (float a : attenuation) require_non_negative(a, who, "attenuation");
+  if (shadow_quality < 0 || shadow_quality > kMaxShadowQuality) {
+    throw ArgumentError(who + ": shadow_quality must be 0 (none) to " +
+                        std::to_string(kMaxShadowQuality) + ", got " +
+                        std::to_string(shadow_quality));
+  }
 }
 
 const OptionTable<LightSpec>& light_options() {
@@ -140,6 +154,8 @@ const OptionTable<LightSpec>& light_options() {
               s.attenuation = {static_cast<float>(a[0]), static_cast<float>(a[1]),
                                static_cast<float>(a[2])};
             }},
+          O{"shadow_quality", "int", "0 (no shadow) to 5: shadow maps of 256 to 4096 texels",
+            [](S& s, V v, K k) { s.shadow_quality = v.integer(k); }},
       });
   return table;
 }

@@ -13,7 +13,8 @@ Light::Light(Model& model, const LightSpec& spec, int id)
       intensity_(spec.intensity),
       spot_cutoff_(spec.spot_cutoff),
       spot_exponent_(spec.spot_exponent),
-      attenuation_(spec.attenuation) {
+      attenuation_(spec.attenuation),
+      shadow_quality_(spec.shadow_quality) {
   spec.validate();
   const double n = spec.direction.norm();
   // Any rotation whose z axis is the direction will do; pick the one nearest the identity.
@@ -23,6 +24,14 @@ Light::Light(Model& model, const LightSpec& spec, int id)
       Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), z).toRotationMatrix();
   pose.translation() = spec.position;
   set_pose(pose);
+}
+
+void Light::set_shadow_quality(int quality) {
+  if (quality < 0 || quality > kMaxShadowQuality) {
+    throw ArgumentError("light '" + name() + "': shadow_quality must be 0 (none) to " +
+                        std::to_string(kMaxShadowQuality) + ", got " + std::to_string(quality));
+  }
+  shadow_quality_ = quality;
 }
 
 Eigen::Vector3d Light::direction() const { return pose().linear().col(2).normalized(); }

@@ -24,6 +24,9 @@ struct AMBFPLUS_API CameraPublish {
   double noise_mean = 0.1, noise_std = 0.001, noise_bias = 0.0;  ///< its mean, std_dev, bias
 };
 
+/// The largest rgb supersampling factor per axis (Camera::set_antialiasing).
+constexpr int kMaxAntialiasing = 4;
+
 /// Everything needed to create a camera. Defaults are AMBF's (fva 0.7 rad, near 0.1, far 10).
 struct AMBFPLUS_API CameraSpec {
   std::string name;
@@ -35,6 +38,8 @@ struct AMBFPLUS_API CameraSpec {
   Eigen::Matrix4d pose = Eigen::Matrix4d::Identity();
   std::array<float, 3> background{0.0f, 0.0f, 0.0f};  ///< RGB, 0..1, where nothing is hit
   CameraPublish publish;
+  bool shadows = false;  ///< lights cast shadows in the rgb pass (see Camera::shadows)
+  int antialiasing = 1;  ///< rgb supersampling factor per axis, 1 (off) to 4
 
   /// Throws ArgumentError naming the camera and the value unless every value can be used (size
   /// 1..16384, fov_y in (0, pi), 0 < near < far, a rigid pose, background in 0..1, intervals
@@ -42,7 +47,8 @@ struct AMBFPLUS_API CameraSpec {
   void validate() const;
 };
 
-/// add_camera's keyword options: width, height, fov_y, near, far, pose, background.
+/// add_camera's keyword options: width, height, fov_y, near, far, pose, background, shadows,
+/// antialiasing.
 AMBFPLUS_API const OptionTable<CameraSpec>& camera_options();
 
 /// A pinhole camera in the OpenCV frame (x right, y down, z forward). pose() is world from camera.
@@ -85,6 +91,16 @@ class AMBFPLUS_API Camera : public Object {
   /// OpenGL clip from camera (OpenCV frame), mapping image row 0 to the first row read back.
   Eigen::Matrix4d projection() const;
 
+  /// Whether the rgb pass draws shadows of the lights whose shadow_quality is above 0
+  /// (directional and spot lights). Ground-truth passes never change.
+  bool shadows() const { return shadows_; }
+  void set_shadows(bool on) { shadows_ = on; }
+  /// The rgb pass's supersampling factor per axis: 1 is off, k (2..4) shades k x k samples in
+  /// each pixel where edges or contrast need them and averages them. Ground-truth passes stay
+  /// one exact sample at each pixel centre. ArgumentError outside 1..4.
+  int antialiasing() const { return antialiasing_; }
+  void set_antialiasing(int k);
+
  private:
   friend class Model;
   Camera(Model& model, const CameraSpec& spec, int id);
@@ -96,6 +112,8 @@ class AMBFPLUS_API Camera : public Object {
   double far_;
   double cx_, cy_;
   unsigned passes_ = kDefaultPasses;
+  bool shadows_ = false;
+  int antialiasing_ = 1;
   std::array<float, 3> background_;
   CameraPublish publish_;
   std::optional<ShaderSpec> preprocessing_shader_;

@@ -4,7 +4,10 @@
 
 demo_montage.png and demo_passes.png come from `ambfplus demo`; launcher.png is a window of
 `ambfplus-launch` (on a virtual X display: Xvfb and xdotool) drilling the built-in phantom, written
-as AMBF files (slice stack, model and launch file), with a task's status line and fixtures on.
+as AMBF files (slice stack, model and launch file), with a task's status line and fixtures on;
+phantom_vs_ear.png is the built-in phantom beside the original system's 256^3 segmented ear (the
+shared fixture, read from ../shared/fixtures or AMBFPLUS_FIXTURES; only its rendering is kept),
+both at 256^3 with their lateral surfaces up, under the same camera and lights.
 """
 
 from __future__ import annotations
@@ -38,6 +41,37 @@ def demo_images(work: Path) -> None:
         view = Image.open(out / f"{name}.png").convert("RGB").crop(box)
         strip.paste(view.resize((size, size), Image.LANCZOS), (k * (size + gap), 0))
     strip.save(IMAGES / "demo_passes.png", optimize=True)
+
+
+FIXTURES = Path(os.environ.get("AMBFPLUS_FIXTURES", ROOT.parent / "shared" / "fixtures"))
+
+
+def phantom_vs_ear() -> None:
+    import numpy as np
+
+    import ambfplus
+    from ambfplus.transforms import make_pose
+
+    ear_files = FIXTURES / "volumetric_drilling"
+    ear = ambfplus.load_volume(
+        ear_files / "ADF" / "volume_256.yaml", labels=ear_files / "labels.csv"
+    )
+    # The ear's pose in its launch file turns its lateral surface towards +x (where the drill
+    # starts); a quarter turn about y then puts it up, as the phantom's.
+    lateral_up = make_pose(rpy=(0.0, -np.pi / 2, 0.0)) @ make_pose(rpy=(1.57079, 1.4, 0.0))
+    views = []
+    for data, pose in ((ambfplus.phantom(256, 0, side="right"), np.eye(4)), (ear, lateral_up)):
+        world = ambfplus.World()
+        world.add_volume("anatomy", data, pose=pose)
+        world.add_light("key", "directional", direction=(-0.3, 0.4, -1.0), intensity=0.8)
+        world.add_light("fill", "point", position=(0.15, -0.2, 0.3), intensity=0.3)
+        camera = world.add_camera("camera", 480, 480, 0.5, 0.01, 10.0, shadows=True,
+                                  antialiasing=2)  # fmt: skip
+        camera.look_at(eye=(0.0, -0.06, 0.12), target=(0.0, 0.0, 0.004))
+        views.append(np.asarray(camera.capture(passes=["rgb"]).rgb))
+    Image.fromarray(np.concatenate(views, axis=1)).save(
+        IMAGES / "phantom_vs_ear.png", optimize=True
+    )
 
 
 def launcher_image(work: Path) -> None:
@@ -144,4 +178,5 @@ if __name__ == "__main__":
     with tempfile.TemporaryDirectory() as work:
         if "--launcher" not in sys.argv:
             demo_images(Path(work))
+            phantom_vs_ear()
         launcher_image(Path(work))

@@ -492,9 +492,9 @@ class World:
         """
         Adds a rigid body: shape is box (size = full extents), sphere (radius), cylinder, capsule or cone (radius, height along axis, z unless axis='x' or 'y'; a capsule's height includes its caps), plane (z = 0, infinite) or mesh (mesh = file, scale; the default when mesh is given); pose is a 4x4 world-from-body matrix. Physics (mass > 0 moves under gravity; 0 is static): inertia, inertial_offset (4x4), friction, rolling_friction, restitution, linear_damping, angular_damping, kinematic, gravity ((x, y, z) m/s^2: its own instead of the world's), collision (False: none), collision_mesh, collision_type (concave, convex_mesh, convex_hull, point_cloud), collision_shapes ([{shape, size/radius/height/axis, pose}]), margin, groups ([0..31]), axis.
         """
-    def add_camera(self, name: str, width: typing.SupportsInt | typing.SupportsIndex = 640, height: typing.SupportsInt | typing.SupportsIndex = 480, fov_y: typing.SupportsFloat | typing.SupportsIndex = 0.7, near: typing.SupportsFloat | typing.SupportsIndex = 0.1, far: typing.SupportsFloat | typing.SupportsIndex = 10.0, *, pose: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"] | None = None, background: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex] = [0.0, 0.0, 0.0], shadows: bool = False, antialiasing: typing.SupportsInt | typing.SupportsIndex = 1) -> Camera:
+    def add_camera(self, name: str, width: typing.SupportsInt | typing.SupportsIndex = 640, height: typing.SupportsInt | typing.SupportsIndex = 480, fov_y: typing.SupportsFloat | typing.SupportsIndex = 0.7, near: typing.SupportsFloat | typing.SupportsIndex = 0.1, far: typing.SupportsFloat | typing.SupportsIndex = 10.0, *, pose: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"] | None = None, background: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex] = [0.0, 0.0, 0.0], shadows: bool = False, antialiasing: typing.SupportsInt | typing.SupportsIndex = 1, looks: bool = False) -> Camera:
         """
-        Adds a pinhole camera (OpenCV frame: x right, y down, z forward); fov_y is the vertical field of view in radians, near and far the clipping distances in metres. shadows and antialiasing (supersampling per axis, 1..4) change the rgb pass only.
+        Adds a pinhole camera (OpenCV frame: x right, y down, z forward); fov_y is the vertical field of view in radians, near and far the clipping distances in metres. shadows, antialiasing (supersampling per axis, 1..4) and looks (volumes' ambient occlusion, bone texture and wet highlights) change the rgb pass only.
         """
     def add_drill(self, name: str, volume: Volume, **kwargs) -> Drill:
         """
@@ -780,9 +780,9 @@ class Model:
         """
         Adds a rigid body: shape is box (size = full extents), sphere (radius), cylinder, capsule or cone (radius, height along axis, z unless axis='x' or 'y'; a capsule's height includes its caps), plane (z = 0, infinite) or mesh (mesh = file, scale; the default when mesh is given); pose is a 4x4 world-from-body matrix. Physics (mass > 0 moves under gravity; 0 is static): inertia, inertial_offset (4x4), friction, rolling_friction, restitution, linear_damping, angular_damping, kinematic, gravity ((x, y, z) m/s^2: its own instead of the world's), collision (False: none), collision_mesh, collision_type (concave, convex_mesh, convex_hull, point_cloud), collision_shapes ([{shape, size/radius/height/axis, pose}]), margin, groups ([0..31]), axis.
         """
-    def add_camera(self, name: str, width: typing.SupportsInt | typing.SupportsIndex = 640, height: typing.SupportsInt | typing.SupportsIndex = 480, fov_y: typing.SupportsFloat | typing.SupportsIndex = 0.7, near: typing.SupportsFloat | typing.SupportsIndex = 0.1, far: typing.SupportsFloat | typing.SupportsIndex = 10.0, *, pose: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"] | None = None, background: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex] = [0.0, 0.0, 0.0], shadows: bool = False, antialiasing: typing.SupportsInt | typing.SupportsIndex = 1) -> Camera:
+    def add_camera(self, name: str, width: typing.SupportsInt | typing.SupportsIndex = 640, height: typing.SupportsInt | typing.SupportsIndex = 480, fov_y: typing.SupportsFloat | typing.SupportsIndex = 0.7, near: typing.SupportsFloat | typing.SupportsIndex = 0.1, far: typing.SupportsFloat | typing.SupportsIndex = 10.0, *, pose: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"] | None = None, background: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex] = [0.0, 0.0, 0.0], shadows: bool = False, antialiasing: typing.SupportsInt | typing.SupportsIndex = 1, looks: bool = False) -> Camera:
         """
-        Adds a pinhole camera (OpenCV frame: x right, y down, z forward); fov_y is the vertical field of view in radians, near and far the clipping distances in metres. shadows and antialiasing (supersampling per axis, 1..4) change the rgb pass only.
+        Adds a pinhole camera (OpenCV frame: x right, y down, z forward); fov_y is the vertical field of view in radians, near and far the clipping distances in metres. shadows, antialiasing (supersampling per axis, 1..4) and looks (volumes' ambient occlusion, bone texture and wet highlights) change the rgb pass only.
         """
     def add_drill(self, name: str, volume: Volume, **kwargs) -> Drill:
         """
@@ -994,6 +994,14 @@ class Camera(Object):
         """
         3x3 K: fx = fy = H / (2 tan(fov_y / 2)), cx = W / 2, cy = H / 2; pixel (row r, column c) is centred at (c + 0.5, r + 0.5)
         """
+    @property
+    def looks(self) -> bool:
+        """
+        whether the rgb pass gives volumes ambient occlusion from their occupancy, a world-fixed bone texture (the CT intensity where the volume has one) and wet specular highlights; ground-truth passes never change
+        """
+    @looks.setter
+    def looks(self, arg1: bool) -> None:
+        ...
     @property
     def near(self) -> float:
         ...

@@ -97,9 +97,10 @@ class StereoRig:
     ``StereoRig(world, "rig", baseline=0.065, width=640, height=480, fov_y=...)`` makes cameras
     ``rig_left`` and ``rig_right``; ``working_distance`` (metres) makes it off-axis;
     ``background`` (RGB 0..1) is what both show where nothing is hit, and
-    ``principal_point_offset`` (pixels) moves both principal points alike; ``shadows`` and
-    ``antialiasing`` (supersampling per axis, 1 = off) change both cameras' rgb pass only
-    (``Camera.shadows``, ``Camera.antialiasing``). Move it with
+    ``principal_point_offset`` (pixels) moves both principal points alike; ``shadows``,
+    ``antialiasing`` (supersampling per axis, 1 = off) and ``looks`` (volumes' ambient
+    occlusion, bone texture and wet highlights) change both cameras' rgb pass only
+    (``Camera.shadows``, ``Camera.antialiasing``, ``Camera.looks``). Move it with
     ``look_at`` or ``pose`` (the left camera's). ``StereoRig.from_cameras(left, right)`` wraps two
     existing cameras (e.g. an ADF file's stereoL and stereoR), keeping their poses.
     """
@@ -119,6 +120,7 @@ class StereoRig:
         principal_point_offset=(0.0, 0.0),
         shadows: bool = False,
         antialiasing: int = 1,
+        looks: bool = False,
     ) -> None:
         if not baseline > 0:
             raise ValueError(f"baseline must be > 0 m, got {baseline}")
@@ -129,6 +131,7 @@ class StereoRig:
             "background": list(background),
             "shadows": shadows,
             "antialiasing": antialiasing,
+            "looks": looks,
         }
         left = world.add_camera(f"{name}_left", width, height, **options)
         right = world.add_camera(f"{name}_right", width, height, **options)

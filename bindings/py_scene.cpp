@@ -195,11 +195,13 @@ Joint& add_joint(Model& model, const std::string& name, RigidBody& parent, Rigid
 
 Camera& add_camera(Model& model, const std::string& name, int width, int height, double fov_y,
                    double near, double far, std::optional<Mat4> pose,
-                   const std::vector<double>& background, bool shadows, int antialiasing) {
+                   const std::vector<double>& background, bool shadows, int antialiasing,
+                   bool looks) {
   OptionMap o{{"width", width},     {"height", height},
               {"fov_y", fov_y},     {"near", near},
               {"far", far},         {"background", OptionValue::from_numbers(background)},
-              {"shadows", shadows}, {"antialiasing", antialiasing}};
+              {"shadows", shadows}, {"antialiasing", antialiasing},
+              {"looks", looks}};
   if (pose) o.push_back({"pose", mat(*pose)});
   return model.add_camera(make_spec(name, camera_options(), o));
 }
@@ -331,20 +333,22 @@ void def_adders(Class& cls, GetModel get_model) {
           "add_camera",
           [get_model](Self& self, const std::string& name, int width, int height, double fov_y,
                       double near, double far, std::optional<Mat4> pose,
-                      const std::vector<double>& background, bool shadows, int antialiasing) {
+                      const std::vector<double>& background, bool shadows, int antialiasing,
+                      bool looks) {
             Model& model = get_model(self);
             auto lock = lock_holding_gil(model.world());  // see the thread-safety contract
             return handle(&add_camera(model, name, width, height, fov_y, near, far, pose,
-                                      background, shadows, antialiasing),
+                                      background, shadows, antialiasing, looks),
                           model.world());
           },
           py::arg("name"), py::arg("width") = 640, py::arg("height") = 480, py::arg("fov_y") = 0.7,
           py::arg("near") = 0.1, py::arg("far") = 10.0, py::kw_only(), py::arg("pose") = py::none(),
           py::arg("background") = std::vector<double>{0.0, 0.0, 0.0}, py::arg("shadows") = false,
-          py::arg("antialiasing") = 1,
+          py::arg("antialiasing") = 1, py::arg("looks") = false,
           "Adds a pinhole camera (OpenCV frame: x right, y down, z forward); fov_y is the "
           "vertical field of view in radians, near and far the clipping distances in metres. "
-          "shadows and antialiasing (supersampling per axis, 1..4) change the rgb pass only.")
+          "shadows, antialiasing (supersampling per axis, 1..4) and looks (volumes' ambient "
+          "occlusion, bone texture and wet highlights) change the rgb pass only.")
       .def(
           "add_light",
           [get_model](Self& self, const std::string& name, const KindOrName<LightSpec::Type>& type,
@@ -958,7 +962,11 @@ void define_camera(py::class_<Camera, Object, std::shared_ptr<Camera>>& camera) 
       .def_property("antialiasing", &Camera::antialiasing, &Camera::set_antialiasing,
                     "the rgb pass's supersampling per axis: 1 is off, k (2..4) averages k x k "
                     "samples in pixels at edges and contrasts; ground-truth passes stay one "
-                    "exact sample per pixel centre");
+                    "exact sample per pixel centre")
+      .def_property("looks", &Camera::looks, &Camera::set_looks,
+                    "whether the rgb pass gives volumes ambient occlusion from their occupancy, "
+                    "a world-fixed bone texture (the CT intensity where the volume has one) and "
+                    "wet specular highlights; ground-truth passes never change");
 }
 
 void define_volume_object(py::class_<Volume, Object, std::shared_ptr<Volume>>& volume) {

@@ -68,7 +68,12 @@ vec3 shade(vec3 base, vec3 n, vec3 to_eye, vec3 to_light, vec3 light_color) {
   float diffuse = max(dot(n, to_light), 0.0);
   float specular = 0.0;
   if (diffuse > 0.0) {
-    specular = pow(max(dot(n, normalize(to_light + to_eye)), 0.0), u_shininess) * u_specular;
+    float facing = max(dot(n, normalize(to_light + to_eye)), 0.0);
+    specular = pow(facing, u_shininess) * u_specular;
+#ifdef WET_SHININESS
+    // A wet surface: a second, sharper and brighter lobe over the material's own.
+    specular += pow(facing, WET_SHININESS) * u_specular * WET_GAIN;
+#endif
   }
   return light_color * (diffuse * base + specular);
 }

@@ -209,7 +209,8 @@ class HmdView:
             fov_y = 2 * math.atan(height / (2 * focal))
             camera = world.add_camera(f"{name}_{eye}", width, height, fov_y=fov_y,
                                       near=base.near, far=base.far, shadows=base.shadows,
-                                      antialiasing=base.antialiasing)  # fmt: skip
+                                      antialiasing=base.antialiasing,
+                                      looks=base.looks)  # fmt: skip
             camera.principal_point = (cx, cy)
             self.cameras.append(camera)
         self.update()
@@ -276,6 +277,7 @@ class XrView:
                         far=self.base.far,
                         shadows=self.base.shadows,
                         antialiasing=self.base.antialiasing,
+                        looks=self.base.looks,
                     )  # fmt: skip
                     for side, g in zip(("left", "right"), shapes)
                 ]

@@ -44,6 +44,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--shadows", type=boolean, default=True,
                    help="shadows of the lights with a 'shadow quality' in what the cameras show "
                    "and record (default true)")  # fmt: skip
+    p.add_argument("--looks", type=boolean, default=True,
+                   help="volumes' ambient occlusion, bone texture and wet highlights in what the "
+                   "cameras show and record (default true)")  # fmt: skip
     p.add_argument(
         "--antialiasing",
         type=int,

@@ -52,11 +52,13 @@ class LaunchSession:
             self.camera = cameras[0]
         else:
             raise SystemExit(f"ambfplus-launch: {launch} has no camera to show")
-        # What a trainee sees and a session records: shadows and anti-aliasing on unless told
-        # otherwise (--shadows false, --antialiasing 1); ground-truth passes never change.
+        # What a trainee sees and a session records: shadows, anti-aliasing and the volumes'
+        # looks on unless told otherwise (--shadows false, --antialiasing 1, --looks false);
+        # ground-truth passes never change.
         for camera in cameras:
             camera.shadows = args.shadows
             camera.antialiasing = args.antialiasing
+            camera.looks = args.looks
         self.drill = self.world.drills[0] if self.world.drills else None
         self.keyboard = KeyboardDevice()
         self.device, self.device_name = make_device(args, self.keyboard)

@@ -29,6 +29,7 @@ def _view_of(world, camera, width: int, height: int, name: str, x: float = 0.0):
             far=camera.far,
             shadows=camera.shadows,
             antialiasing=camera.antialiasing,
+            looks=camera.looks,
         )
         view.attach_to(camera, offset)
         view.pose = camera.pose @ offset

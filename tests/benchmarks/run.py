@@ -375,9 +375,9 @@ def stereo(args) -> Iterator[dict]:
             times.append(time.process_time() - c0)
         return statistics.median(times)
 
-    def look(shadows: bool, antialiasing: int) -> None:
+    def look(shadows: bool, antialiasing: int, looks: bool = False) -> None:
         for camera in (rig.left, rig.right):
-            camera.shadows, camera.antialiasing = shadows, antialiasing
+            camera.shadows, camera.antialiasing, camera.looks = shadows, antialiasing, looks
 
     everything = ("rgb", "depth", "instance", "label")
     look(False, 1)
@@ -402,10 +402,11 @@ def stereo(args) -> Iterator[dict]:
             "ratio": round(cost / rgb, 3),
             "what": f"the {name} pass alone, relative to rgb alone",
         }
-    # Shadows (the fixture's lights and their shadow quality) and 2 x 2 supersampling, against
-    # everything off, rounds alternating so that machine noise hits both alike. The shadow maps
-    # are kept while nothing that casts moves; "redrawn" nudges the drill in view before each
-    # pair, so each pair draws them again (what a session pays while the drill moves).
+    # Shadows (the fixture's lights and their shadow quality), 2 x 2 supersampling and the
+    # volume looks (ambient occlusion, bone texture, wet highlights), against everything off,
+    # rounds alternating so that machine noise hits all alike. The shadow maps are kept while
+    # nothing that casts moves; "redrawn" nudges the drill in view before each pair, so each
+    # pair draws them again (what a session pays while the drill moves).
     lights = [(light.name, light.shadow_quality) for light in sim.world.lights]
     seen = rig.left.capture(passes=["instance"]).instance
     body = max(sim.world.bodies, key=lambda b: int((seen == b.id).sum()))  # the drill in view
@@ -420,7 +421,9 @@ def stereo(args) -> Iterator[dict]:
         rig.capture(passes)
         body.pose = pose
 
-    off, on, moving, shadows_only, antialiasing_only = [], [], [], [], []
+    off, on, moving, shadows_only, antialiasing_only, looks_only, shadows_antialiasing = (
+        [] for _ in range(7)
+    )
     for _ in range(repeats):
         look(False, 1)
         off.append(cpu_per_capture(everything))
@@ -428,7 +431,11 @@ def stereo(args) -> Iterator[dict]:
         shadows_only.append(cpu_per_capture(everything))
         look(False, 2)
         antialiasing_only.append(cpu_per_capture(everything))
+        look(False, 1, looks=True)
+        looks_only.append(cpu_per_capture(everything))
         look(True, 2)
+        shadows_antialiasing.append(cpu_per_capture(everything))
+        look(True, 2, looks=True)
         on.append(cpu_per_capture(everything))
         nudged(everything)
         c0 = time.process_time()
@@ -439,14 +446,16 @@ def stereo(args) -> Iterator[dict]:
         "unit": "CPU-s per stereo pair",
         "passes": "+".join(everything),
         "lights": lights,
-        "what": "drill + ear 256^3, stereoL/stereoR; on = shadows + antialiasing 2; baseline: "
-        "both off (the capture as before)",
+        "what": "drill + ear 256^3, stereoL/stereoR; on = shadows + antialiasing 2 + looks; "
+        "baseline: all off (the capture as before)",
     }
     figures = (
         ("on", on),
         ("on_shadow_maps_redrawn", moving),
         ("shadows_only", shadows_only),
         ("antialiasing_only", antialiasing_only),
+        ("looks_only", looks_only),
+        ("shadows_antialiasing", shadows_antialiasing),
     )
     for name, values in figures:
         yield {

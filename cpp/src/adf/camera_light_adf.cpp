@@ -81,7 +81,8 @@ CameraPlan plan_camera(const Doc& doc, const std::string& base_ns, const std::st
                           "passive",
                           "plugins",
                           "shadows",
-                          "antialiasing"});
+                          "antialiasing",
+                          "looks"});
   CameraPlan plan;
   plan.id = id;
   plan.ns = block_ns(doc, ctx, base_ns, id, n);
@@ -121,8 +122,10 @@ CameraPlan plan_camera(const Doc& doc, const std::string& base_ns, const std::st
   if (pub.image_interval < 1 || pub.depth_interval < 1) {
     fail(doc, n, id, "publish intervals must be >= 1");
   }
-  // ambfplus's own keys: the rgb pass's shadows and supersampling (ground truth never changes).
+  // ambfplus's own keys: the rgb pass's shadows, supersampling and volume looks (ground truth
+  // never changes).
   if (n["shadows"]) plan.spec.shadows = boolean(doc, n["shadows"], id, "shadows");
+  if (n["looks"]) plan.spec.looks = boolean(doc, n["looks"], id, "looks");
   if (n["antialiasing"]) {
     plan.spec.antialiasing = integer(doc, n["antialiasing"], id, "antialiasing");
     if (plan.spec.antialiasing < 1 || plan.spec.antialiasing > kMaxAntialiasing) {

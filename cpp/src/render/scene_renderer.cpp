@@ -261,7 +261,8 @@ void SceneRenderer::take(const Camera& camera, unsigned passes, Snapshot& s) {
     GpuVolume& gpu = gpu_volume(*volume);
     gpu.stage(volume->iso());
     s.volumes.push_back({&gpu, volume->pose(), volume->iso(), volume->specular(),
-                         volume->shininess(), volume->id(), volume->empty_space_skipping()});
+                         volume->shininess(), volume->id(), volume->empty_space_skipping(),
+                         camera.looks()});
   }
 }
 

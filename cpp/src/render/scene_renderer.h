@@ -110,6 +110,7 @@ struct Snapshot {
     float specular = 0.0f, shininess = 1.0f;
     int id = 0;
     bool skipping = true;
+    bool looks = false;  // the camera's Camera::looks, for the rgb pass
   };
 
   int camera_id = 0;

@@ -17,6 +17,44 @@ namespace {
 constexpr std::size_t kStagedBoxes = 8;
 constexpr std::int64_t kStagingSlack = 4096;
 
+// The intensity grid as 0..255 between its 2nd and 98th percentiles over the labelled voxels
+// (over all voxels where none is labelled): the albedo the looks give a volume with CT data.
+std::vector<std::uint8_t> normalized_intensity(VolumeData& data) {
+  const std::size_t n = static_cast<std::size_t>(data.voxel_count());
+  const bool int16 = data.intensity_type() == IntensityType::kInt16;
+  const void* raw = data.intensity_data();
+  auto value = [&](std::size_t i) {
+    return int16 ? float(static_cast<const std::int16_t*>(raw)[i])
+                 : static_cast<const float*>(raw)[i];
+  };
+  const bool wide = data.label_type() == LabelType::kUInt16;
+  auto labelled = [&](std::size_t i) {
+    return wide ? static_cast<const std::uint16_t*>(data.label_data())[i] != 0
+                : static_cast<const std::uint8_t*>(data.label_data())[i] != 0;
+  };
+  // A strided sample of about a million voxels is enough for two percentiles.
+  const std::size_t stride = std::max<std::size_t>(1, n / 1000000);
+  std::vector<float> sample;
+  for (std::size_t i = 0; i < n; i += stride) {
+    if (labelled(i)) sample.push_back(value(i));
+  }
+  if (sample.empty()) {
+    for (std::size_t i = 0; i < n; i += stride) sample.push_back(value(i));
+  }
+  auto percentile = [&](double q) {
+    auto at = sample.begin() + static_cast<std::ptrdiff_t>(q * double(sample.size() - 1));
+    std::nth_element(sample.begin(), at, sample.end());
+    return *at;
+  };
+  const float lo = percentile(0.02), hi = std::max(percentile(0.98), lo + 1e-6f);
+  std::vector<std::uint8_t> out(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const float t = std::clamp((value(i) - lo) / (hi - lo), 0.0f, 1.0f);
+    out[i] = static_cast<std::uint8_t>(t * 255.0f + 0.5f);
+  }
+  return out;
+}
+
 }  // namespace
 
 std::vector<std::uint8_t> brick_distances(const std::vector<std::uint8_t>& brick_max,
@@ -202,8 +240,8 @@ void GpuVolume::create_textures() {
 
 GpuVolume::~GpuVolume() {
   if (vao_ == 0) return;  // never uploaded
-  const GLuint textures[4] = {occupancy_, labels_, bricks_, colors_};
-  glDeleteTextures(4, textures);
+  const GLuint textures[5] = {occupancy_, labels_, bricks_, colors_, intensity_};
+  glDeleteTextures(intensity_ != 0 ? 5 : 4, textures);
   glDeleteBuffers(1, &vbo_);
   glDeleteVertexArrays(1, &vao_);
 }
@@ -261,6 +299,10 @@ void GpuVolume::stage(double iso) {
   staged_level_ = pending.level;
   if (boxes_.empty() && pending.colors.empty() && !level_changed) return;
   pending.full = first;
+  // The intensity grid is read once: drilling edits labels, never the CT.
+  if (first && data_->intensity_type() != IntensityType::kNone) {
+    pending.intensity = normalized_intensity(*data_);
+  }
   pending.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::lock_guard<std::mutex> lock(mutex_);
   pending_.push_back(std::move(pending));
@@ -342,6 +384,14 @@ void GpuVolume::upload() {
       glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, 256, p.color_rows, 0, GL_RGBA, GL_UNSIGNED_BYTE,
                    p.colors.data());
     }
+    if (!p.intensity.empty()) {
+      if (intensity_ == 0) intensity_ = make_texture_3d(GL_LINEAR, GL_CLAMP_TO_EDGE);
+      const auto& n = data_->shape();
+      glBindTexture(GL_TEXTURE_3D, intensity_);
+      glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+      glTexImage3D(GL_TEXTURE_3D, 0, GL_R8, n[0], n[1], n[2], 0, GL_RED, GL_UNSIGNED_BYTE,
+                   p.intensity.data());
+    }
     Derived derived;
     for (const Region& region : p.regions) derive(region, wide ? 2 : 1, derived);
     for (const Box& box : derived.labels) {
@@ -373,6 +423,7 @@ void GpuVolume::draw(const Snapshot::Volume& volume, const Eigen::Isometry3d& vi
   const std::string defines =
       lights.defines() + "#define EMPTY_SPACE_SKIPPING " + (volume.skipping ? "1" : "0") + "\n" +
       ((passes & kPassRgb) ? "#define SHADE 1\n" : "#define SHADE 0\n") +
+      ((passes & kPassRgb) && volume.looks ? "#define LOOKS 1\n" : "") +
       (pass.orthographic ? "#define ORTHOGRAPHIC 1\n" : "") +
       (pass.points_vao != 0 ? "#define FROM_PIXELS 1\n" : "") + pass.defines +
       (std::getenv("AMBFPLUS_DEBUG_VOLUME_STEPS") ? "#define DEBUG_STEPS 1\n" : "");
@@ -411,6 +462,7 @@ void GpuVolume::draw(const Snapshot::Volume& volume, const Eigen::Isometry3d& vi
   const Eigen::Matrix4f camera_f = camera_from_voxel.cast<float>();
   const Eigen::Matrix3f normal_f = normal_from_voxel.cast<float>();
   glUniform3f(program.uniform("u_shape"), float(n[0]), float(n[1]), float(n[2]));
+  glUniform3f(program.uniform("u_voxel_size"), float(s.x()), float(s.y()), float(s.z()));
   glUniform3f(program.uniform("u_eye"), float(eye.x()), float(eye.y()), float(eye.z()));
   glUniformMatrix4fv(program.uniform("u_clip_from_voxel"), 1, GL_FALSE, clip_f.data());
   glUniformMatrix4fv(program.uniform("u_camera_from_voxel"), 1, GL_FALSE, camera_f.data());
@@ -421,16 +473,18 @@ void GpuVolume::draw(const Snapshot::Volume& volume, const Eigen::Isometry3d& vi
   glUniform1f(program.uniform("u_specular"), volume.specular);
   glUniform1f(program.uniform("u_shininess"), volume.shininess);
   glUniform1i(program.uniform("u_instance"), volume.id);
+  glUniform1i(program.uniform("u_has_intensity"), intensity_ != 0 ? 1 : 0);
   lights.upload(program);
   const struct {
     const char* name;
     GLenum target;
     GLuint texture;
-  } units[4] = {{"u_occupancy", GL_TEXTURE_3D, occupancy_},
+  } units[5] = {{"u_occupancy", GL_TEXTURE_3D, occupancy_},
                 {"u_labels", GL_TEXTURE_3D, labels_},
                 {"u_bricks", GL_TEXTURE_3D, bricks_},
-                {"u_colors", GL_TEXTURE_2D, colors_}};
-  for (int u = 0; u < 4; ++u) {
+                {"u_colors", GL_TEXTURE_2D, colors_},
+                {"u_intensity", GL_TEXTURE_3D, intensity_}};
+  for (int u = 0; u < 5; ++u) {
     glActiveTexture(GL_TEXTURE0 + u);
     glBindTexture(units[u].target, units[u].texture);
     glUniform1i(program.uniform(units[u].name), u);

@@ -87,7 +87,8 @@ class GpuVolume {
     std::vector<Region> regions;
     std::vector<std::uint8_t> colors;  // RGBA rows of 256 label ids; empty: unchanged
     int color_rows = 0;
-    double level = 0.0;  // 0..255 of the smoothed occupancy that counts as surface
+    std::vector<std::uint8_t> intensity;  // the whole grid, 0..255 (the first stage only)
+    double level = 0.0;                   // 0..255 of the smoothed occupancy that counts as surface
     bool full = false;
     double seconds = 0.0;  // staging time
   };
@@ -101,6 +102,7 @@ class GpuVolume {
 
   std::shared_ptr<VolumeData> data_;
   GLuint occupancy_ = 0, labels_ = 0, bricks_ = 0, colors_ = 0, vao_ = 0, vbo_ = 0;
+  GLuint intensity_ = 0;  // the CT intensity (normalized_intensity), 0 without one
   // Staging state (touched under the world's state lock only).
   std::int64_t revision_ = -1;
   std::vector<Label> staged_table_;

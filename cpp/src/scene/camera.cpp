@@ -20,6 +20,7 @@ Camera::Camera(Model& model, const CameraSpec& spec, int id)
       cy_(spec.height / 2.0),
       shadows_(spec.shadows),
       antialiasing_(spec.antialiasing),
+      looks_(spec.looks),
       background_(spec.background),
       publish_(spec.publish) {
   spec.validate();

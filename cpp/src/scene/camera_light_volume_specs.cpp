@@ -82,6 +82,9 @@ const OptionTable<CameraSpec>& camera_options() {
             [](S& s, V v, K k) { s.shadows = v.boolean(k); }},
           O{"antialiasing", "int", "rgb supersampling per axis, 1 (off) to 4",
             [](S& s, V v, K k) { s.antialiasing = v.integer(k); }},
+          O{"looks", "bool",
+            "volumes in rgb get ambient occlusion, a bone texture and wet highlights",
+            [](S& s, V v, K k) { s.looks = v.boolean(k); }},
       });
   return table;
 }

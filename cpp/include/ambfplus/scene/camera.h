@@ -40,6 +40,7 @@ struct AMBFPLUS_API CameraSpec {
   CameraPublish publish;
   bool shadows = false;  ///< lights cast shadows in the rgb pass (see Camera::shadows)
   int antialiasing = 1;  ///< rgb supersampling factor per axis, 1 (off) to 4
+  bool looks = false;    ///< volume surface looks in the rgb pass (see Camera::looks)
 
   /// Throws ArgumentError naming the camera and the value unless every value can be used (size
   /// 1..16384, fov_y in (0, pi), 0 < near < far, a rigid pose, background in 0..1, intervals
@@ -48,7 +49,7 @@ struct AMBFPLUS_API CameraSpec {
 };
 
 /// add_camera's keyword options: width, height, fov_y, near, far, pose, background, shadows,
-/// antialiasing.
+/// antialiasing, looks.
 AMBFPLUS_API const OptionTable<CameraSpec>& camera_options();
 
 /// A pinhole camera in the OpenCV frame (x right, y down, z forward). pose() is world from camera.
@@ -100,6 +101,11 @@ class AMBFPLUS_API Camera : public Object {
   /// one exact sample at each pixel centre. ArgumentError outside 1..4.
   int antialiasing() const { return antialiasing_; }
   void set_antialiasing(int k);
+  /// Whether the rgb pass gives volumes their surface looks: ambient occlusion from the
+  /// occupancy, a world-fixed bone texture (or the CT intensity where the volume has one) and a
+  /// wet specular highlight. Ground-truth passes never change.
+  bool looks() const { return looks_; }
+  void set_looks(bool on) { looks_ = on; }
 
  private:
   friend class Model;
@@ -114,6 +120,7 @@ class AMBFPLUS_API Camera : public Object {
   unsigned passes_ = kDefaultPasses;
   bool shadows_ = false;
   int antialiasing_ = 1;
+  bool looks_ = false;
   std::array<float, 3> background_;
   CameraPublish publish_;
   std::optional<ShaderSpec> preprocessing_shader_;

@@ -66,7 +66,7 @@ def phantom_vs_ear() -> None:
         world.add_light("key", "directional", direction=(-0.3, 0.4, -1.0), intensity=0.8)
         world.add_light("fill", "point", position=(0.15, -0.2, 0.3), intensity=0.3)
         camera = world.add_camera("camera", 480, 480, 0.5, 0.01, 10.0, shadows=True,
-                                  antialiasing=2)  # fmt: skip
+                                  antialiasing=2, looks=True)  # fmt: skip
         camera.look_at(eye=(0.0, -0.06, 0.12), target=(0.0, 0.0, 0.004))
         views.append(np.asarray(camera.capture(passes=["rgb"]).rgb))
     Image.fromarray(np.concatenate(views, axis=1)).save(

@@ -8,8 +8,8 @@
 // voxel with the largest trilinear weight at the hit (or, where the smoothed surface bridges a
 // concave corner over eight empty voxels, the nearest solid voxel), the normal the field's
 // negative gradient. VolumeData::raycast on the CPU is the same algorithm without the skipping.
-// With LOOKS (Camera::looks) the rgb pass alone also gets ambient occlusion from the occupancy,
-// a bone texture fixed to the volume and a wet specular lobe; no other output changes.
+// With LOOKS (Camera::looks) the rgb pass alone also gets ambient occlusion from the blurred
+// occupancy, a bone texture fixed to the volume and a wet specular lobe; no other output changes.
 
 #ifndef SHADE
 #define SHADE 1
@@ -41,6 +41,9 @@ uniform vec3 u_eye;                // camera position, voxel units
 // own sub-pixel centre.
 uniform mat4 u_voxel_from_clip;
 uniform vec2 u_viewport;
+uniform sampler2D u_pixel_depth;       // the capture's depth pass (camera z; 0: nothing)
+uniform isampler2D u_pixel_instance;   // its instance pass
+uniform int u_supersample_factor;      // k: samples per pixel along x and y
 #endif
 #ifdef ORTHOGRAPHIC
 uniform vec3 u_ray_dir;            // parallel rays (a directional light's shadow map), unit
@@ -57,6 +60,8 @@ uniform usampler3D u_bricks;       // Chebyshev distance, in bricks, to the near
 uniform sampler2D u_colors;        // label id -> colour, 256 per row
 uniform sampler3D u_intensity;     // CT intensity, 0..1 between its 2nd and 98th percentiles
 uniform bool u_has_intensity;
+uniform sampler3D u_obscurance;       // the obscurance field (ambient_occlusion), zero border
+uniform vec3 u_obscurance_scale;      // voxel units to its texture coordinates
 uniform int u_brick_size;
 
 layout(location = 0) out vec4 o_color;
@@ -161,25 +166,24 @@ float bone_texture(vec3 p) {
   return 1.0 + 0.26 * (t - 0.5);
 }
 
-// Ambient occlusion at surface point u (voxel units) with outward direction out_n: the share
-// of 21 points around it, on rays 30 degrees above the tangent plane and along the normal at 3,
-// 6 and 12 voxels, that lie inside the smoothed occupancy's surface. Open flat ground leaves
-// every point outside (1: unoccluded); creases and pits put some in the walls.
+// Ambient occlusion at surface point u (voxel units) with outward direction out_n, from the
+// obscurance field: the share of solid voxels around a point, weighted by a Gaussian of 4 voxels
+// (GpuVolume: the occupancy at half resolution, blurred). Read 4 and 10 voxels out along the
+// normal, less what flat open ground gives there (a half-space seen through the same Gaussian),
+// it is what creases, pits and cavities put around the point: they darken, open ground and
+// edges keep their light.
 float ambient_occlusion(vec3 u, vec3 out_n) {
-  vec3 t = normalize(cross(out_n, abs(out_n.x) < 0.9 ? vec3(1, 0, 0) : vec3(0, 1, 0)));
-  vec3 b = cross(out_n, t);
-  float inside = 0.0;
-  float hi = min(u_level + 0.25, 1.0);
-  for (int ring = 0; ring < 3; ++ring) {
-    float r = 3.0 * float(1 << ring);
-    inside += smoothstep(u_level, hi, field(u + r * out_n));
-    for (int k = 0; k < 6; ++k) {
-      float a = 1.0471976 * float(k) + 0.5 * float(ring);  // rings turned against each other
-      vec3 d = 0.5 * out_n + 0.8660254 * (cos(a) * t + sin(a) * b);
-      inside += smoothstep(u_level, hi, field(u + r * d));
-    }
+  // Flat ground's share at d voxels: the normal tail Phi(-d / 4.1), 4.1 voxels being the
+  // Gaussian's 2 cells with the cells' and trilinear filtering's spread.
+  const float reach[2] = float[2](4.0, 10.0);
+  const float flat_ground[2] = float[2](0.1646, 0.0074);
+  const float weight[2] = float[2](0.6, 0.4);
+  float occluded = 0.0;
+  for (int i = 0; i < 2; ++i) {
+    float g = texture(u_obscurance, (u + reach[i] * out_n) * u_obscurance_scale).r;
+    occluded += weight[i] * clamp((g - flat_ground[i]) / (1.0 - flat_ground[i]), 0.0, 1.0);
   }
-  return 1.0 - inside / 21.0;
+  return 1.0 - 1.3 * min(occluded, 0.7);
 }
 #endif
 
@@ -211,6 +215,39 @@ void main() {
   bool hit = false;
   int budget = int(4.0 * (u_shape.x + u_shape.y + u_shape.z)) + 16;
   float t = t_enter;
+#ifdef FROM_PIXELS
+  // A sample searches the depths at which the nine pixel centres around its pixel see this
+  // volume, 3 voxels either side (a surface the centres see is found in a few steps, and a ray
+  // that passes it ends there instead of grazing on): only a feature thinner than a pixel,
+  // missed by all nine, could lie outside. None of them seeing the volume, the sample does not
+  // either. Where the search would start inside the surface it starts at the box instead.
+  ivec2 pixel = ivec2(gl_FragCoord.xy) / u_supersample_factor;
+  ivec2 last = textureSize(u_pixel_instance, 0) - 1;
+  float z_near = 1e30, z_far = -1e30;
+  for (int dy = -1; dy <= 1; ++dy) {
+    for (int dx = -1; dx <= 1; ++dx) {
+      ivec2 q = clamp(pixel + ivec2(dx, dy), ivec2(0), last);
+      if (texelFetch(u_pixel_instance, q, 0).r == u_instance) {
+        float z = texelFetch(u_pixel_depth, q, 0).r;
+        z_near = min(z_near, z);
+        z_far = max(z_far, z);
+      }
+    }
+  }
+  float z0 = (u_camera_from_voxel * vec4(eye, 1.0)).z;
+  float dz = (u_camera_from_voxel * vec4(dir, 0.0)).z;
+  if (z_far < 0.0 || dz <= 0.0) {
+    t = t_exit + 1.0;  // no search
+  } else {
+    t_exit = min(t_exit, (z_far - z0) / dz + 3.0);
+    int m_near = int(floor(((z_near - z0) / dz - 3.0 - t_enter) / dt));
+    if (m_near > 0 && field(eye + (t_enter + float(m_near) * dt) * dir) < u_level) {
+      m = m_near;
+      m_below = m;
+      t = t_enter + float(m) * dt;
+    }
+  }
+#endif
 #if EMPTY_SPACE_SKIPPING
   ivec3 brick_shape = textureSize(u_bricks, 0);
   float bs = float(u_brick_size);

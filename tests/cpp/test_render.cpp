@@ -134,4 +134,51 @@ TEST(RenderDeathTest, ExitAfterTheDriverWasTornDownIsClean) {
       ::testing::ExitedWithCode(0), "");
 }
 
+// Supersampling picks a pixel whose neighbours (of the 8) differ in object, label, depth (over
+// 1%) or colour (over 25 of 255 in a channel), and nothing else.
+TEST(Supersampling, EdgesArePickedByTheExactPassesAndColourSteps) {
+  const int w = 9, h = 7;
+  render::EdgeInputs in;
+  in.rgba.assign(w * h * 4, 100);
+  in.depth.assign(w * h, 0.5f);
+  in.label.assign(w * h, 3);
+  in.instance.assign(w * h, 7);
+  std::vector<std::uint8_t> mask(w * h, 9);
+  auto marked = [&] {
+    render::supersample_edges(in, w, h, mask.data());
+    std::vector<std::pair<int, int>> out;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+        if (mask[y * w + x] != 0) out.emplace_back(x, y);
+    return out;
+  };
+  EXPECT_TRUE(marked().empty());
+  const auto block = [](int cx, int cy) {
+    std::vector<std::pair<int, int>> b;
+    for (int y = cy - 1; y <= cy + 1; ++y)
+      for (int x = cx - 1; x <= cx + 1; ++x) b.emplace_back(x, y);
+    return b;
+  };
+  const int p = 3 * w + 4;  // (4, 3)
+  in.label[p] = 4;
+  EXPECT_EQ(marked(), block(4, 3));
+  in.label[p] = 3;
+  in.instance[p] = 8;
+  EXPECT_EQ(marked(), block(4, 3));
+  in.instance[p] = 7;
+  in.depth[p] = 0.5f * 1.009f;
+  EXPECT_TRUE(marked().empty());
+  in.depth[p] = 0.5f * 1.011f;
+  EXPECT_EQ(marked(), block(4, 3));
+  in.depth[p] = 0.5f;
+  in.rgba[p * 4 + 1] = 125;
+  EXPECT_TRUE(marked().empty());
+  in.rgba[p * 4 + 1] = 126;
+  EXPECT_EQ(marked(), block(4, 3));
+  // At a corner, only the pixels inside.
+  in.rgba[p * 4 + 1] = 100;
+  in.label[0] = 1;
+  EXPECT_EQ(marked(), (std::vector<std::pair<int, int>>{{0, 0}, {1, 0}, {0, 1}, {1, 1}}));
+}
+
 }  // namespace ambfplus

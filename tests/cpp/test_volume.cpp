@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <random>
 
 #include "ambfplus/volume/volume_data.h"
@@ -258,6 +259,73 @@ TEST(CoalesceBoxes, MergesFarEditsBeyondTheLimit) {
   std::vector<VoxelBox> none{VoxelBox{}};
   render::coalesce_boxes(none, 2, 8, 4096);
   EXPECT_TRUE(none.empty());
+}
+
+// The obscurance field of a half-space (solid below z = 32 voxels) is the share of its Gaussian
+// below the plane: the discrete weights' tail exactly, and the normal tail of sigma 2 cells
+// (4 voxels) within sampling error.
+TEST(Obscurance, AHalfSpaceGivesTheGaussiansTail) {
+  const std::array<int, 3> shape = {64, 64, 64};
+  std::vector<std::uint8_t> labels(64 * 64 * 64, 0);
+  for (int k = 0; k < 32; ++k) std::fill_n(labels.begin() + k * 64 * 64, 64 * 64, 1);
+  const auto cells = render::obscurance_cells(shape);
+  ASSERT_EQ(cells, (std::array<int, 3>{32, 32, 32}));
+  std::vector<std::uint8_t> counts(32 * 32 * 32, 99);
+  const VoxelBox all{{0, 0, 0}, shape}, all_cells{{0, 0, 0}, cells};
+  render::count_cell_occupancy(labels.data(), all, 1, shape, all_cells, counts.data());
+  for (int k = 0; k < 32; ++k) EXPECT_EQ(counts[16 + 32 * (16 + 32 * k)], k < 16 ? 8 : 0);
+  const auto field = render::blur_cell_occupancy(counts, cells, all_cells);
+  constexpr int R = render::kObscuranceReach;
+  double weights[2 * R + 1], total = 0;
+  for (int t = -R; t <= R; ++t) {
+    weights[t + R] = std::exp(-0.5 * t * t / (render::kObscuranceSigma * render::kObscuranceSigma));
+    total += weights[t + R];
+  }
+  for (int k = 8; k < 24; ++k) {
+    double tail = 0;  // the weights of the cells below the plane
+    for (int t = -R; t <= R; ++t) tail += k + t < 16 ? weights[t + R] / total : 0.0;
+    const double value = field[16 + 32 * (16 + 32 * k)] / 255.0;
+    EXPECT_NEAR(value, tail, 0.6 / 255) << "cell " << k;
+    // Cell k's centre lies 2k + 1 - 32 voxels above the plane.
+    const double d = 2.0 * k + 1.0 - 32.0;
+    EXPECT_NEAR(value, 0.5 * std::erfc(d / (4.0 * std::sqrt(2.0))), 0.03) << "cell " << k;
+  }
+  // Beyond the Gaussian's reach of the plane: all solid, or nothing; and near the grid's floor
+  // the cells outside count as empty (open ground there, as the texture's border says).
+  EXPECT_EQ(field[16 + 32 * (16 + 32 * 9)], 255);
+  EXPECT_EQ(field[16 + 32 * (16 + 32 * 22)], 0);
+  EXPECT_LT(field[16 + 32 * (16 + 32 * 2)], 240);
+}
+
+// A box of the field, as a drilling edit recomputes it, equals the same cells of the whole
+// field; an odd-sized grid's last cells count only the voxels inside it; 16-bit labels count
+// alike.
+TEST(Obscurance, ABoxEqualsTheWholeFieldsCells) {
+  const std::array<int, 3> shape = {23, 18, 15};
+  std::mt19937 rng(11);
+  std::vector<std::uint16_t> labels(23 * 18 * 15);
+  for (auto& l : labels) l = rng() % 3 == 0 ? 0 : 300 + rng() % 5;
+  const auto cells = render::obscurance_cells(shape);
+  ASSERT_EQ(cells, (std::array<int, 3>{12, 9, 8}));
+  std::vector<std::uint8_t> counts(12 * 9 * 8);
+  const VoxelBox all{{0, 0, 0}, shape}, all_cells{{0, 0, 0}, cells};
+  render::count_cell_occupancy(reinterpret_cast<const std::uint8_t*>(labels.data()), all, 2, shape,
+                               all_cells, counts.data());
+  // The last cell along i holds voxel 22 only (one column of 2 x 2 in j, k).
+  int solid = 0;
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < 2; ++j) solid += labels[22 + 23 * (j + 18 * k)] != 0;
+  EXPECT_EQ(counts[11], solid);
+  const auto whole = render::blur_cell_occupancy(counts, cells, all_cells);
+  const VoxelBox box{{3, 1, 2}, {9, 7, 5}};
+  const auto part = render::blur_cell_occupancy(counts, cells, box);
+  ASSERT_EQ(part.size(), std::size_t(box.count()));
+  std::size_t at = 0;
+  for (int k = box.lo[2]; k < box.hi[2]; ++k)
+    for (int j = box.lo[1]; j < box.hi[1]; ++j)
+      for (int i = box.lo[0]; i < box.hi[0]; ++i) {
+        ASSERT_EQ(part[at++], whole[i + 12 * (j + 9 * k)]) << i << "," << j << "," << k;
+      }
 }
 
 }  // namespace

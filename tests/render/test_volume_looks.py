@@ -79,6 +79,41 @@ def test_ambient_occlusion_darkens_a_pits_floor_and_leaves_open_ground():
     assert floor_ratio < 0.85 and floor_ratio < ground_ratio - 0.12, (floor_ratio, ground_ratio)
 
 
+def test_drilling_updates_the_occlusion_as_a_fresh_volume_has_it():
+    """The occlusion field is updated in boxes as voxels go: after a hole is drilled into open
+    ground, the image is bit for bit that of a volume built with the hole, and the hole's floor
+    has darkened while the ground around keeps its light."""
+    hole = ((0.0, 0.0, 0.008), 0.005)  # a 5 mm sphere centred on the top surface
+
+    def view(world):
+        camera = world.add_camera("cam", W, H, fov_y=0.5, near=0.01, far=1.0, looks=True)
+        camera.look_at((0.0, 0.0, 0.13), (0.0, 0.0, 0.0), up=(0, 1, 0))
+        return camera
+
+    drilled = world_over(slab(pit=False))
+    camera = view(drilled)
+    before = camera.capture(passes=["rgb", "depth"])
+    assert drilled.volumes[0].remove_sphere(*hole) > 0
+    after = camera.capture(passes=["rgb", "depth"])
+    built = slab(pit=False)
+    built.remove_sphere(*hole)
+    fresh = view(world_over(built)).capture(passes=["rgb", "depth"])
+    np.testing.assert_array_equal(after.rgb, fresh.rgb)
+    np.testing.assert_array_equal(after.depth, fresh.depth)
+    camera.looks = False
+    plain = camera.capture(passes=["rgb", "depth"])
+    p = world_points(after)
+    floor = (np.hypot(p[..., 0], p[..., 1]) < 0.0015) & (p[..., 2] < 0.004)
+    ground = (np.hypot(p[..., 0], p[..., 1]) > 0.011) & (np.abs(p[..., 2] - 0.008) < 0.0005)
+    assert floor.sum() > 50 and ground.sum() > 1000
+    ratio = brightness(after) / np.maximum(brightness(plain), 1)
+    floor_ratio, ground_ratio = ratio[floor].mean(), ratio[ground].mean()
+    assert floor_ratio < ground_ratio - 0.15, (floor_ratio, ground_ratio)
+    assert abs(ground_ratio - 1) < 0.06
+    # Before the hole, the same floor pixels showed flat ground at the top.
+    assert np.abs(before.depth[floor] - after.depth[floor]).min() > 0.003
+
+
 def test_bone_texture_varies_the_albedo_and_is_fixed_to_the_volume():
     world = world_over(slab(pit=False))
     cameras = [world.add_camera(f"cam{i}", W, H, fov_y=0.5, near=0.01, far=1.0) for i in (0, 1)]

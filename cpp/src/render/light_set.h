@@ -16,7 +16,7 @@ namespace ambfplus::render {
 /// The most lights whose shadows one camera draws (the first directional and spot lights with a
 /// shadow quality above 0, in the world's order).
 constexpr int kMaxShadowMaps = 4;
-/// The texture unit of shadow map i is kShadowMapUnit + i (surface shaders use units 0..4).
+/// The texture unit of shadow map i is kShadowMapUnit + i (surface shaders use units 0..5).
 constexpr int kShadowMapUnit = 8;
 
 /// A light that casts shadows: what its shadow map is made of (world frame).

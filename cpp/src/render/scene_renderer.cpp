@@ -62,7 +62,6 @@ void release_supersampling(RenderTarget& t) {
   if (t.factor == 0) return;
   glDeleteFramebuffers(1, &t.samples_framebuffer);
   glDeleteTextures(2, t.samples);
-  glDeleteFramebuffers(1, &t.mask_framebuffer);
   glDeleteTextures(1, &t.mask);
   glDeleteVertexArrays(1, &t.points_vao);
   glDeleteBuffers(1, &t.points_buffer);
@@ -778,6 +777,34 @@ ShadowUniforms SceneRenderer::shadow_maps(const Snapshot& s) {
   return out;
 }
 
+void supersample_edges(const EdgeInputs& in, int width, int height, std::uint8_t* mask) {
+  std::fill(mask, mask + std::size_t(width) * height, std::uint8_t(0));
+  const auto differ = [&](std::size_t a, std::size_t b) {
+    if (in.instance[a] != in.instance[b] || in.label[a] != in.label[b]) return true;
+    const float za = in.depth[a], zb = in.depth[b];
+    if (std::abs(za - zb) > 0.01f * std::max(std::abs(za), std::abs(zb))) return true;
+    for (int c = 0; c < 3; ++c) {
+      if (std::abs(int(in.rgba[4 * a + c]) - int(in.rgba[4 * b + c])) > 25) return true;
+    }
+    return false;
+  };
+  // Each pair of neighbours once: right, and the three above.
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const std::size_t p = std::size_t(y) * width + x;
+      const auto mark = [&](int qx, int qy) {
+        if (qx < 0 || qx >= width || qy >= height) return;
+        const std::size_t q = std::size_t(qy) * width + qx;
+        if (differ(p, q)) mask[p] = mask[q] = 1;
+      };
+      mark(x + 1, y);
+      mark(x - 1, y + 1);
+      mark(x, y + 1);
+      mark(x + 1, y + 1);
+    }
+  }
+}
+
 void SceneRenderer::supersample(const Snapshot& s, RenderTarget& target,
                                 const SurfacePass& shading) {
   const int k = s.antialiasing;
@@ -806,9 +833,6 @@ void SceneRenderer::supersample(const Snapshot& s, RenderTarget& target,
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     glBindTexture(GL_TEXTURE_2D, 0);
-    glGenFramebuffers(1, &target.mask_framebuffer);
-    glBindFramebuffer(GL_FRAMEBUFFER, target.mask_framebuffer);
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, target.mask, 0);
     glGenVertexArrays(1, &target.points_vao);
     glGenBuffers(1, &target.points_buffer);
     glBindVertexArray(target.points_vao);
@@ -817,8 +841,7 @@ void SceneRenderer::supersample(const Snapshot& s, RenderTarget& target,
     glEnableVertexAttribArray(0);
     glBindVertexArray(0);
     glBindBuffer(GL_ARRAY_BUFFER, 0);
-    if (samples_status != GL_FRAMEBUFFER_COMPLETE ||
-        glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+    if (samples_status != GL_FRAMEBUFFER_COMPLETE) {
       release_supersampling(target);
       throw RenderError("camera '" + s.camera_name + "': the supersampled image of " +
                         std::to_string(w) + "x" + std::to_string(h) + " cannot be made");
@@ -826,32 +849,33 @@ void SceneRenderer::supersample(const Snapshot& s, RenderTarget& target,
     check_gl("creating a supersampled target");
   }
   // Which pixels to sample, from the exact passes and the shaded colour of the pixel centres.
-  glBindFramebuffer(GL_FRAMEBUFFER, target.mask_framebuffer);
-  glViewport(0, 0, target.width, target.height);
-  glDisable(GL_DEPTH_TEST);
-  Program& mask = Context::get().program("overlay.vert", "supersample_mask.frag", "");
-  mask.use();
-  const char* inputs[4] = {"u_rgb", "u_depth", "u_label", "u_instance"};
-  for (int i = 0; i < 4; ++i) {
-    glActiveTexture(static_cast<GLenum>(GL_TEXTURE0 + i));
-    glBindTexture(GL_TEXTURE_2D, target.textures[i]);
-    glUniform1i(mask.uniform(inputs[i]), i);
-  }
-  // A step of 0.1 in a channel (26 of 255) is an edge worth sampling.
-  glUniform1f(mask.uniform("u_contrast"), 0.1f);
-  glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
-  for (int i = 0; i < 4; ++i) {
-    glActiveTexture(static_cast<GLenum>(GL_TEXTURE0 + i));
-    glBindTexture(GL_TEXTURE_2D, 0);
-  }
-  glActiveTexture(GL_TEXTURE0);
-  // Those pixels, as points: only their samples are shaded.
-  supersample_mask_.resize(std::size_t(target.width) * target.height);
-  glReadBuffer(GL_COLOR_ATTACHMENT0);
+  const std::size_t pixels = std::size_t(target.width) * target.height;
+  edge_inputs_.rgba.resize(pixels * 4);
+  edge_inputs_.depth.resize(pixels);
+  edge_inputs_.label.resize(pixels);
+  edge_inputs_.instance.resize(pixels);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, target.framebuffer);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
   glPixelStorei(GL_PACK_ROW_LENGTH, 0);
-  glReadPixels(0, 0, target.width, target.height, GL_RED_INTEGER, GL_UNSIGNED_BYTE,
-               supersample_mask_.data());
+  const struct {
+    void* data;
+    GLenum format, type;
+  } inputs[4] = {{edge_inputs_.rgba.data(), GL_RGBA, GL_UNSIGNED_BYTE},
+                 {edge_inputs_.depth.data(), GL_RED, GL_FLOAT},
+                 {edge_inputs_.label.data(), GL_RED_INTEGER, GL_UNSIGNED_SHORT},
+                 {edge_inputs_.instance.data(), GL_RED_INTEGER, GL_INT}};
+  for (int i = 0; i < 4; ++i) {
+    glReadBuffer(static_cast<GLenum>(GL_COLOR_ATTACHMENT0 + i));
+    glReadPixels(0, 0, target.width, target.height, inputs[i].format, inputs[i].type,
+                 inputs[i].data);
+  }
+  supersample_mask_.resize(pixels);
+  supersample_edges(edge_inputs_, target.width, target.height, supersample_mask_.data());
+  glBindTexture(GL_TEXTURE_2D, target.mask);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, target.width, target.height, GL_RED_INTEGER,
+                  GL_UNSIGNED_BYTE, supersample_mask_.data());
+  glBindTexture(GL_TEXTURE_2D, 0);
   // One point per 2 x 2 block of pixels with one to sample: a software rasteriser shades
   // blocks of 4 x 4 samples together, so isolated pixels would leave most of its lanes idle.
   supersample_points_.clear();
@@ -918,11 +942,30 @@ void SceneRenderer::supersample(const Snapshot& s, RenderTarget& target,
   volumes.meshes = false;
   volumes.points_vao = target.points_vao;
   volumes.points = points;
+  // Their rays read the capture's depth and instance passes (see volume.frag), on units
+  // between the volume's own and the shadow maps'.
+  const struct {
+    const char* name;
+    int unit, attachment;
+  } pixel_inputs[2] = {{"u_pixel_depth", 6, 1}, {"u_pixel_instance", 7, 3}};
+  static_assert(kShadowMapUnit >= 8);
   volumes.setup = [&](Program& p) {
     if (shading.setup) shading.setup(p);
     point_uniforms(p);
+    for (const auto& input : pixel_inputs) {
+      glActiveTexture(static_cast<GLenum>(GL_TEXTURE0 + input.unit));
+      glBindTexture(GL_TEXTURE_2D, target.textures[input.attachment]);
+      glUniform1i(p.uniform(input.name), input.unit);
+    }
+    glActiveTexture(GL_TEXTURE0);
+    glUniform1i(p.uniform("u_supersample_factor"), k);
   };
   draw_surfaces(s, program, s.camera_pose, s.projection, kPassRgb, volumes);
+  for (const auto& input : pixel_inputs) {
+    glActiveTexture(static_cast<GLenum>(GL_TEXTURE0 + input.unit));
+    glBindTexture(GL_TEXTURE_2D, 0);
+  }
+  glActiveTexture(GL_TEXTURE0);
 
   // Their means replace the marked pixels' colours.
   constexpr int kMaskUnit = 7;

@@ -43,6 +43,20 @@ struct GpuMesh {
   std::shared_ptr<const MeshData> source;  // kept alive, so its address is never reused
 };
 
+/// What supersampling reads of a capture to pick its pixels: the shaded colour (RGBA) and the
+/// exact depth, label and instance passes at the pixel centres, rows bottom up.
+struct EdgeInputs {
+  std::vector<std::uint8_t> rgba;
+  std::vector<float> depth;
+  std::vector<std::uint16_t> label;
+  std::vector<std::int32_t> instance;
+};
+
+/// Marks (1, else 0) the pixels whose samples may differ: where a neighbour (of the 8) shows
+/// another object or label, a depth more than 1% apart, or a colour more than 25 of 255 apart in
+/// a channel (shadow edges, textures, highlights).
+void supersample_edges(const EdgeInputs& in, int width, int height, std::uint8_t* mask);
+
 /// Off-screen colour, metric-depth, id and depth-test buffers of one camera's size.
 struct RenderTarget {
   // One colour attachment per drawn pass (pass i on attachment i), then the depth test.
@@ -57,7 +71,7 @@ struct RenderTarget {
   // k x k larger colour and depth test, and the mask of the pixels supersampled.
   int factor = 0;
   GLuint samples_framebuffer = 0, samples[2] = {0, 0};  // colour, depth and stencil
-  GLuint mask_framebuffer = 0, mask = 0;
+  GLuint mask = 0;
   GLuint points_vao = 0, points_buffer = 0;  // the pixels to sample, as points
   int stencil = 0;  // the stencil value marking this capture's samples (1..255)
 };
@@ -212,6 +226,7 @@ class SceneRenderer : public Renderer {
   std::map<int, RenderTarget> targets_;         // by camera id
   std::map<std::string, GLuint> textures_;      // by image file
   std::map<int, ShadowMap> shadow_maps_;        // by light id
+  EdgeInputs edge_inputs_;                      // scratch: what picks them
   std::vector<std::uint8_t> supersample_mask_;  // scratch: the pixels to supersample
   std::vector<float> supersample_points_;       // scratch: their coordinates
   mutable std::mutex volumes_mutex_;  // volumes_ grows during takes, which may overlap draws

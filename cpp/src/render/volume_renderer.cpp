@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 
@@ -135,6 +136,97 @@ void coalesce_boxes(std::vector<VoxelBox>& boxes, int margin, std::size_t max_bo
   }
 }
 
+std::array<int, 3> obscurance_cells(const std::array<int, 3>& shape) {
+  constexpr int C = kObscuranceCell;
+  return {(shape[0] + C - 1) / C, (shape[1] + C - 1) / C, (shape[2] + C - 1) / C};
+}
+
+void count_cell_occupancy(const std::uint8_t* labels, const VoxelBox& frame, int bytes,
+                          const std::array<int, 3>& shape, const VoxelBox& cells,
+                          std::uint8_t* counts) {
+  constexpr int C = kObscuranceCell;
+  const auto n = obscurance_cells(shape);
+  const std::size_t w = static_cast<std::size_t>(frame.hi[0] - frame.lo[0]);
+  const std::size_t h = static_cast<std::size_t>(frame.hi[1] - frame.lo[1]);
+  auto solid = [&](int i, int j, int k) {
+    const std::size_t at = static_cast<std::size_t>(i - frame.lo[0]) +
+                           w * (static_cast<std::size_t>(j - frame.lo[1]) + h * (k - frame.lo[2]));
+    if (bytes == 1) return labels[at] != 0;
+    std::uint16_t value = 0;
+    std::memcpy(&value, labels + at * 2, 2);
+    return value != 0;
+  };
+  for (int ck = cells.lo[2]; ck < cells.hi[2]; ++ck) {
+    for (int cj = cells.lo[1]; cj < cells.hi[1]; ++cj) {
+      for (int ci = cells.lo[0]; ci < cells.hi[0]; ++ci) {
+        int count = 0;
+        for (int k = ck * C; k < std::min(shape[2], ck * C + C); ++k)
+          for (int j = cj * C; j < std::min(shape[1], cj * C + C); ++j)
+            for (int i = ci * C; i < std::min(shape[0], ci * C + C); ++i) count += solid(i, j, k);
+        counts[static_cast<std::size_t>(ci) +
+               std::size_t(n[0]) * (std::size_t(cj) + std::size_t(n[1]) * ck)] =
+            static_cast<std::uint8_t>(count);
+      }
+    }
+  }
+}
+
+std::vector<std::uint8_t> blur_cell_occupancy(const std::vector<std::uint8_t>& counts,
+                                              const std::array<int, 3>& n, const VoxelBox& cells) {
+  constexpr int R = kObscuranceReach;
+  constexpr int C3 = kObscuranceCell * kObscuranceCell * kObscuranceCell;
+  float weights[2 * R + 1];
+  float total = 0.0f;
+  for (int t = -R; t <= R; ++t) {
+    weights[t + R] =
+        static_cast<float>(std::exp(-0.5 * t * t / (kObscuranceSigma * kObscuranceSigma)));
+    total += weights[t + R];
+  }
+  for (float& w : weights) w /= total;
+  // Separable: along k over the box grown along i and j, then along j, then along i; cells
+  // outside the grid are empty.
+  const VoxelBox b = cells;
+  const int gi0 = b.lo[0] - R, gi1 = b.hi[0] + R, gj0 = b.lo[1] - R, gj1 = b.hi[1] + R;
+  const int wi = gi1 - gi0, wj = gj1 - gj0, wk = b.hi[2] - b.lo[2], hj = b.hi[1] - b.lo[1];
+  auto count_at = [&](int i, int j, int k) -> float {
+    if (i < 0 || j < 0 || k < 0 || i >= n[0] || j >= n[1] || k >= n[2]) return 0.0f;
+    return counts[static_cast<std::size_t>(i) +
+                  std::size_t(n[0]) * (std::size_t(j) + std::size_t(n[1]) * k)];
+  };
+  std::vector<float> along_k(static_cast<std::size_t>(wi) * wj * wk);
+  for (int k = 0; k < wk; ++k)
+    for (int j = 0; j < wj; ++j)
+      for (int i = 0; i < wi; ++i) {
+        float sum = 0.0f;
+        for (int t = -R; t <= R; ++t)
+          sum += weights[t + R] * count_at(gi0 + i, gj0 + j, b.lo[2] + k + t);
+        along_k[static_cast<std::size_t>(i) + std::size_t(wi) * (j + std::size_t(wj) * k)] = sum;
+      }
+  std::vector<float> along_j(static_cast<std::size_t>(wi) * hj * wk);
+  for (int k = 0; k < wk; ++k)
+    for (int j = 0; j < hj; ++j)
+      for (int i = 0; i < wi; ++i) {
+        float sum = 0.0f;
+        for (int t = 0; t <= 2 * R; ++t) {
+          sum += weights[t] * along_k[static_cast<std::size_t>(i) +
+                                      std::size_t(wi) * (j + t + std::size_t(wj) * k)];
+        }
+        along_j[static_cast<std::size_t>(i) + std::size_t(wi) * (j + std::size_t(hj) * k)] = sum;
+      }
+  const int w = b.hi[0] - b.lo[0];
+  std::vector<std::uint8_t> out(static_cast<std::size_t>(w) * hj * wk);
+  for (int k = 0; k < wk; ++k)
+    for (int j = 0; j < hj; ++j)
+      for (int i = 0; i < w; ++i) {
+        float sum = 0.0f;
+        const float* row = &along_j[std::size_t(wi) * (j + std::size_t(hj) * k)];
+        for (int t = 0; t <= 2 * R; ++t) sum += weights[t] * row[i + t];
+        out[static_cast<std::size_t>(i) + std::size_t(w) * (j + std::size_t(hj) * k)] =
+            static_cast<std::uint8_t>(std::clamp(sum / C3, 0.0f, 1.0f) * 255.0f + 0.5f);
+      }
+  return out;
+}
+
 namespace {
 
 GLuint make_texture_3d(GLenum filter, GLenum wrap) {
@@ -240,8 +332,8 @@ void GpuVolume::create_textures() {
 
 GpuVolume::~GpuVolume() {
   if (vao_ == 0) return;  // never uploaded
-  const GLuint textures[5] = {occupancy_, labels_, bricks_, colors_, intensity_};
-  glDeleteTextures(intensity_ != 0 ? 5 : 4, textures);
+  const GLuint textures[6] = {occupancy_, labels_, bricks_, colors_, intensity_, obscurance_};
+  glDeleteTextures(6, textures);  // zeros are ignored
   glDeleteBuffers(1, &vbo_);
   glDeleteVertexArrays(1, &vao_);
 }
@@ -393,7 +485,23 @@ void GpuVolume::upload() {
                    p.intensity.data());
     }
     Derived derived;
-    for (const Region& region : p.regions) derive(region, wide ? 2 : 1, derived);
+    const auto cell_shape = obscurance_cells(data_->shape());
+    if (cell_counts_.empty()) {
+      cell_counts_.assign(std::size_t(cell_shape[0]) * cell_shape[1] * cell_shape[2], 0);
+    }
+    for (const Region& region : p.regions) {
+      derive(region, wide ? 2 : 1, derived);
+      // The cells the edit touched: the frame holds their voxels (it holds whole bricks, and
+      // a brick is whole cells).
+      VoxelBox cells;
+      for (int a = 0; a < 3; ++a) {
+        cells.lo[a] = region.edited.lo[a] / kObscuranceCell;
+        cells.hi[a] = (region.edited.hi[a] + kObscuranceCell - 1) / kObscuranceCell;
+      }
+      count_cell_occupancy(region.labels.data(), region.frame, wide ? 2 : 1, data_->shape(), cells,
+                           cell_counts_.data());
+      if (obscurance_ != 0) update_obscurance(cells);
+    }
     for (const Box& box : derived.labels) {
       upload_box(labels_, box.box, GL_RED_INTEGER, wide ? GL_UNSIGNED_SHORT : GL_UNSIGNED_BYTE,
                  box.bytes);
@@ -410,6 +518,17 @@ void GpuVolume::upload() {
   stats.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::lock_guard<std::mutex> lock(mutex_);
   last_upload_ = stats;
+}
+
+void GpuVolume::update_obscurance(const VoxelBox& cells) {
+  const auto n = obscurance_cells(data_->shape());
+  VoxelBox box = cells.grown(kObscuranceReach).clipped(n);
+  if (obscurance_ == 0) {
+    obscurance_ = make_texture_3d(GL_LINEAR, GL_CLAMP_TO_BORDER);
+    glTexImage3D(GL_TEXTURE_3D, 0, GL_R8, n[0], n[1], n[2], 0, GL_RED, GL_UNSIGNED_BYTE, nullptr);
+    box = VoxelBox{{0, 0, 0}, n};
+  }
+  upload_box(obscurance_, box, GL_RED, GL_UNSIGNED_BYTE, blur_cell_occupancy(cell_counts_, n, box));
 }
 
 VolumeUpload GpuVolume::last_upload() const {
@@ -442,6 +561,8 @@ void GpuVolume::draw(const Snapshot::Volume& volume, const Eigen::Isometry3d& vi
   const Eigen::Matrix3d normal_from_voxel =
       camera_from_voxel.topLeftCorner<3, 3>().inverse().transpose();
   const auto& n = data_->shape();
+  const bool looks = (passes & kPassRgb) && volume.looks;
+  if (looks && obscurance_ == 0) update_obscurance(VoxelBox{{0, 0, 0}, obscurance_cells(n)});
   if (pass.orthographic) {
     // Rays along the view's z, starting behind the box by more than its diagonal.
     const Eigen::Vector3d dir = (voxel_from_camera * Eigen::Vector4d(0, 0, 1, 0)).head<3>();
@@ -474,17 +595,19 @@ void GpuVolume::draw(const Snapshot::Volume& volume, const Eigen::Isometry3d& vi
   glUniform1f(program.uniform("u_shininess"), volume.shininess);
   glUniform1i(program.uniform("u_instance"), volume.id);
   glUniform1i(program.uniform("u_has_intensity"), intensity_ != 0 ? 1 : 0);
+  const auto cells = obscurance_cells(n);
+  glUniform3f(program.uniform("u_obscurance_scale"), 1.0f / float(kObscuranceCell * cells[0]),
+              1.0f / float(kObscuranceCell * cells[1]), 1.0f / float(kObscuranceCell * cells[2]));
   lights.upload(program);
   const struct {
     const char* name;
     GLenum target;
     GLuint texture;
-  } units[5] = {{"u_occupancy", GL_TEXTURE_3D, occupancy_},
-                {"u_labels", GL_TEXTURE_3D, labels_},
-                {"u_bricks", GL_TEXTURE_3D, bricks_},
-                {"u_colors", GL_TEXTURE_2D, colors_},
-                {"u_intensity", GL_TEXTURE_3D, intensity_}};
-  for (int u = 0; u < 5; ++u) {
+  } units[6] = {
+      {"u_occupancy", GL_TEXTURE_3D, occupancy_}, {"u_labels", GL_TEXTURE_3D, labels_},
+      {"u_bricks", GL_TEXTURE_3D, bricks_},       {"u_colors", GL_TEXTURE_2D, colors_},
+      {"u_intensity", GL_TEXTURE_3D, intensity_}, {"u_obscurance", GL_TEXTURE_3D, obscurance_}};
+  for (int u = 0; u < 6; ++u) {
     glActiveTexture(GL_TEXTURE0 + u);
     glBindTexture(units[u].target, units[u].texture);
     glUniform1i(program.uniform(units[u].name), u);

@@ -28,6 +28,31 @@ std::vector<std::uint8_t> brick_distances(const std::vector<std::uint8_t>& brick
 void coalesce_boxes(std::vector<VoxelBox>& boxes, int margin, std::size_t max_boxes,
                     std::int64_t slack);
 
+/// The obscurance field of the volume looks is made at half resolution: a cell is 2 x 2 x 2
+/// voxels (cell c spans voxels [2c, 2c + 2) on each axis; cells past the grid count as empty).
+constexpr int kObscuranceCell = 2;
+/// Its Gaussian's standard deviation and reach, in cells.
+constexpr double kObscuranceSigma = 2.0;
+constexpr int kObscuranceReach = 6;
+
+/// The cells of a grid of `shape` voxels (rounded up).
+std::array<int, 3> obscurance_cells(const std::array<int, 3>& shape);
+
+/// The solid voxels (label != 0) of each cell of `cells` (0..8), read from labels packed in
+/// `frame` (i fastest, `bytes` per label; the frame holds every voxel of those cells inside the
+/// grid), into `counts`, the whole cell grid packed.
+void count_cell_occupancy(const std::uint8_t* labels, const VoxelBox& frame, int bytes,
+                          const std::array<int, 3>& shape, const VoxelBox& cells,
+                          std::uint8_t* counts);
+
+/// The share of solid voxels around each cell of `cells` (0..255), weighted by a Gaussian of
+/// kObscuranceSigma cells cut at kObscuranceReach, from the cell counts of the whole grid
+/// (`cell_shape`; nothing outside it is solid): packed in `cells`, i fastest. Exact for any
+/// box: a box's values equal the same cells of the whole grid's.
+std::vector<std::uint8_t> blur_cell_occupancy(const std::vector<std::uint8_t>& counts,
+                                              const std::array<int, 3>& cell_shape,
+                                              const VoxelBox& cells);
+
 /// What the last upload of a volume sent to the GPU.
 struct VolumeUpload {
   bool full = false;
@@ -35,7 +60,8 @@ struct VolumeUpload {
   double seconds = 0.0;     ///< wall time of staging and upload, derived fields included
 };
 
-/// The GPU copies of one VolumeData (smoothed occupancy, labels, brick distances, label colours),
+/// The GPU copies of one VolumeData (smoothed occupancy, labels, brick distances, label colours,
+/// and for the looks the obscurance field),
 /// brought up to date with only the boxes edited since the last update. Updating has two halves:
 /// stage() only copies the edited labels (with the margin their derived fields need) out of the
 /// data while the world's state lock is held, upload() does everything else (the smoothed
@@ -99,6 +125,9 @@ class GpuVolume {
   /// them.
   void update_distances(const std::vector<Box>& brick_boxes, double level, bool full);
   void create_textures();
+  /// Recomputes the obscurance field over `cells` (grown by its reach) and uploads it; creates
+  /// it over the whole grid the first time.
+  void update_obscurance(const VoxelBox& cells);
 
   std::shared_ptr<VolumeData> data_;
   GLuint occupancy_ = 0, labels_ = 0, bricks_ = 0, colors_ = 0, vao_ = 0, vbo_ = 0;
@@ -118,6 +147,10 @@ class GpuVolume {
   std::vector<std::uint8_t> distances_;
   double distance_level_ = -1;
   std::int64_t generation_ = 0;
+  // The solid voxels of each cell (count_cell_occupancy), kept up to date by every upload, and
+  // the obscurance texture made of them the first time a camera with looks draws the volume.
+  std::vector<std::uint8_t> cell_counts_;
+  GLuint obscurance_ = 0;
 };
 
 }  // namespace ambfplus::render

@@ -36,13 +36,17 @@ in vec3 v_voxel;
 uniform vec3 u_shape;
 uniform vec3 u_voxel_size;         // metres
 uniform vec3 u_eye;                // camera position, voxel units
+#ifndef SILHOUETTE_REACH
+#define SILHOUETTE_REACH 12.0
+#endif
 #ifdef FROM_PIXELS
 // Supersampling draws points over the pixels to sample: each fragment's ray goes through its
 // own sub-pixel centre.
 uniform mat4 u_voxel_from_clip;
 uniform vec2 u_viewport;
-uniform sampler2D u_pixel_depth;       // the capture's depth pass (camera z; 0: nothing)
-uniform isampler2D u_pixel_instance;   // its instance pass
+uniform sampler2D u_depth_range;  // per pixel, the nearest and farthest camera z at which the 3 x 3
+                                   // pixel centres around it see a volume (y < 0: none does; x < 0:
+                                   // -nearest, and one of them shows a mesh or nothing)
 uniform int u_supersample_factor;      // k: samples per pixel along x and y
 #endif
 #ifdef ORTHOGRAPHIC
@@ -216,33 +220,29 @@ void main() {
   int budget = int(4.0 * (u_shape.x + u_shape.y + u_shape.z)) + 16;
   float t = t_enter;
 #ifdef FROM_PIXELS
-  // A sample searches the depths at which the nine pixel centres around its pixel see this
-  // volume, 3 voxels either side (a surface the centres see is found in a few steps, and a ray
+  // A sample searches the depths at which the nine pixel centres around its pixel see a
+  // volume, widened by 3 voxels and their spread on either side, with no far end where one of
+  // them shows a mesh or nothing (a surface the centres see is found in a few steps, and a ray
   // that passes it ends there instead of grazing on): only a feature thinner than a pixel,
-  // missed by all nine, could lie outside. None of them seeing the volume, the sample does not
-  // either. Where the search would start inside the surface it starts at the box instead.
-  ivec2 pixel = ivec2(gl_FragCoord.xy) / u_supersample_factor;
-  ivec2 last = textureSize(u_pixel_instance, 0) - 1;
-  float z_near = 1e30, z_far = -1e30;
-  for (int dy = -1; dy <= 1; ++dy) {
-    for (int dx = -1; dx <= 1; ++dx) {
-      ivec2 q = clamp(pixel + ivec2(dx, dy), ivec2(0), last);
-      if (texelFetch(u_pixel_instance, q, 0).r == u_instance) {
-        float z = texelFetch(u_pixel_depth, q, 0).r;
-        z_near = min(z_near, z);
-        z_far = max(z_far, z);
-      }
-    }
-  }
+  // missed by all nine, could lie outside. None of them seeing one, the sample is not drawn
+  // (SceneRenderer::supersample). Where the search would start inside the surface it starts at
+  // the box instead.
+  vec3 range = texelFetch(u_depth_range, ivec2(gl_FragCoord.xy) / u_supersample_factor, 0).xyz;
+  float z_near = range.x, z_far = range.y;
+  bool open_far = range.z > 1.5;
+  float reach = range.z > 0.5 ? SILHOUETTE_REACH : 3.0;
   float z0 = (u_camera_from_voxel * vec4(eye, 1.0)).z;
   float dz = (u_camera_from_voxel * vec4(dir, 0.0)).z;
   if (z_far < 0.0 || dz <= 0.0) {
     t = t_exit + 1.0;  // no search
   } else {
-    t_exit = min(t_exit, (z_far - z0) / dz + 3.0);
-    int m_near = int(floor(((z_near - z0) / dz - 3.0 - t_enter) / dt));
-    if (m_near > 0 && field(eye + (t_enter + float(m_near) * dt) * dir) < u_level) {
-      m = m_near;
+    // Near a silhouette the depth runs on past the nine: add their spread on either side.
+    float spread = (z_far - z_near) / dz;
+    if (!open_far) t_exit = min(t_exit, (z_far - z0) / dz + reach + spread);
+    float m_near = floor(((z_near - z0) / dz - 3.0 - spread - t_enter) / dt);
+    if (m_near > 0.0 && t_enter + m_near * dt <= t_exit &&
+        field(eye + (t_enter + m_near * dt) * dir) < u_level) {
+      m = int(m_near);
       m_below = m;
       t = t_enter + float(m) * dt;
     }

@@ -174,6 +174,40 @@ def test_antialiasing_blends_edges_and_leaves_label_and_instance_pure():
 GROUND_TRUTH = ["depth", "label", "instance", "voxel", "segmentation", "points"]
 
 
+@pytest.mark.parametrize("k", [2, 3])
+def test_supersampled_pixels_are_the_mean_of_a_render_at_k_times_the_resolution(k):
+    """Every pixel supersampling changes takes the box filter of a camera with k times the
+    pixels (whose pixel centres are the k x k sample positions): the phantom's silhouettes and
+    label boundaries and a rod in front of it, with the looks on. The volume's samples search
+    only near the depths their pixels' neighbours see (volume.frag); this finds what a full
+    search finds."""
+    world = ambfplus.World()
+    world.add_volume("bone", ambfplus.phantom(96))
+    rod = world.add_body("rod", "cylinder", radius=0.002, height=0.06, mass=0.0, axis="x")
+    pose = np.eye(4)
+    pose[:3, 3] = (0, 0, 0.028)
+    rod.pose = pose
+    world.add_light("sun", direction=(0.3, 0.4, -1.0))
+    w, h = 240, 180
+    cameras = {
+        name: world.add_camera(name, w * f, h * f, fov_y=0.8, near=0.01, far=2.0, looks=True)
+        for name, f in (("plain", 1), ("sampled", 1), ("fine", k))
+    }
+    cameras["sampled"].antialiasing = k
+    for camera in cameras.values():
+        camera.look_at((0.03, -0.075, 0.075), (0, 0, 0.005))
+    rgb = {
+        name: c.capture(passes=["rgb"]).rgb[..., :3].astype(float) for name, c in cameras.items()
+    }
+    reference = rgb["fine"].reshape(h, k, w, k, 3).mean(axis=(1, 3))
+    changed = (rgb["sampled"] != rgb["plain"]).any(axis=-1)
+    assert changed.sum() > 2000
+    error = np.abs(rgb["sampled"] - reference).max(axis=-1)[changed]
+    plain_error = np.abs(rgb["plain"] - reference).max(axis=-1)[changed]
+    assert error.max() <= 2.0, (error.max(), int((error > 2).sum()))
+    assert plain_error.mean() > 5.0  # the one centre sample is far from the mean there
+
+
 def test_ground_truth_is_bit_identical_with_shadows_and_antialiasing_on_or_off():
     world = ambfplus.World()
     volume = world.add_volume("bone", ambfplus.phantom(64))

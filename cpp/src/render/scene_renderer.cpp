@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <functional>
+#include <limits>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -63,6 +64,7 @@ void release_supersampling(RenderTarget& t) {
   glDeleteFramebuffers(1, &t.samples_framebuffer);
   glDeleteTextures(2, t.samples);
   glDeleteTextures(1, &t.mask);
+  glDeleteTextures(1, &t.depth_range);
   glDeleteVertexArrays(1, &t.points_vao);
   glDeleteBuffers(1, &t.points_buffer);
   t.factor = 0;
@@ -833,6 +835,12 @@ void SceneRenderer::supersample(const Snapshot& s, RenderTarget& target,
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     glBindTexture(GL_TEXTURE_2D, 0);
+    glGenTextures(1, &target.depth_range);
+    glBindTexture(GL_TEXTURE_2D, target.depth_range);
+    glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGB32F, target.width, target.height);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glBindTexture(GL_TEXTURE_2D, 0);
     glGenVertexArrays(1, &target.points_vao);
     glGenBuffers(1, &target.points_buffer);
     glBindVertexArray(target.points_vao);
@@ -878,18 +886,71 @@ void SceneRenderer::supersample(const Snapshot& s, RenderTarget& target,
   glBindTexture(GL_TEXTURE_2D, 0);
   // One point per 2 x 2 block of pixels with one to sample: a software rasteriser shades
   // blocks of 4 x 4 samples together, so isolated pixels would leave most of its lanes idle.
+  // Blocks where a volume is seen come first: volumes are sampled at those only, each pixel
+  // searching between the nearest and farthest depths at which the 3 x 3 around it sees a
+  // volume (volume.frag).
   supersample_points_.clear();
+  supersample_others_.clear();
+  supersample_depths_.resize(pixels * 3);
   const auto marked = [&](int x, int y) {
     return x < target.width && y < target.height &&
            supersample_mask_[std::size_t(y) * target.width + x] != 0;
   };
-  for (int y = 0; y < target.height; y += 2) {
-    for (int x = 0; x < target.width; x += 2) {
-      if (marked(x, y) || marked(x + 1, y) || marked(x, y + 1) || marked(x + 1, y + 1)) {
-        supersample_points_.insert(supersample_points_.end(), {float(x + 1), float(y + 1)});
+  const auto is_volume = [&](std::int32_t id) {
+    for (const Snapshot::Volume& v : s.volumes) {
+      if (v.id == id) return true;
+    }
+    return false;
+  };
+  // The depth range of pixel (x, y)'s neighbourhood, and how far past it to search: false
+  // where no volume is seen there. Past a silhouette against the background a grazing sample
+  // meets the surface farther on; a mesh seen there may hide any of a volume behind it.
+  const auto depth_range = [&](int x, int y) {
+    float lo = std::numeric_limits<float>::infinity(), hi = -1.0f, reach = 0.0f;
+    for (int qy = std::max(0, y - 1); qy <= std::min(target.height - 1, y + 1); ++qy) {
+      for (int qx = std::max(0, x - 1); qx <= std::min(target.width - 1, x + 1); ++qx) {
+        const std::size_t q = std::size_t(qy) * target.width + qx;
+        const std::int32_t id = edge_inputs_.instance[q];
+        if (!is_volume(id)) {
+          reach = std::max(reach, id == 0 ? 1.0f : 2.0f);
+          continue;
+        }
+        lo = std::min(lo, edge_inputs_.depth[q]);
+        hi = std::max(hi, edge_inputs_.depth[q]);
       }
     }
+    // Nearest and farthest depth (-1: no volume), and 0 (within the range), 1 (a silhouette)
+    // or 2 (no far end).
+    float* out = &supersample_depths_[3 * (std::size_t(y) * target.width + x)];
+    out[0] = hi < 0.0f ? 0.0f : lo;
+    out[1] = hi;
+    out[2] = reach;
+    return hi >= 0.0f;
+  };
+  for (int y = 0; y < target.height; y += 2) {
+    for (int x = 0; x < target.width; x += 2) {
+      if (!(marked(x, y) || marked(x + 1, y) || marked(x, y + 1) || marked(x + 1, y + 1))) {
+        continue;
+      }
+      bool volume = false;
+      for (int py = y; py < std::min(y + 2, target.height); ++py) {
+        for (int px = x; px < std::min(x + 2, target.width); ++px) {
+          volume = depth_range(px, py) || volume;
+        }
+      }
+      (volume ? supersample_points_ : supersample_others_)
+          .insert((volume ? supersample_points_ : supersample_others_).end(),
+                  {float(x + 1), float(y + 1)});
+    }
   }
+  const auto volume_points = static_cast<GLsizei>(supersample_points_.size() / 2);
+  supersample_points_.insert(supersample_points_.end(), supersample_others_.begin(),
+                             supersample_others_.end());
+  glBindTexture(GL_TEXTURE_2D, target.depth_range);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, target.width, target.height, GL_RGB, GL_FLOAT,
+                  supersample_depths_.data());
+  glBindTexture(GL_TEXTURE_2D, 0);
   const auto points = static_cast<GLsizei>(supersample_points_.size() / 2);
   glEnable(GL_DEPTH_TEST);
   if (points == 0) {
@@ -941,30 +1002,23 @@ void SceneRenderer::supersample(const Snapshot& s, RenderTarget& target,
   SurfacePass volumes = shading;
   volumes.meshes = false;
   volumes.points_vao = target.points_vao;
-  volumes.points = points;
-  // Their rays read the capture's depth and instance passes (see volume.frag), on units
-  // between the volume's own and the shadow maps'.
-  const struct {
-    const char* name;
-    int unit, attachment;
-  } pixel_inputs[2] = {{"u_pixel_depth", 6, 1}, {"u_pixel_instance", 7, 3}};
-  static_assert(kShadowMapUnit >= 8);
+  volumes.points = volume_points;
+  // Their rays read the depth ranges (see volume.frag) on a unit between the volume's own and
+  // the shadow maps'.
+  constexpr int kDepthRangeUnit = 6;
+  static_assert(kShadowMapUnit > kDepthRangeUnit);
   volumes.setup = [&](Program& p) {
     if (shading.setup) shading.setup(p);
     point_uniforms(p);
-    for (const auto& input : pixel_inputs) {
-      glActiveTexture(static_cast<GLenum>(GL_TEXTURE0 + input.unit));
-      glBindTexture(GL_TEXTURE_2D, target.textures[input.attachment]);
-      glUniform1i(p.uniform(input.name), input.unit);
-    }
+    glActiveTexture(GL_TEXTURE0 + kDepthRangeUnit);
+    glBindTexture(GL_TEXTURE_2D, target.depth_range);
     glActiveTexture(GL_TEXTURE0);
+    glUniform1i(p.uniform("u_depth_range"), kDepthRangeUnit);
     glUniform1i(p.uniform("u_supersample_factor"), k);
   };
-  draw_surfaces(s, program, s.camera_pose, s.projection, kPassRgb, volumes);
-  for (const auto& input : pixel_inputs) {
-    glActiveTexture(static_cast<GLenum>(GL_TEXTURE0 + input.unit));
-    glBindTexture(GL_TEXTURE_2D, 0);
-  }
+  if (volume_points > 0) draw_surfaces(s, program, s.camera_pose, s.projection, kPassRgb, volumes);
+  glActiveTexture(GL_TEXTURE0 + kDepthRangeUnit);
+  glBindTexture(GL_TEXTURE_2D, 0);
   glActiveTexture(GL_TEXTURE0);
 
   // Their means replace the marked pixels' colours.

@@ -72,6 +72,7 @@ struct RenderTarget {
   int factor = 0;
   GLuint samples_framebuffer = 0, samples[2] = {0, 0};  // colour, depth and stencil
   GLuint mask = 0;
+  GLuint depth_range = 0;  // per pixel, the depths at which the 3 x 3 around it see a volume
   GLuint points_vao = 0, points_buffer = 0;  // the pixels to sample, as points
   int stencil = 0;  // the stencil value marking this capture's samples (1..255)
 };
@@ -229,6 +230,8 @@ class SceneRenderer : public Renderer {
   EdgeInputs edge_inputs_;                      // scratch: what picks them
   std::vector<std::uint8_t> supersample_mask_;  // scratch: the pixels to supersample
   std::vector<float> supersample_points_;       // scratch: their coordinates
+  std::vector<float> supersample_others_;       // scratch: those no volume is sampled at
+  std::vector<float> supersample_depths_;       // scratch: depth_range's values
   mutable std::mutex volumes_mutex_;  // volumes_ grows during takes, which may overlap draws
   std::map<int, std::unique_ptr<GpuVolume>> volumes_;  // by volume id
   // Ids of objects that left the world, and whether a mesh may have lost its last body;

@@ -829,17 +829,16 @@ void SceneRenderer::supersample(const Snapshot& s, RenderTarget& target,
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_TEXTURE_2D,
                            target.samples[1], 0);
     const GLenum samples_status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
-    glGenTextures(1, &target.mask);
-    glBindTexture(GL_TEXTURE_2D, target.mask);
-    glTexStorage2D(GL_TEXTURE_2D, 1, GL_R8UI, target.width, target.height);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    glBindTexture(GL_TEXTURE_2D, 0);
-    glGenTextures(1, &target.depth_range);
-    glBindTexture(GL_TEXTURE_2D, target.depth_range);
-    glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGB32F, target.width, target.height);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    // Per pixel: the mask, and the depth ranges of the volumes' samples.
+    const GLenum formats_per_pixel[2] = {GL_R8UI, GL_RGB32F};
+    GLuint* per_pixel[2] = {&target.mask, &target.depth_range};
+    for (int i = 0; i < 2; ++i) {
+      glGenTextures(1, per_pixel[i]);
+      glBindTexture(GL_TEXTURE_2D, *per_pixel[i]);
+      glTexStorage2D(GL_TEXTURE_2D, 1, formats_per_pixel[i], target.width, target.height);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    }
     glBindTexture(GL_TEXTURE_2D, 0);
     glGenVertexArrays(1, &target.points_vao);
     glGenBuffers(1, &target.points_buffer);

@@ -59,6 +59,19 @@ void release_mesh(GpuMesh& m) {
   if (m.texcoords != 0) glDeleteBuffers(1, &m.texcoords);
 }
 
+// The GL state every surface pass draws with. Reversed z: depth clears to 0 (far) and the
+// greater depth is kept. Our projections flip image y relative to GL's window y, so visible
+// fronts wind clockwise.
+void surface_state() {
+  glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_GREATER);
+  glDepthMask(GL_TRUE);
+  glDisable(GL_CULL_FACE);
+  glDisable(GL_BLEND);
+  glFrontFace(GL_CW);
+}
+
 void release_supersampling(RenderTarget& t) {
   if (t.factor == 0) return;
   glDeleteFramebuffers(1, &t.samples_framebuffer);
@@ -486,15 +499,7 @@ void SceneRenderer::draw(const Snapshot& s) {
   }
   glDrawBuffers(kRenderedPassCount, draw_buffers);
   glViewport(0, 0, target.width, target.height);
-  // Reversed z: clear to 0 (far), keep the greater depth.
-  glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
-  glEnable(GL_DEPTH_TEST);
-  glDepthFunc(GL_GREATER);
-  glDepthMask(GL_TRUE);
-  glDisable(GL_CULL_FACE);
-  glDisable(GL_BLEND);
-  // Our projection flips image y relative to GL's window y, so visible fronts wind clockwise.
-  glFrontFace(GL_CW);
+  surface_state();
   const GLfloat clear_color[4] = {s.background[0], s.background[1], s.background[2], 1.0f};
   const GLfloat clear_depth_image[4] = {0, 0, 0, 0};
   const GLfloat clear_depth = 0.0f;
@@ -731,13 +736,7 @@ ShadowUniforms SceneRenderer::shadow_maps(const Snapshot& s) {
       map.clip_from_world = p * light.matrix();
       glBindFramebuffer(GL_FRAMEBUFFER, map.framebuffer);
       glViewport(0, 0, c.size, c.size);
-      glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
-      glEnable(GL_DEPTH_TEST);
-      glDepthFunc(GL_GREATER);
-      glDepthMask(GL_TRUE);
-      glDisable(GL_CULL_FACE);
-      glDisable(GL_BLEND);
-      glFrontFace(GL_CW);
+      surface_state();
       const GLfloat far_depth = 0.0f;
       glClearBufferfv(GL_DEPTH, 0, &far_depth);
       if (visible) {

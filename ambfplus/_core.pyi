@@ -236,6 +236,10 @@ class VolumeData:
         """
         declares voxels [lo, hi) (default: all) changed through the labels view
         """
+    def mark_intensity_changed(self) -> None:
+        """
+        declares the intensity grid changed through its view: renderers read it again
+        """
     def raycast(self, origin: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], direction: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], iso: typing.SupportsFloat | typing.SupportsIndex = 0.5) -> typing.Any:
         """
         first iso-surface hit of a volume-frame ray: dict(distance, position, normal, label) or None (it brings the smoothed field up to date: while a real-time loop drills this data, call it under world.lock(), or use Volume.raycast, which takes the lock)
@@ -289,7 +293,7 @@ class VolumeData:
     @property
     def intensity(self) -> typing.Any:
         """
-        (nx, ny, nz) view of the intensity (CT) grid, or None
+        (nx, ny, nz) view of the intensity (CT) grid, or None; after writing through it, call mark_intensity_changed() so renderers see the change
         """
     @property
     def label_table(self) -> list[Label]:

@@ -225,7 +225,15 @@ void define_volume(py::module_& m) {
                                  : py::dtype::of<float>(),
                              true);
           },
-          "(nx, ny, nz) view of the intensity (CT) grid, or None")
+          "(nx, ny, nz) view of the intensity (CT) grid, or None; after writing through it, call "
+          "mark_intensity_changed() so renderers see the change")
+      .def(
+          "mark_intensity_changed",
+          [](VolumeData& v) {
+            py::gil_scoped_release release;
+            v.mark_intensity_changed();
+          },
+          "declares the intensity grid changed through its view: renderers read it again")
       .def_property_readonly(
           "smoothed_occupancy",
           [](py::object self) {

@@ -338,16 +338,19 @@ void main() {
   if (label == 0u) label = dominant_label(u, voxel);
   if (label == 0u) label = nearest_label(u, voxel);
   if (label == 0u) discard;  // cannot happen (see nearest_label); never an unlabelled hit
-  vec3 base = texelFetch(u_colors, ivec2(int(label & 255u), int(label >> 8)), 0).rgb;
+  vec4 entry = texelFetch(u_colors, ivec2(int(label & 255u), int(label >> 8)), 0);
+  vec3 base = entry.rgb;  // alpha: 1 for bone (is_bone), which alone takes the bone texture
 #if SHADE
   vec3 n = normalize(u_normal_from_voxel * -g);
   if (dot(n, camera.xyz) > 0.0) n = -n;  // grazing hits: light the side the camera sees
 #if LOOKS
-  // Albedo darkened by occlusion (ambient and diffuse light alike) and mottled like bone, or
-  // by the CT intensity a voxel inside the surface where the volume has one.
+  // Albedo darkened by occlusion (ambient and diffuse light alike) and, on bone, mottled like
+  // bone, or by the CT intensity a voxel inside the surface where the volume has one. Soft
+  // tissue (nerves, vessels, dura) keeps its even colour.
   float grain = u_has_intensity
                     ? 1.0 + 0.26 * (texture(u_intensity, (u + inward) * inv_shape).r - 0.5)
                     : bone_texture(u * u_voxel_size);
+  grain = mix(1.0, grain, entry.a);
   vec3 albedo = base * (grain * ambient_occlusion(u, -inward));
   o_color = vec4(lit(albedo, n, camera.xyz), 1.0);
 #else

@@ -330,3 +330,34 @@ TEST(Obscurance, ABoxEqualsTheWholeFieldsCells) {
 
 }  // namespace
 }  // namespace ambfplus
+
+TEST(LabelTable, BoneIsNamedOrTheOnlyMaterial) {
+  // The original system's ear: its bony labels take the bone texture, soft tissue does not.
+  const char* const names[] = {"Bone",
+                               "Malleus",
+                               "Incus",
+                               "Stapes",
+                               "Bony_Labyrinth",
+                               "IAC",
+                               "Superior_Vestibular_Nerve",
+                               "Facial_Nerve",
+                               "Chorda_Tympani",
+                               "ICA",
+                               "Sinus_+_Dura",
+                               "Vestibular_Aqueduct",
+                               "TMJ",
+                               "EAC"};
+  ambfplus::LabelTable ear;
+  std::uint16_t id = 0;
+  for (const char* name : names) ear.add(ambfplus::Label{++id, name, {255, 255, 255}, true, false});
+  std::vector<std::string> bone;
+  for (const ambfplus::Label& l : ear.labels()) {
+    if (ambfplus::is_bone(ear, l)) bone.push_back(l.name);
+  }
+  EXPECT_EQ(bone,
+            (std::vector<std::string>{"Bone", "Malleus", "Incus", "Stapes", "Bony_Labyrinth"}));
+  EXPECT_TRUE(ambfplus::is_bone(ear, ambfplus::Label{99, "mastoid CORTEX", {}, true, false}));
+  // A one-material volume (a thresholded CT's "Segmented") is bone, whatever its name.
+  const ambfplus::LabelTable one({ambfplus::Label{1, "Segmented", {255, 249, 219}, true, false}});
+  EXPECT_TRUE(ambfplus::is_bone(one, one.labels()[0]));
+}

@@ -147,6 +147,28 @@ def test_bone_texture_varies_the_albedo_and_is_fixed_to_the_volume():
     assert abs(np.corrcoef(here, off)[0, 1]) < 0.5
 
 
+def test_only_bone_takes_the_bone_texture():
+    """Soft tissue keeps its even colour: of two halves of the flat top with the same colour, the
+    one labelled Bone is mottled, the one labelled Facial_Nerve is not."""
+    labels = np.zeros((48, 48, 24), np.uint8)
+    labels[:24, :, :20] = 1
+    labels[24:, :, :20] = 2
+    table = [ambfplus.Label(1, "Bone", BONE), ambfplus.Label(2, "Facial_Nerve", BONE)]
+    data = ambfplus.VolumeData(labels, dimensions=(0.048, 0.048, 0.024), label_table=table)
+    camera = world_over(data).add_camera("cam", W, H, fov_y=0.5, near=0.01, far=1.0)
+    camera.look_at((0.0, 0.0, 0.12), (0.0, 0.0, 0.0), up=(0, 1, 0))
+    plain, looks = capture_both(camera, ("rgb", "depth", "label"))
+    p = world_points(plain)
+    top = (plain.depth > 0) & (np.abs(p[..., 1]) < 0.012) & (np.abs(p[..., 2] - 0.008) < 0.0005)
+    bone = top & (p[..., 0] < -0.004) & (p[..., 0] > -0.016) & (plain.label == 1)
+    nerve = top & (p[..., 0] > 0.004) & (p[..., 0] < 0.016) & (plain.label == 2)
+    assert bone.sum() > 2000 and nerve.sum() > 2000
+    factor = brightness(looks) / np.maximum(brightness(plain), 1)
+    assert factor[bone].std() > 0.03, factor[bone].std()
+    assert factor[nerve].std() < 0.01, factor[nerve].std()
+    assert abs(np.median(factor[nerve]) - 1) < 0.06
+
+
 def test_a_ct_intensity_grid_replaces_the_procedural_texture(tmp_path):
     # CT of the slab: bone in 4 mm stripes along x of 400 and 1000 HU under air (-1000 HU).
     ct = np.full((48, 48, 24), -1000, np.int16)
@@ -172,6 +194,37 @@ def test_a_ct_intensity_grid_replaces_the_procedural_texture(tmp_path):
     # 1000 HU is the 98th percentile (factor 1.13), 400 HU the 2nd (0.87); nothing else varies.
     assert abs(np.median(factor[dense]) - 1.13) < 0.02 and factor[dense].std() < 0.02
     assert abs(np.median(factor[light]) - 0.87) < 0.02 and factor[light].std() < 0.02
+
+
+def test_a_changed_intensity_grid_is_drawn_after_mark_intensity_changed(tmp_path):
+    """The intensity grid is read again when it is declared changed: the stripes, inverted
+    through the NumPy view after a first render, are drawn inverted; an undeclared write is not
+    seen."""
+    ct = np.full((48, 48, 24), -1000, np.int16)
+    ct[:, :, :20] = np.where((np.arange(48) // 4) % 2 == 1, 1000, 400)[:, None, None]
+    path = tmp_path / "ct.nrrd"
+    header = "NRRD0004\ntype: short\ndimension: 3\nsizes: 48 48 24\nspacings: 1 1 1\n"
+    header += "encoding: raw\nendian: little\n\n"
+    path.write_bytes(header.encode() + ct.tobytes(order="F"))
+    data = ambfplus.load_nrrd(path, kind="intensity", threshold=300)
+    camera = world_over(data).add_camera("cam", W, H, fov_y=0.5, near=0.01, far=1.0, looks=True)
+    camera.look_at((0.0, 0.0, 0.13), (0.0, 0.0, 0.0), up=(0, 1, 0))
+    first = camera.capture(passes=["rgb", "depth"])
+    p = world_points(first)
+    stripe, within = np.divmod((p[..., 0] + 0.024) * 1000, 4)
+    clear = (first.depth > 0) & (np.abs(p[..., 1]) < 0.016) & (within > 1) & (within < 3)
+    clear &= np.abs(p[..., 0]) < 0.016
+    dense, light = clear & (stripe % 2 == 1), clear & (stripe % 2 == 0)
+    b = brightness(first)
+    assert b[dense].mean() > 1.2 * b[light].mean()
+    grid = data.intensity
+    solid = grid[:, :, :20].copy()
+    grid[:, :, :20] = np.where(solid == 1000, 400, 1000)  # the stripes swapped
+    np.testing.assert_array_equal(brightness(camera.capture(passes=["rgb"])), b)  # not declared
+    data.mark_intensity_changed()
+    after = brightness(camera.capture(passes=["rgb"]))
+    assert after[light].mean() > 1.2 * after[dense].mean()
+    np.testing.assert_allclose(after[light].mean(), b[dense].mean(), rtol=0.02)
 
 
 GROUND_TRUTH = ["depth", "label", "instance", "voxel", "segmentation", "points"]

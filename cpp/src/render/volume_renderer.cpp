@@ -341,15 +341,18 @@ GpuVolume::~GpuVolume() {
 void GpuVolume::stage_colors(Pending& pending) {
   const LabelTable& table = data_->label_table();
   if (table.labels().size() == staged_table_.size() &&
-      std::equal(
-          staged_table_.begin(), staged_table_.end(), table.labels().begin(),
-          [](const Label& a, const Label& b) { return a.id == b.id && a.color == b.color; })) {
+      std::equal(staged_table_.begin(), staged_table_.end(), table.labels().begin(),
+                 [](const Label& a, const Label& b) {
+                   return a.id == b.id && a.color == b.color && a.name == b.name;
+                 })) {
     return;
   }
+  // RGB: the label's colour; alpha: 255 where the looks' bone texture applies (is_bone).
   pending.color_rows = table.max_id() / 256 + 1;
   pending.colors.assign(static_cast<std::size_t>(pending.color_rows) * 256 * 4, 255);
   for (const Label& l : table.labels()) {
     for (int c = 0; c < 3; ++c) pending.colors[l.id * 4 + c] = l.color[c];
+    pending.colors[l.id * 4 + 3] = is_bone(table, l) ? 255 : 0;
   }
   staged_table_ = table.labels();
 }
@@ -389,12 +392,21 @@ void GpuVolume::stage(double iso) {
   revision_ = data_->revision();
   const bool level_changed = pending.level != staged_level_;
   staged_level_ = pending.level;
-  if (boxes_.empty() && pending.colors.empty() && !level_changed) return;
-  pending.full = first;
-  // The intensity grid is read once: drilling edits labels, never the CT.
-  if (first && data_->intensity_type() != IntensityType::kNone) {
-    pending.intensity = normalized_intensity(*data_);
+  // The intensity grid when it is new or was changed (drilling edits labels, never the CT).
+  const bool intensity_changed = data_->intensity_revision() != staged_intensity_;
+  if (intensity_changed) {
+    if (data_->intensity_type() != IntensityType::kNone) {
+      pending.intensity = normalized_intensity(*data_);
+    } else {
+      pending.drop_intensity = !first;
+    }
+    staged_intensity_ = data_->intensity_revision();
   }
+  if (boxes_.empty() && pending.colors.empty() && !level_changed && pending.intensity.empty() &&
+      !pending.drop_intensity) {
+    return;
+  }
+  pending.full = first;
   pending.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::lock_guard<std::mutex> lock(mutex_);
   pending_.push_back(std::move(pending));
@@ -475,6 +487,10 @@ void GpuVolume::upload() {
       glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
       glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, 256, p.color_rows, 0, GL_RGBA, GL_UNSIGNED_BYTE,
                    p.colors.data());
+    }
+    if (p.drop_intensity && intensity_ != 0) {
+      glDeleteTextures(1, &intensity_);
+      intensity_ = 0;
     }
     if (!p.intensity.empty()) {
       if (intensity_ == 0) intensity_ = make_texture_3d(GL_LINEAR, GL_CLAMP_TO_EDGE);

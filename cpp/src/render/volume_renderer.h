@@ -113,7 +113,8 @@ class GpuVolume {
     std::vector<Region> regions;
     std::vector<std::uint8_t> colors;  // RGBA rows of 256 label ids; empty: unchanged
     int color_rows = 0;
-    std::vector<std::uint8_t> intensity;  // the whole grid, 0..255 (the first stage only)
+    std::vector<std::uint8_t> intensity;  // the whole grid, 0..255, when it is new or changed
+    bool drop_intensity = false;          // the grid was removed
     double level = 0.0;                   // 0..255 of the smoothed occupancy that counts as surface
     bool full = false;
     double seconds = 0.0;  // staging time
@@ -136,7 +137,8 @@ class GpuVolume {
   std::int64_t revision_ = -1;
   std::vector<Label> staged_table_;
   double staged_level_ = -1;
-  std::vector<VoxelBox> boxes_;  // scratch
+  std::int64_t staged_intensity_ = -1;  // VolumeData::intensity_revision() last staged
+  std::vector<VoxelBox> boxes_;         // scratch
   // Handed from stage() to upload(), which may run on different threads.
   mutable std::mutex mutex_;
   std::vector<Pending> pending_;

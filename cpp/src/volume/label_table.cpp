@@ -1,6 +1,7 @@
 #include "ambfplus/volume/label_table.h"
 
 #include <yaml-cpp/yaml.h>
+#include <cctype>
 #include <cerrno>
 #include <cstring>
 
@@ -65,6 +66,20 @@ std::uint16_t resolve_label(const LabelTable& table, const std::string& name,
   }
   if (table.empty()) message << " no labels";
   throw NotFound(message.str());
+}
+
+bool is_bone(const LabelTable& table, const Label& label) {
+  if (table.size() == 1) return true;
+  std::string name = label.name;
+  for (char& c : name) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  static const char* const kBony[] = {"bone",   "bony",   "osse",      "ossic",   "malleus",
+                                      "incus",  "stapes", "labyrinth", "cochlea", "mastoid",
+                                      "cortex", "tegmen", "petrous",   "skull",   "zygom",
+                                      "mandib", "condyl", "vertebr"};
+  for (const char* word : kBony) {
+    if (name.find(word) != std::string::npos) return true;
+  }
+  return false;
 }
 
 std::uint16_t LabelTable::max_id() const {

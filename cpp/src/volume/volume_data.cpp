@@ -176,7 +176,14 @@ void VolumeData::mark_critical_structures() {
   table_ = LabelTable(labels);
 }
 
+void VolumeData::mark_intensity_changed() {
+  auto guarded = guard_lock();  // the world showing it renders under this lock
+  ++intensity_revision_;
+}
+
 void VolumeData::set_intensity_type(IntensityType type) {
+  auto guarded = guard_lock();
+  ++intensity_revision_;
   intensity_type_ = type;
   const std::size_t bytes = type == IntensityType::kNone    ? 0
                             : type == IntensityType::kInt16 ? 2

@@ -49,6 +49,13 @@ class AMBFPLUS_API LabelTable {
 AMBFPLUS_API std::uint16_t resolve_label(const LabelTable& table, const std::string& name,
                                          const std::string& what);
 
+/// Whether a label is bone, for the looks' bone texture (Camera::looks): its name names a bone
+/// or a bony structure (a word of "bone", "bony", "osse", "ossic", "malleus", "incus", "stapes",
+/// "labyrinth", "cochlea", "mastoid", "cortex", "tegmen", "petrous", "skull", "zygom", "mandib",
+/// "condyl", "vertebr", case ignored), or it is the only label of its table (a one-material
+/// volume such as a thresholded CT). Nerves, vessels, dura, canals and joints are not.
+AMBFPLUS_API bool is_bone(const LabelTable& table, const Label& label);
+
 /// Reads a label table from CSV or YAML (by extension). CSV: a header row, then rows of
 /// `name,r,g,b` (ids 1, 2, ... in file order) or with an `id` column and optional `removable` and
 /// `critical` columns. YAML: a list (or `labels:` list) of {id, name, color: [r, g, b], removable,

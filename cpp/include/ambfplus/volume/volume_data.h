@@ -117,9 +117,16 @@ class AMBFPLUS_API VolumeData {
   }
 
   IntensityType intensity_type() const { return intensity_type_; }
+  /// The intensity grid. Writes through it are not seen by renderers until
+  /// mark_intensity_changed().
   void* intensity_data() { return intensity_.empty() ? nullptr : intensity_.data(); }
   /// Allocates a zeroed intensity grid of this type (kNone removes it).
   void set_intensity_type(IntensityType type);
+  /// Declares that the intensity grid was changed directly (through intensity_data() or the
+  /// NumPy view): renderers read it again.
+  void mark_intensity_changed();
+  /// Counts set_intensity_type() and mark_intensity_changed() calls.
+  std::int64_t intensity_revision() const { return intensity_revision_; }
 
   /// Centre of voxel (i, j, k) in the volume frame; throws OutOfRange outside the grid.
   Eigen::Vector3d voxel_center(int i, int j, int k) const;
@@ -241,6 +248,7 @@ class AMBFPLUS_API VolumeData {
   std::vector<std::uint8_t> original_;  // what reset() restores
   IntensityType intensity_type_ = IntensityType::kNone;
   std::vector<std::uint8_t> intensity_;
+  std::int64_t intensity_revision_ = 0;
   Eigen::Matrix4d patient_from_volume_ = Eigen::Matrix4d::Identity();
   std::string source_;
 

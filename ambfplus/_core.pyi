@@ -29,7 +29,7 @@ class OutOfRange(Error, IndexError):
     """An index outside what it indexes."""
 class ArgumentTypeError(ArgumentError, TypeError):
     """A value of the wrong type, or a keyword option that does not exist."""
-__all__: list[str] = ['ActuatorHold', 'ArgumentError', 'ArgumentTypeError', 'AssetNotFound', 'Axis', 'Camera', 'ConfigError', 'ConstraintActuator', 'ControlOutput', 'DRILL_SOUND_MAX_WARNINGS', 'Device', 'DistanceField', 'Drill', 'DrillSound', 'Error', 'Frame', 'InputDevice', 'Joint', 'JointType', 'JoystickDevice', 'JoystickMapping', 'KeyboardDevice', 'Label', 'Light', 'LightType', 'LiveMetrics', 'LoadReport', 'MergedDevice', 'MeshCollision', 'Model', 'NetworkDevice', 'NotFound', 'NullDevice', 'Object', 'OpenXrSession', 'OutOfRange', 'PLUGIN_ABI_VERSION', 'PluginError', 'PluginInfo', 'PluginSite', 'ProximitySensor', 'RealTimeLoop', 'RemovalMode', 'RenderError', 'ReplayDevice', 'ResourceError', 'RigidBody', 'ScriptedDevice', 'ShapeKind', 'SimulatedDevice', 'Simulator', 'SkillMetrics', 'SoftBody', 'StateError', 'Volume', 'VolumeData', 'Window', 'World', 'capture_passes', 'gl_info', 'live_metrics', 'load_nrrd', 'load_slice_stack', 'openxr_built', 'phantom', 'plugin_search_path', 'read_colors', 'read_input_devices', 'read_label_table', 'read_launch', 'render_drill_sound', 'use_x11_display', 'write_image', 'write_label_table']
+__all__: list[str] = ['ActuatorHold', 'ArgumentError', 'ArgumentTypeError', 'AssetNotFound', 'Axis', 'Camera', 'ConfigError', 'ConstraintActuator', 'ControlOutput', 'DRILL_SOUND_MAX_WARNINGS', 'Device', 'DistanceField', 'Drill', 'DrillSound', 'Error', 'Frame', 'InputDevice', 'Joint', 'JointType', 'JoystickDevice', 'JoystickMapping', 'KeyboardDevice', 'Label', 'Light', 'LightType', 'LiveMetrics', 'LoadReport', 'MergedDevice', 'MeshCollision', 'Model', 'NetworkDevice', 'NotFound', 'NullDevice', 'Object', 'OpenXrSession', 'OutOfRange', 'PLUGIN_ABI_VERSION', 'PluginError', 'PluginInfo', 'PluginSite', 'ProximitySensor', 'RealTimeLoop', 'RemovalMode', 'RenderError', 'ReplayDevice', 'ResourceError', 'RigidBody', 'ScriptedDevice', 'ShapeKind', 'SimulatedDevice', 'Simulator', 'SkillMetrics', 'SoftBody', 'StateError', 'Volume', 'VolumeData', 'Window', 'World', 'burr_in_volume', 'capture_passes', 'gl_info', 'live_metrics', 'load_nrrd', 'load_slice_stack', 'openxr_built', 'phantom', 'plugin_search_path', 'read_colors', 'read_input_devices', 'read_label_table', 'read_launch', 'render_drill_sound', 'use_x11_display', 'write_image', 'write_label_table']
 class Window:
     """
     An X11 window (GLFW's, made without a client API) showing cameras.
@@ -2698,6 +2698,10 @@ class PluginInfo:
 def _register_plugin_support(arg0: typing.Any, arg1: typing.Any, arg2: typing.Any) -> None:
     """
     Called once by ambfplus.plugin: the Plugin base class and the functions making Python plugins from a file and from an entry-point name.
+    """
+def burr_in_volume(world_from_volume: typing.Annotated[numpy.typing.ArrayLike, numpy.float64], burr_in_world: typing.Annotated[numpy.typing.ArrayLike, numpy.float64]) -> numpy.typing.NDArray[numpy.float64]:
+    """
+    The burr centres (N, 3, world) in the frame of the volume at world_from_volume (4x4): the live metrics' own computation, so that an offline replay sees the same bits.
     """
 def capture_passes() -> list:
     """

@@ -389,6 +389,35 @@ void define_training(py::module_& m) {
                              "Whether the metrics are still fed (their drill is in the world).");
 
   m.def(
+      "burr_in_volume",
+      [](const Doubles& world_from_volume, const Doubles& burr_in_world) {
+        if (world_from_volume.ndim() != 2 || world_from_volume.shape(0) != 4 ||
+            world_from_volume.shape(1) != 4) {
+          throw ArgumentError("burr_in_volume: world_from_volume must be a 4x4 matrix");
+        }
+        if (burr_in_world.ndim() != 2 || burr_in_world.shape(1) != 3) {
+          throw ArgumentError("burr_in_volume: burr_in_world must have shape (N, 3)");
+        }
+        Eigen::Matrix4d pose;
+        for (int r = 0; r < 4; ++r) {
+          for (int c = 0; c < 4; ++c) pose(r, c) = world_from_volume.at(r, c);
+        }
+        const py::ssize_t n = burr_in_world.shape(0);
+        py::array_t<double> out({n, py::ssize_t(3)});
+        auto o = out.mutable_unchecked<2>();
+        for (py::ssize_t i = 0; i < n; ++i) {
+          const Eigen::Vector3d p(burr_in_world.at(i, 0), burr_in_world.at(i, 1),
+                                  burr_in_world.at(i, 2));
+          const Eigen::Vector3d v = burr_in_volume(pose, p);
+          for (int a = 0; a < 3; ++a) o(i, a) = v[a];
+        }
+        return out;
+      },
+      py::arg("world_from_volume"), py::arg("burr_in_world"),
+      "The burr centres (N, 3, world) in the frame of the volume at world_from_volume (4x4): the "
+      "live metrics' own computation, so that an offline replay sees the same bits.");
+
+  m.def(
       "live_metrics",
       [](Drill& drill, const py::list& protect, const py::handle& target_labels,
          const py::handle& target_mask, double excess_force, double stroke_gap, double turn_step,

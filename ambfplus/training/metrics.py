@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._core import SkillMetrics, VolumeData
+from .._core import SkillMetrics, VolumeData, burr_in_volume
 from ..recording.ticks import drill_columns, removed_ticks, tick_seconds
 
 
@@ -51,8 +51,10 @@ def drill_ticks(
             f"drill '{drill}' used burr {int(burr.max())}, but {len(diameters)} burr diameters "
             "were given"
         )
-    volume_from_world = np.linalg.inv(np.asarray(volume_pose, dtype=float))
-    tips = pose[:, :3, 3] @ volume_from_world[:3, :3].T + volume_from_world[:3, 3]
+    # The live metrics' own computation (not NumPy's inverse, which differs in the last bits).
+    tips = burr_in_volume(
+        np.asarray(volume_pose, dtype=float), np.ascontiguousarray(pose[:, :3, 3])
+    )
     step = np.asarray(steps["step"], dtype=np.int64)
     times = np.asarray(steps["time"], dtype=float)
     dt = tick_seconds(times)

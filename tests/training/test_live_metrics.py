@@ -65,6 +65,41 @@ def test_live_metrics_equal_the_offline_assessment(tmp_path):
     assert len(costs) == 6000 and np.all(costs >= 0)
 
 
+def test_the_replay_takes_the_burr_centres_the_live_metrics_took_bit_for_bit():
+    """With the volume turned, NumPy's inverse of its pose differs from the engine's in the last
+    bits; the replay takes the burr centres from the live metrics' own computation, so that a
+    clearance, and a near tie between two ticks' clearances, falls the same live and offline."""
+    from ambfplus.training.metrics import burr_in_volume, drill_ticks
+    from ambfplus.transforms import make_pose
+
+    scene = ambfplus.scenes.drilling_phantom(resolution=32, width=64, height=48)
+    drill, volume = scene.drill, scene.drill.volume
+    volume.pose = make_pose((0.003, -0.002, 0.001), rpy=(0.31, -0.27, 0.93))
+    protect = [{"labels": "Facial_Nerve", "margin": 0.001}]
+    live = ambfplus.live_metrics(drill, protect=protect)
+    poses = []
+    for _ in range(5):
+        scene.world.step(1)
+        poses.append(np.asarray(drill.pose, float).copy())
+    n = len(poses)
+    steps = {"step": np.arange(n), "time": np.arange(n) * 0.001,
+             f"{drill.key}.pose": np.stack(poses).reshape(n, 16),
+             f"{drill.key}.force": np.zeros((n, 3)), f"{drill.key}.on": np.zeros((n, 1)),
+             f"{drill.key}.burr": np.full((n, 1), drill.burr)}  # fmt: skip
+    removed = {"step": np.zeros(0, np.int64), "voxel": np.zeros((0, 3), np.int32),
+               "label": np.zeros(0, np.uint16)}  # fmt: skip
+    pose = np.asarray(volume.pose, float)
+    tips = drill_ticks(steps, removed, drill.key, drill.burr_diameters, pose)["tips"]
+    centres = np.stack(poses)[:, :3, 3]
+    np.testing.assert_array_equal(tips, burr_in_volume(pose, centres))
+    inverse = np.linalg.inv(pose)
+    assert np.any(centres @ inverse[:3, :3].T + inverse[:3, 3] != tips), "the bits do differ"
+    # The same centre and the same field: the same clearance, to the last bit.
+    offline = ambfplus.SkillMetrics(volume.data, protect=protect)
+    distance = live.clearances()[0]["distance"]
+    assert distance == offline.clearance(0, tips[-1], drill.burr_radius)
+
+
 def test_live_metrics_check_their_config_and_count_every_step():
     scene = ambfplus.scenes.drilling_phantom(resolution=32, width=64, height=48)
     with pytest.raises(ambfplus.NotFound, match="Facial nerve"):

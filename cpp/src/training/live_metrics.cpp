@@ -54,7 +54,7 @@ void LiveMetrics::tick(const StepContext& context) {
 }
 
 Eigen::Vector3d LiveMetrics::tip() const {
-  return drill_->volume().pose().inverse() * drill_->pose().translation();
+  return burr_in_volume(drill_->volume().pose().matrix(), drill_->pose().translation());
 }
 
 std::vector<LiveMetrics::Clearance> LiveMetrics::clearances() const {

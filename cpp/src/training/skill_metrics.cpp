@@ -257,4 +257,10 @@ MetricsSummary SkillMetrics::summary() const {
   return out;
 }
 
+Eigen::Vector3d burr_in_volume(const Eigen::Matrix4d& world_from_volume,
+                               const Eigen::Vector3d& burr_in_world) {
+  const Eigen::Isometry3d volume(world_from_volume);
+  return volume.inverse() * burr_in_world;
+}
+
 }  // namespace ambfplus

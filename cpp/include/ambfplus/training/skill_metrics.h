@@ -7,6 +7,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "ambfplus/export.h"
 #include "ambfplus/volume/distance_field.h"
@@ -122,6 +123,13 @@ struct AMBFPLUS_API MetricsSummary {
   std::vector<StructureMetrics> structures;
   std::vector<Stroke> strokes;
 };
+
+/// The burr's centre in the volume's frame, from the volume's pose and the burr's position in the
+/// world. The live metrics and an offline replay of a recording both take their ticks' centres
+/// from here, so that both compare the same bits (a near tie between two ticks' clearances must
+/// not fall differently).
+AMBFPLUS_API Eigen::Vector3d burr_in_volume(const Eigen::Matrix4d& world_from_volume,
+                                            const Eigen::Vector3d& burr_in_world);
 
 /// Skill metrics of a drilling session, computed tick by tick: live in the haptic loop (each
 /// tick costs a distance-field sample per protected structure and a few additions) and offline

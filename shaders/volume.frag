@@ -221,10 +221,10 @@ void main() {
   float t = t_enter;
 #ifdef FROM_PIXELS
   // A sample searches the depths at which the nine pixel centres around its pixel see a
-  // volume, widened by 3 voxels and their spread on either side, with no far end where one of
-  // them shows a mesh or nothing (a surface the centres see is found in a few steps, and a ray
-  // that passes it ends there instead of grazing on): only a feature thinner than a pixel,
-  // missed by all nine, could lie outside. None of them seeing one, the sample is not drawn
+  // volume, widened by 3 voxels (and at a silhouette their spread) on either side, with no far
+  // end where one of them shows a mesh or nothing (a surface the centres see is found in a few
+  // steps, and a ray that passes it ends there instead of grazing on): only a feature thinner
+  // than a pixel, missed by all nine, could lie outside. None of them seeing one, the sample is not drawn
   // (SceneRenderer::supersample). Where the search would start inside the surface it starts at
   // the box instead.
   vec3 range = texelFetch(u_depth_range, ivec2(gl_FragCoord.xy) / u_supersample_factor, 0).xyz;
@@ -236,8 +236,10 @@ void main() {
   if (z_far < 0.0 || dz <= 0.0) {
     t = t_exit + 1.0;  // no search
   } else {
-    // Near a silhouette the depth runs on past the nine: add their spread on either side.
-    float spread = (z_far - z_near) / dz;
+    // Near a silhouette the depth runs on past the nine: add their spread on either side. Where
+    // all nine see a volume, the surface between them lies within their depths (a slope's
+    // depths span the pixel, an inner edge's side wall lies between its top and the floor).
+    float spread = range.z > 0.5 ? (z_far - z_near) / dz : 0.0;
     if (!open_far) t_exit = min(t_exit, (z_far - z0) / dz + reach + spread);
     float m_near = floor(((z_near - z0) / dz - 3.0 - spread - t_enter) / dt);
     if (m_near > 0.0 && t_enter + m_near * dt <= t_exit &&

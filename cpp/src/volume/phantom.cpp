@@ -235,6 +235,23 @@ class Painter {
     }
   }
 
+  // A tapered tube: a point is inside where its distance to segment [a, b] is within the radius
+  // at its foot, from ra at a to rb at b.
+  void taper(const V3& a, const V3& b, double ra, double rb, std::uint8_t label,
+             const std::function<bool(std::uint8_t)>& allowed = nullptr) {
+    ra = std::max(ra, min_radius_);
+    rb = std::max(rb, min_radius_);
+    const double r = std::max(ra, rb);
+    const V3 ab = b - a;
+    paint(
+        a.cwiseMin(b).array() - r, a.cwiseMax(b).array() + r,
+        [&](const V3& p) {
+          const double t = std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
+          return (p - (a + t * ab)).norm() <= ra + (rb - ra) * t;
+        },
+        label, allowed);
+  }
+
   void torus(const V3& centre, const V3& axis, double major, double minor, std::uint8_t label) {
     minor = std::max(minor, min_radius_);
     const double reach = major + minor;
@@ -478,8 +495,11 @@ Landmarks place_landmarks(const Anatomy& a) {
 // of and above it, and the suprameatal (Henle's) spine at its posterosuperior rim.
 void paint_cortex(Painter& paint, const Landmarks& m, const Anatomy& a) {
   paint.ellipsoid(V3(-6, -18, 6), V3(8, 8, 7.5), kBone, only(kEmpty));
-  paint.tube({m.eac + V3(3, 6, 8), m.eac + V3(10, 6.5, 7.5), V3(24, m.eac.y() + 6, 13)}, 2.6, kBone,
-             nullptr, only(kEmpty));
+  // The zygomatic root: a ridge that rises out of the squama above the canal and runs forwards.
+  const V3 root = m.eac + V3(3, 6, 7.6);
+  paint.taper(m.eac + V3(-9, 6.5, 6.8), root, 1.0, 2.6, kBone, only(kEmpty));
+  paint.tube({root, m.eac + V3(10, 6.5, 7.5), V3(24, m.eac.y() + 6, 13)}, 2.6, kBone, nullptr,
+             only(kEmpty));
   const V3 rim = m.eac + V3(2.0 - a.eac_radius * 0.75, 1.0 + a.eac_radius * 0.65, 8.2);
   paint.tube({rim, rim + V3(0.4, -0.3, 1.2)}, 0.7, kBone, nullptr, only(kEmpty));
 }

@@ -527,6 +527,8 @@ void paint_canal_and_joint(Painter& paint, const Skull& skull, const Landmarks& 
                            const Anatomy& a) {
   const double s = a.tmj_scale;
   paint.ellipsoid(m.eac + V3(13.5, 0, 0), V3(4.5, 7, 6.5) * s, kTmj, any_of({kBone, kEmpty}));
+  // In front of the canal the cortex falls away to the joint: the condyle shows in its fossa.
+  paint.ellipsoid(m.eac + V3(15, -2, 9), V3(6.5, 8, 4.5), kEmpty, only(kBone));
   // The lateral (cartilaginous) part turns forwards to its opening.
   const std::vector<V3> canal = {m.eac + V3(1.5, 0.5, -7), m.eac + V3(0.5, 0, -3),
                                  m.eac + V3(1.5, 0.4, 4), m.eac + V3(2.0, 1.0, 12)};

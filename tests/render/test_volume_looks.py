@@ -169,15 +169,20 @@ def test_only_bone_takes_the_bone_texture():
     assert abs(np.median(factor[nerve]) - 1) < 0.06
 
 
-def test_a_ct_intensity_grid_replaces_the_procedural_texture(tmp_path):
-    # CT of the slab: bone in 4 mm stripes along x of 400 and 1000 HU under air (-1000 HU).
+def striped_ct(tmp_path) -> ambfplus.VolumeData:
+    """CT of the slab, loaded from an NRRD file: bone in 4 mm stripes along x of 400 and
+    1000 HU under air (-1000 HU), segmented at 300 HU."""
     ct = np.full((48, 48, 24), -1000, np.int16)
     ct[:, :, :20] = np.where((np.arange(48) // 4) % 2 == 1, 1000, 400)[:, None, None]
     path = tmp_path / "ct.nrrd"
     header = "NRRD0004\ntype: short\ndimension: 3\nsizes: 48 48 24\nspacings: 1 1 1\n"
     header += "encoding: raw\nendian: little\n\n"
     path.write_bytes(header.encode() + ct.tobytes(order="F"))
-    data = ambfplus.load_nrrd(path, kind="intensity", threshold=300)
+    return ambfplus.load_nrrd(path, kind="intensity", threshold=300)
+
+
+def test_a_ct_intensity_grid_replaces_the_procedural_texture(tmp_path):
+    data = striped_ct(tmp_path)
     assert data.intensity is not None and data.shape == (48, 48, 24)
     world = world_over(data)
     camera = world.add_camera("cam", W, H, fov_y=0.5, near=0.01, far=1.0)
@@ -200,13 +205,7 @@ def test_a_changed_intensity_grid_is_drawn_after_mark_intensity_changed(tmp_path
     """The intensity grid is read again when it is declared changed: the stripes, inverted
     through the NumPy view after a first render, are drawn inverted; an undeclared write is not
     seen."""
-    ct = np.full((48, 48, 24), -1000, np.int16)
-    ct[:, :, :20] = np.where((np.arange(48) // 4) % 2 == 1, 1000, 400)[:, None, None]
-    path = tmp_path / "ct.nrrd"
-    header = "NRRD0004\ntype: short\ndimension: 3\nsizes: 48 48 24\nspacings: 1 1 1\n"
-    header += "encoding: raw\nendian: little\n\n"
-    path.write_bytes(header.encode() + ct.tobytes(order="F"))
-    data = ambfplus.load_nrrd(path, kind="intensity", threshold=300)
+    data = striped_ct(tmp_path)
     camera = world_over(data).add_camera("cam", W, H, fov_y=0.5, near=0.01, far=1.0, looks=True)
     camera.look_at((0.0, 0.0, 0.13), (0.0, 0.0, 0.0), up=(0, 1, 0))
     first = camera.capture(passes=["rgb", "depth"])

@@ -498,7 +498,7 @@ class World:
         """
     def add_camera(self, name: str, width: typing.SupportsInt | typing.SupportsIndex = 640, height: typing.SupportsInt | typing.SupportsIndex = 480, fov_y: typing.SupportsFloat | typing.SupportsIndex = 0.7, near: typing.SupportsFloat | typing.SupportsIndex = 0.1, far: typing.SupportsFloat | typing.SupportsIndex = 10.0, *, pose: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"] | None = None, background: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex] = [0.0, 0.0, 0.0], shadows: bool = False, antialiasing: typing.SupportsInt | typing.SupportsIndex = 1, looks: bool = False) -> Camera:
         """
-        Adds a pinhole camera (OpenCV frame: x right, y down, z forward); fov_y is the vertical field of view in radians, near and far the clipping distances in metres. shadows, antialiasing (supersampling per axis, 1..4) and looks (volumes' ambient occlusion, bone texture and wet highlights) change the rgb pass only.
+        Adds a pinhole camera (OpenCV frame: x right, y down, z forward); fov_y is the vertical field of view in radians, near and far the clipping distances in metres. shadows, antialiasing (1 = off to 4, see Camera.antialiasing) and looks (volumes' ambient occlusion, bone texture and wet highlights) change the rgb pass only.
         """
     def add_drill(self, name: str, volume: Volume, **kwargs) -> Drill:
         """
@@ -786,7 +786,7 @@ class Model:
         """
     def add_camera(self, name: str, width: typing.SupportsInt | typing.SupportsIndex = 640, height: typing.SupportsInt | typing.SupportsIndex = 480, fov_y: typing.SupportsFloat | typing.SupportsIndex = 0.7, near: typing.SupportsFloat | typing.SupportsIndex = 0.1, far: typing.SupportsFloat | typing.SupportsIndex = 10.0, *, pose: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"] | None = None, background: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex] = [0.0, 0.0, 0.0], shadows: bool = False, antialiasing: typing.SupportsInt | typing.SupportsIndex = 1, looks: bool = False) -> Camera:
         """
-        Adds a pinhole camera (OpenCV frame: x right, y down, z forward); fov_y is the vertical field of view in radians, near and far the clipping distances in metres. shadows, antialiasing (supersampling per axis, 1..4) and looks (volumes' ambient occlusion, bone texture and wet highlights) change the rgb pass only.
+        Adds a pinhole camera (OpenCV frame: x right, y down, z forward); fov_y is the vertical field of view in radians, near and far the clipping distances in metres. shadows, antialiasing (1 = off to 4, see Camera.antialiasing) and looks (volumes' ambient occlusion, bone texture and wet highlights) change the rgb pass only.
         """
     def add_drill(self, name: str, volume: Volume, **kwargs) -> Drill:
         """
@@ -974,7 +974,7 @@ class Camera(Object):
     @property
     def antialiasing(self) -> int:
         """
-        the rgb pass's supersampling per axis: 1 is off, k (2..4) averages k x k samples in pixels at edges and contrasts; ground-truth passes stay one exact sample per pixel centre
+        the rgb pass's antialiasing at edges and contrasts: 1 is off, 2 blends a pixel's centre (1/2) with its four corners (1/8 each), 3 and 4 average a k x k grid of samples; ground-truth passes stay one exact sample per pixel centre
         """
     @antialiasing.setter
     def antialiasing(self, arg1: typing.SupportsInt | typing.SupportsIndex) -> None:

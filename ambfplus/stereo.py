@@ -98,7 +98,7 @@ class StereoRig:
     ``rig_left`` and ``rig_right``; ``working_distance`` (metres) makes it off-axis;
     ``background`` (RGB 0..1) is what both show where nothing is hit, and
     ``principal_point_offset`` (pixels) moves both principal points alike; ``shadows``,
-    ``antialiasing`` (supersampling per axis, 1 = off) and ``looks`` (volumes' ambient
+    ``antialiasing`` (1 = off to 4, see ``Camera.antialiasing``) and ``looks`` (volumes' ambient
     occlusion, bone texture and wet highlights) change both cameras' rgb pass only
     (``Camera.shadows``, ``Camera.antialiasing``, ``Camera.looks``). Move it with
     ``look_at`` or ``pose`` (the left camera's). ``StereoRig.from_cameras(left, right)`` wraps two

@@ -347,7 +347,8 @@ void def_adders(Class& cls, GetModel get_model) {
           py::arg("antialiasing") = 1, py::arg("looks") = false,
           "Adds a pinhole camera (OpenCV frame: x right, y down, z forward); fov_y is the "
           "vertical field of view in radians, near and far the clipping distances in metres. "
-          "shadows, antialiasing (supersampling per axis, 1..4) and looks (volumes' ambient "
+          "shadows, antialiasing (1 = off to 4, see Camera.antialiasing) and looks (volumes' "
+          "ambient "
           "occlusion, bone texture and wet highlights) change the rgb pass only.")
       .def(
           "add_light",
@@ -960,9 +961,10 @@ void define_camera(py::class_<Camera, Object, std::shared_ptr<Camera>>& camera) 
                     "whether the rgb pass draws the shadows of lights with a shadow_quality "
                     "above 0 (directional and spot); ground-truth passes never change")
       .def_property("antialiasing", &Camera::antialiasing, &Camera::set_antialiasing,
-                    "the rgb pass's supersampling per axis: 1 is off, k (2..4) averages k x k "
-                    "samples in pixels at edges and contrasts; ground-truth passes stay one "
-                    "exact sample per pixel centre")
+                    "the rgb pass's antialiasing at edges and contrasts: 1 is off, 2 blends a "
+                    "pixel's centre (1/2) with its four corners (1/8 each), 3 and 4 average a "
+                    "k x k grid of samples; ground-truth passes stay one exact sample per pixel "
+                    "centre")
       .def_property("looks", &Camera::looks, &Camera::set_looks,
                     "whether the rgb pass gives volumes ambient occlusion from their occupancy, "
                     "a world-fixed bone texture (the CT intensity where the volume has one) and "

@@ -1,6 +1,6 @@
 #version 450 core
 // Supersampling: the samples under the points start as background at the far plane, and the
-// stencil marks them (the rest of the k x k larger image is neither cleared nor shaded).
+// stencil marks them (the rest of the lattice is neither cleared nor shaded).
 
 uniform vec4 u_background;
 

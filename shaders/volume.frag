@@ -40,14 +40,17 @@ uniform vec3 u_eye;                // camera position, voxel units
 #define SILHOUETTE_REACH 12.0
 #endif
 #ifdef FROM_PIXELS
-// Supersampling draws points over the pixels to sample: each fragment's ray goes through its
-// own sub-pixel centre.
+// Supersampling casts one ray per fragment of a densely packed target (SceneRenderer::
+// supersample): each reads which lattice point of the camera's image its ray goes through, and
+// the depths to search.
 uniform mat4 u_voxel_from_clip;
-uniform vec2 u_viewport;
-uniform sampler2D u_depth_range;  // per pixel, the nearest and farthest camera z at which the 3 x 3
-                                   // pixel centres around it see a volume (y < 0: none does; x < 0:
-                                   // -nearest, and one of them shows a mesh or nothing)
-uniform int u_supersample_factor;      // k: samples per pixel along x and y
+uniform sampler2D u_packed_where;  // per texel: x the lattice column + reach / 4 (0: within the
+                                   // range, 1: a silhouette, 2: no far end), y the row, z and w the
+                                   // nearest and farthest camera z at which the pixel centres
+                                   // around the point see a volume (w < 0: no ray)
+uniform vec2 u_lattice_origin;     // where lattice point (0, 0) lies, pixels
+uniform float u_lattice_step;      // pixels between lattice points
+uniform vec2 u_image_size;         // the camera's image, pixels
 #endif
 #ifdef ORTHOGRAPHIC
 uniform vec3 u_ray_dir;            // parallel rays (a directional light's shadow map), unit
@@ -197,8 +200,11 @@ void main() {
   vec3 dir = u_ray_dir;
   vec3 eye = v_voxel - u_ray_back * dir;
 #elif defined(FROM_PIXELS)
+  vec4 where = texelFetch(u_packed_where, ivec2(gl_FragCoord.xy), 0);
+  if (where.w < 0.0) discard;
+  vec2 pixel = u_lattice_origin + vec2(floor(where.x), where.y) * u_lattice_step;
   vec3 eye = u_eye;
-  vec4 through = u_voxel_from_clip * vec4(gl_FragCoord.xy / u_viewport * 2.0 - 1.0, 0.5, 1.0);
+  vec4 through = u_voxel_from_clip * vec4(pixel / u_image_size * 2.0 - 1.0, 0.5, 1.0);
   vec3 dir = normalize(through.xyz / through.w - eye);
 #else
   vec3 eye = u_eye;
@@ -220,14 +226,14 @@ void main() {
   int budget = int(4.0 * (u_shape.x + u_shape.y + u_shape.z)) + 16;
   float t = t_enter;
 #ifdef FROM_PIXELS
-  // A sample searches the depths at which the nine pixel centres around its pixel see a
-  // volume, widened by 3 voxels (and at a silhouette their spread) on either side, with no far
-  // end where one of them shows a mesh or nothing (a surface the centres see is found in a few
-  // steps, and a ray that passes it ends there instead of grazing on): only a feature thinner
-  // than a pixel, missed by all nine, could lie outside. None of them seeing one, the sample is not drawn
-  // (SceneRenderer::supersample). Where the search would start inside the surface it starts at
-  // the box instead.
-  vec3 range = texelFetch(u_depth_range, ivec2(gl_FragCoord.xy) / u_supersample_factor, 0).xyz;
+  // A sample searches the depths at which the pixel centres around it (those within a pixel
+  // along each axis) see a volume, widened by 3 voxels (and at a silhouette their spread) on
+  // either side, with no far end where one of them shows a mesh or nothing (a surface the
+  // centres see is found in a few steps, and a ray that passes it ends there instead of grazing
+  // on): only a feature thinner than a pixel, missed by all of them, could lie outside. None of
+  // them seeing one, no ray is cast (SceneRenderer::supersample). Where the search would start
+  // inside the surface it starts at the box instead.
+  vec3 range = vec3(where.z, where.w, fract(where.x) * 4.0);
   float z_near = range.x, z_far = range.y;
   bool open_far = range.z > 1.5;
   float reach = range.z > 0.5 ? SILHOUETTE_REACH : 3.0;
@@ -236,9 +242,9 @@ void main() {
   if (z_far < 0.0 || dz <= 0.0) {
     t = t_exit + 1.0;  // no search
   } else {
-    // Near a silhouette the depth runs on past the nine: add their spread on either side. Where
-    // all nine see a volume, the surface between them lies within their depths (a slope's
-    // depths span the pixel, an inner edge's side wall lies between its top and the floor).
+    // Near a silhouette the depth runs on past the centres: add their spread on either side.
+    // Where all of them see a volume, the surface between them lies within their depths (a
+    // slope's depths span the pixel, an inner edge's side wall lies between its top and floor).
     float spread = range.z > 0.5 ? (z_far - z_near) / dz : 0.0;
     if (!open_far) t_exit = min(t_exit, (z_far - z0) / dz + reach + spread);
     float m_near = floor(((z_near - z0) / dz - 3.0 - spread - t_enter) / dt);

@@ -53,7 +53,8 @@ def build_parser() -> argparse.ArgumentParser:
         default=2,
         choices=range(1, 5),
         metavar="K",
-        help="supersample the cameras' rgb K x K at edges, 1 = off (default 2)",
+        help="supersample the cameras' rgb at edges: 1 = off, 2 = centre and corners, "
+        "3 or 4 = K x K grid (default 2)",
     )
     p.add_argument("--width", type=int, help="window width (default 1536, an HMD's screen)")
     p.add_argument("--height", type=int, help="window height (default 540, an HMD's screen)")

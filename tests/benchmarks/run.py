@@ -469,6 +469,56 @@ def stereo(args) -> Iterator[dict]:
         }
 
 
+@benchmark
+def antialiasing(args) -> Iterator[dict]:
+    """What supersampling buys: on the fixture's stereoL view (drill and ear, shadows and looks
+    on), each pixel supersampling changes, against the mean of a 4 x 4 grid of samples over it
+    (a render at 4 times the resolution). Errors are the largest channel's, 0-255."""
+    if not DRILLING_LAUNCH.is_file():
+        print(f"antialiasing: skipped, fixtures not found at {DRILLING_LAUNCH}", file=sys.stderr)
+        return
+    sim = ambfplus.Simulator.from_launch(DRILLING_LAUNCH, models=[0, 2, 5])
+    base = sim.get("stereoL")
+    w, h = base.width, base.height
+
+    def render(name, factor, antialiasing=1):
+        camera = sim.world.add_camera(
+            name, factor * w, factor * h, fov_y=base.fov_y, near=base.near, far=base.far,
+            shadows=True, looks=True, antialiasing=antialiasing,
+        )  # fmt: skip
+        camera.attach_to(base.attached_to)
+        camera.pose = base.pose
+        rgb = camera.capture(passes=["rgb"]).rgb[..., :3].astype(float)
+        return rgb.reshape(h, factor, w, factor, 3).mean(axis=(1, 3))
+
+    truth = render("x4", 4)
+    images = {
+        "off": render("k1", 1),
+        "k2": render("k2", 1, antialiasing=2),
+        "k3": render("k3", 1, antialiasing=3),
+        "grid_2x2": render("x2", 2),  # the 2 x 2 grid k = 2 took before stop 45
+    }
+    changed = (images["k2"] != images["off"]).any(axis=-1)
+    what = {
+        "off": "no antialiasing: the pixel centre",
+        "k2": "antialiasing 2: centre 1/2, corners 1/8 each (shared with neighbours)",
+        "k3": "antialiasing 3: a 3 x 3 grid per pixel",
+        "grid_2x2": "a 2 x 2 grid per pixel (a render at twice the resolution)",
+    }
+    for name, image in images.items():
+        error = np.abs(image - truth).max(axis=-1)[changed]
+        yield {
+            "bench": f"antialiasing_error_{name}",
+            "value": round(float(error.mean()), 3),
+            "unit": "mean error (0-255) over the pixels antialiasing 2 changes",
+            "median": round(float(np.median(error)), 3),
+            "p99": round(float(np.percentile(error, 99)), 3),
+            "max": round(float(error.max()), 3),
+            "pixels": int(changed.sum()),
+            "what": what[name],
+        }
+
+
 def realtime_scene():
     """The drilling fixture (drill meshes, ear 256^3, its main camera at 640x480) with the
     drilling plugin's drill, or the built-in phantom when the fixtures are absent. Returns the

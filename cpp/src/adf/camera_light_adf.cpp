@@ -129,7 +129,7 @@ CameraPlan plan_camera(const Doc& doc, const std::string& base_ns, const std::st
   if (n["antialiasing"]) {
     plan.spec.antialiasing = integer(doc, n["antialiasing"], id, "antialiasing");
     if (plan.spec.antialiasing < 1 || plan.spec.antialiasing > kMaxAntialiasing) {
-      fail(doc, n["antialiasing"], id, "'antialiasing' must be 1 (off) to 4 samples per axis");
+      fail(doc, n["antialiasing"], id, "'antialiasing' must be 1 (off) to 4");
     }
   }
   if (const YAML::Node stereo = mapping(doc, n, "stereo", id)) {

@@ -77,7 +77,12 @@ void release_supersampling(RenderTarget& t) {
   glDeleteFramebuffers(1, &t.samples_framebuffer);
   glDeleteTextures(2, t.samples);
   glDeleteTextures(1, &t.mask);
-  glDeleteTextures(1, &t.depth_range);
+  glDeleteTextures(1, &t.lattice_index);
+  glDeleteFramebuffers(1, &t.packed_framebuffer);
+  glDeleteTextures(3, t.packed);
+  t.packed_framebuffer = 0;
+  t.packed[0] = t.packed[1] = t.packed[2] = 0;
+  t.packed_width = t.packed_height = 0;
   glDeleteVertexArrays(1, &t.points_vao);
   glDeleteBuffers(1, &t.points_buffer);
   t.factor = 0;
@@ -806,21 +811,50 @@ void supersample_edges(const EdgeInputs& in, int width, int height, std::uint8_t
   }
 }
 
+namespace {
+
+/// A 2D texture of one level, filtered nearest.
+GLuint nearest_texture(GLenum format, int width, int height) {
+  GLuint texture = 0;
+  glGenTextures(1, &texture);
+  glBindTexture(GL_TEXTURE_2D, texture);
+  glTexStorage2D(GL_TEXTURE_2D, 1, format, width, height);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glBindTexture(GL_TEXTURE_2D, 0);
+  return texture;
+}
+
+/// Binds a 2D texture to a unit and names the unit in a sampler uniform.
+void bind_unit(Program& program, const char* name, int unit, GLuint texture) {
+  glActiveTexture(GL_TEXTURE0 + unit);
+  glBindTexture(GL_TEXTURE_2D, texture);
+  glUniform1i(program.uniform(name), unit);
+}
+
+}  // namespace
+
 void SceneRenderer::supersample(const Snapshot& s, RenderTarget& target,
                                 const SurfacePass& shading) {
   const int k = s.antialiasing;
-  const int w = target.width * k, h = target.height * k;
+  const int width = target.width, height = target.height;
+  // The samples' lattice, in pixel units with pixel x spanning [x, x + 1]: for k = 2 the pixels'
+  // corners (point (i, j) at (i, j)); each pixel sampled becomes the mean of its centre (its
+  // own sample from the main pass) and of its four corners, weighted 1/2 and 1/8 each, corners
+  // shared with its neighbours. For k = 3 and 4, k x k points per pixel (point (i, j) at
+  // ((i + 0.5) / k, (j + 0.5) / k)) and their plain mean.
+  const bool corners = k == 2;
+  const int lw = corners ? width + 1 : width * k, lh = corners ? height + 1 : height * k;
+  const float step = corners ? 1.0f : 1.0f / float(k), origin = corners ? 0.0f : 0.5f / float(k);
   if (target.factor != k) {
     release_supersampling(target);
     target.factor = k;
-    glGenTextures(2, target.samples);
-    const GLenum formats[2] = {GL_RGBA8, GL_DEPTH32F_STENCIL8};
-    for (int i = 0; i < 2; ++i) {
-      glBindTexture(GL_TEXTURE_2D, target.samples[i]);
-      glTexStorage2D(GL_TEXTURE_2D, 1, formats[i], w, h);
-      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    }
+    target.lattice_width = lw;
+    target.lattice_height = lh;
+    target.samples[0] = nearest_texture(GL_RGBA8, lw, lh);
+    target.samples[1] = nearest_texture(GL_DEPTH32F_STENCIL8, lw, lh);
+    target.mask = nearest_texture(GL_R8UI, width, height);
+    target.lattice_index = nearest_texture(GL_RG16I, lw, lh);
     glGenFramebuffers(1, &target.samples_framebuffer);
     glBindFramebuffer(GL_FRAMEBUFFER, target.samples_framebuffer);
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, target.samples[0],
@@ -828,17 +862,6 @@ void SceneRenderer::supersample(const Snapshot& s, RenderTarget& target,
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_TEXTURE_2D,
                            target.samples[1], 0);
     const GLenum samples_status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
-    // Per pixel: the mask, and the depth ranges of the volumes' samples.
-    const GLenum formats_per_pixel[2] = {GL_R8UI, GL_RGB32F};
-    GLuint* per_pixel[2] = {&target.mask, &target.depth_range};
-    for (int i = 0; i < 2; ++i) {
-      glGenTextures(1, per_pixel[i]);
-      glBindTexture(GL_TEXTURE_2D, *per_pixel[i]);
-      glTexStorage2D(GL_TEXTURE_2D, 1, formats_per_pixel[i], target.width, target.height);
-      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-      glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    }
-    glBindTexture(GL_TEXTURE_2D, 0);
     glGenVertexArrays(1, &target.points_vao);
     glGenBuffers(1, &target.points_buffer);
     glBindVertexArray(target.points_vao);
@@ -849,13 +872,13 @@ void SceneRenderer::supersample(const Snapshot& s, RenderTarget& target,
     glBindBuffer(GL_ARRAY_BUFFER, 0);
     if (samples_status != GL_FRAMEBUFFER_COMPLETE) {
       release_supersampling(target);
-      throw RenderError("camera '" + s.camera_name + "': the supersampled image of " +
-                        std::to_string(w) + "x" + std::to_string(h) + " cannot be made");
+      throw RenderError("camera '" + s.camera_name + "': the supersampling lattice of " +
+                        std::to_string(lw) + "x" + std::to_string(lh) + " cannot be made");
     }
-    check_gl("creating a supersampled target");
+    check_gl("creating a supersampling lattice");
   }
   // Which pixels to sample, from the exact passes and the shaded colour of the pixel centres.
-  const std::size_t pixels = std::size_t(target.width) * target.height;
+  const std::size_t pixels = std::size_t(width) * height;
   edge_inputs_.rgba.resize(pixels * 4);
   edge_inputs_.depth.resize(pixels);
   edge_inputs_.label.resize(pixels);
@@ -872,101 +895,167 @@ void SceneRenderer::supersample(const Snapshot& s, RenderTarget& target,
                  {edge_inputs_.instance.data(), GL_RED_INTEGER, GL_INT}};
   for (int i = 0; i < 4; ++i) {
     glReadBuffer(static_cast<GLenum>(GL_COLOR_ATTACHMENT0 + i));
-    glReadPixels(0, 0, target.width, target.height, inputs[i].format, inputs[i].type,
-                 inputs[i].data);
+    glReadPixels(0, 0, width, height, inputs[i].format, inputs[i].type, inputs[i].data);
   }
   supersample_mask_.resize(pixels);
-  supersample_edges(edge_inputs_, target.width, target.height, supersample_mask_.data());
-  glBindTexture(GL_TEXTURE_2D, target.mask);
-  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, target.width, target.height, GL_RED_INTEGER,
-                  GL_UNSIGNED_BYTE, supersample_mask_.data());
-  glBindTexture(GL_TEXTURE_2D, 0);
-  // One point per 2 x 2 block of pixels with one to sample: a software rasteriser shades
-  // blocks of 4 x 4 samples together, so isolated pixels would leave most of its lanes idle.
-  // Blocks where a volume is seen come first: volumes are sampled at those only, each pixel
-  // searching between the nearest and farthest depths at which the 3 x 3 around it sees a
-  // volume (volume.frag).
-  supersample_points_.clear();
-  supersample_others_.clear();
-  supersample_depths_.resize(pixels * 3);
-  const auto marked = [&](int x, int y) {
-    return x < target.width && y < target.height &&
-           supersample_mask_[std::size_t(y) * target.width + x] != 0;
+  supersample_edges(edge_inputs_, width, height, supersample_mask_.data());
+
+  // The lattice points of the pixels to sample.
+  lattice_needed_.assign(std::size_t(lw) * lh, 0);
+  std::size_t needed = 0;
+  const auto need = [&](int i, int j) {
+    std::uint8_t& n = lattice_needed_[std::size_t(j) * lw + i];
+    needed += n == 0;
+    n = 1;
   };
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      if (supersample_mask_[std::size_t(y) * width + x] == 0) continue;
+      const int n = corners ? 2 : k, x0 = corners ? x : k * x, y0 = corners ? y : k * y;
+      for (int b = 0; b < n; ++b) {
+        for (int a = 0; a < n; ++a) need(x0 + a, y0 + b);
+      }
+    }
+  }
   const auto is_volume = [&](std::int32_t id) {
     for (const Snapshot::Volume& v : s.volumes) {
       if (v.id == id) return true;
     }
     return false;
   };
-  // The depth range of pixel (x, y)'s neighbourhood, and how far past it to search: false
-  // where no volume is seen there. Past a silhouette against the background a grazing sample
-  // meets the surface farther on; a mesh seen there may hide any of a volume behind it.
-  const auto depth_range = [&](int x, int y) {
-    float lo = std::numeric_limits<float>::infinity(), hi = -1.0f, reach = 0.0f;
-    for (int qy = std::max(0, y - 1); qy <= std::min(target.height - 1, y + 1); ++qy) {
-      for (int qx = std::max(0, x - 1); qx <= std::min(target.width - 1, x + 1); ++qx) {
-        const std::size_t q = std::size_t(qy) * target.width + qx;
+  // Where a volume's ray at a lattice point searches: between the nearest and farthest depths
+  // at which the pixel centres within one pixel of it (along each axis) see a volume, and how
+  // far past them (volume.frag): 0 within the range, 1 at a silhouette against the background
+  // (a grazing ray meets the surface farther on), 2 with no far end (a mesh seen there may hide
+  // any of a volume behind it). False where none of them sees a volume: no ray.
+  struct Range {
+    float lo, hi, reach;
+  };
+  const auto depth_range = [&](int i, int j, Range& r) {
+    const float sx = origin + float(i) * step, sy = origin + float(j) * step;
+    const int x0 = std::max(0, int(std::ceil(sx - 1.5f)));
+    const int x1 = std::min(width - 1, int(std::floor(sx + 0.5f)));
+    const int y0 = std::max(0, int(std::ceil(sy - 1.5f)));
+    const int y1 = std::min(height - 1, int(std::floor(sy + 0.5f)));
+    r = {std::numeric_limits<float>::infinity(), -1.0f, 0.0f};
+    for (int qy = y0; qy <= y1; ++qy) {
+      for (int qx = x0; qx <= x1; ++qx) {
+        const std::size_t q = std::size_t(qy) * width + qx;
         const std::int32_t id = edge_inputs_.instance[q];
         if (!is_volume(id)) {
-          reach = std::max(reach, id == 0 ? 1.0f : 2.0f);
+          r.reach = std::max(r.reach, id == 0 ? 1.0f : 2.0f);
           continue;
         }
-        lo = std::min(lo, edge_inputs_.depth[q]);
-        hi = std::max(hi, edge_inputs_.depth[q]);
+        r.lo = std::min(r.lo, edge_inputs_.depth[q]);
+        r.hi = std::max(r.hi, edge_inputs_.depth[q]);
       }
     }
-    // Nearest and farthest depth (-1: no volume), and 0 (within the range), 1 (a silhouette)
-    // or 2 (no far end).
-    float* out = &supersample_depths_[3 * (std::size_t(y) * target.width + x)];
-    out[0] = hi < 0.0f ? 0.0f : lo;
-    out[1] = hi;
-    out[2] = reach;
-    return hi >= 0.0f;
+    return r.hi >= 0.0f;
   };
-  for (int y = 0; y < target.height; y += 2) {
-    for (int x = 0; x < target.width; x += 2) {
-      if (!(marked(x, y) || marked(x + 1, y) || marked(x, y + 1) || marked(x + 1, y + 1))) {
-        continue;
-      }
-      bool volume = false;
-      for (int py = y; py < std::min(y + 2, target.height); ++py) {
-        for (int px = x; px < std::min(x + 2, target.width); ++px) {
-          volume = depth_range(px, py) || volume;
+  // The volumes' rays are packed densely into a target about square, 16 neighbouring lattice
+  // points to each 4 x 4 block of it (a software rasteriser shades such blocks together, so its
+  // lanes all work, on rays much alike). Per texel: x the lattice column plus reach / 4, y the
+  // row, z and w the depth range (w < 0: no ray). lattice_index gives each point its texel.
+  const auto round4 = [](int v) { return (v + 3) / 4 * 4; };
+  const int side = std::max(4, round4(int(std::ceil(std::sqrt(double(needed))))));
+  packed_where_.assign(std::size_t(side) * side * 4, -1.0f);
+  lattice_index_.assign(std::size_t(lw) * lh * 2, std::int16_t(-1));
+  supersample_points_.clear();
+  int packed = 0;
+  for (int ty = 0; ty < lh; ty += 4) {
+    for (int tx = 0; tx < lw; tx += 4) {
+      bool any = false;
+      for (int j = ty; j < std::min(ty + 4, lh); ++j) {
+        for (int i = tx; i < std::min(tx + 4, lw); ++i) {
+          if (lattice_needed_[std::size_t(j) * lw + i] == 0) continue;
+          any = true;
+          Range r;
+          if (!depth_range(i, j, r)) continue;
+          const int tile = packed / 16, in_tile = packed % 16;
+          const int u = tile % (side / 4) * 4 + in_tile % 4,
+                    v = tile / (side / 4) * 4 + in_tile / 4;
+          ++packed;
+          float* where = &packed_where_[4 * (std::size_t(v) * side + u)];
+          where[0] = float(i) + 0.25f * r.reach;
+          where[1] = float(j);
+          where[2] = r.lo;
+          where[3] = r.hi;
+          std::int16_t* index = &lattice_index_[2 * (std::size_t(j) * lw + i)];
+          index[0] = std::int16_t(u);
+          index[1] = std::int16_t(v);
         }
       }
-      (volume ? supersample_points_ : supersample_others_)
-          .insert((volume ? supersample_points_ : supersample_others_).end(),
-                  {float(x + 1), float(y + 1)});
+      // One point per 4 x 4 tile of the lattice with a point to sample: the marker.
+      if (any)
+        supersample_points_.insert(supersample_points_.end(), {float(tx + 2), float(ty + 2)});
     }
   }
-  const auto volume_points = static_cast<GLsizei>(supersample_points_.size() / 2);
-  supersample_points_.insert(supersample_points_.end(), supersample_others_.begin(),
-                             supersample_others_.end());
-  glBindTexture(GL_TEXTURE_2D, target.depth_range);
-  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, target.width, target.height, GL_RGB, GL_FLOAT,
-                  supersample_depths_.data());
-  glBindTexture(GL_TEXTURE_2D, 0);
-  const auto points = static_cast<GLsizei>(supersample_points_.size() / 2);
+  const auto tiles = static_cast<GLsizei>(supersample_points_.size() / 2);
+  // One point per 2 x 2 block of pixels with one to sample: the resolve.
+  for (int y = 0; y < height; y += 2) {
+    for (int x = 0; x < width; x += 2) {
+      bool any = false;
+      for (int py = y; py < std::min(y + 2, height); ++py) {
+        for (int px = x; px < std::min(x + 2, width); ++px) {
+          any = any || supersample_mask_[std::size_t(py) * width + px] != 0;
+        }
+      }
+      if (any) supersample_points_.insert(supersample_points_.end(), {float(x + 1), float(y + 1)});
+    }
+  }
+  const auto blocks = static_cast<GLsizei>(supersample_points_.size() / 2) - tiles;
   glEnable(GL_DEPTH_TEST);
-  if (points == 0) {
+  if (blocks == 0) {
     glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
     return;
   }
+  const int tiles_packed = (packed + 15) / 16, tiles_per_row = side / 4;
+  const int rows = 4 * ((tiles_packed + tiles_per_row - 1) / tiles_per_row);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glBindTexture(GL_TEXTURE_2D, target.mask);
+  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width, height, GL_RED_INTEGER, GL_UNSIGNED_BYTE,
+                  supersample_mask_.data());
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glBindTexture(GL_TEXTURE_2D, target.lattice_index);
+  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, lw, lh, GL_RG_INTEGER, GL_SHORT, lattice_index_.data());
+  if (packed > 0 && (side > target.packed_width || rows > target.packed_height)) {
+    glDeleteFramebuffers(1, &target.packed_framebuffer);
+    glDeleteTextures(3, target.packed);
+    target.packed_width = std::max(side, target.packed_width);
+    target.packed_height = std::max(rows, target.packed_height);
+    const GLenum formats[3] = {GL_RGBA8, GL_DEPTH_COMPONENT32F, GL_RGBA32F};
+    for (int i = 0; i < 3; ++i) {
+      target.packed[i] = nearest_texture(formats[i], target.packed_width, target.packed_height);
+    }
+    glGenFramebuffers(1, &target.packed_framebuffer);
+    glBindFramebuffer(GL_FRAMEBUFFER, target.packed_framebuffer);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, target.packed[0],
+                           0);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, target.packed[1], 0);
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+      release_supersampling(target);
+      throw RenderError("camera '" + s.camera_name + "': the supersampling target of " +
+                        std::to_string(side) + "x" + std::to_string(rows) + " cannot be made");
+    }
+  }
+  if (packed > 0) {
+    glBindTexture(GL_TEXTURE_2D, target.packed[2]);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, side, rows, GL_RGBA, GL_FLOAT, packed_where_.data());
+  }
+  glBindTexture(GL_TEXTURE_2D, 0);
   glBindBuffer(GL_ARRAY_BUFFER, target.points_buffer);
   glBufferData(GL_ARRAY_BUFFER, supersample_points_.size() * sizeof(float),
                supersample_points_.data(), GL_STREAM_DRAW);
   glBindBuffer(GL_ARRAY_BUFFER, 0);
 
+  // The meshes' samples: the marker points set the lattice's tiles to the background at the far
+  // plane and mark them in the stencil with this capture's value (other points keep older
+  // values): nothing is cleared, and meshes are shaded at the marked points only. For k = 2 the
+  // projection is narrowed so that the lattice's pixel centres fall on the pixels' corners.
   glBindFramebuffer(GL_FRAMEBUFFER, target.samples_framebuffer);
-  glViewport(0, 0, w, h);
+  glViewport(0, 0, lw, lh);
   glEnable(GL_PROGRAM_POINT_SIZE);
   glBindVertexArray(target.points_vao);
-  // The points set their samples to the background at the far plane and mark them in the
-  // stencil with this capture's value (other samples keep older values): nothing is cleared,
-  // and meshes are shaded at the marked samples only.
   target.stencil = target.stencil % 255 + 1;
   if (target.stencil == 1) glClearBufferfi(GL_DEPTH_STENCIL, 0, 0.0f, 0);
   glEnable(GL_STENCIL_TEST);
@@ -976,75 +1065,93 @@ void SceneRenderer::supersample(const Snapshot& s, RenderTarget& target,
   Program& marker =
       Context::get().program("supersample_points.vert", "supersample_marker.frag", "");
   marker.use();
-  glUniform2f(marker.uniform("u_size"), float(target.width), float(target.height));
-  glUniform1f(marker.uniform("u_point_size"), float(2 * k));
+  glUniform2f(marker.uniform("u_size"), float(lw), float(lh));
+  glUniform1f(marker.uniform("u_point_size"), 4.0f);
   glUniform4f(marker.uniform("u_background"), s.background[0], s.background[1], s.background[2],
               1.0f);
-  glDrawArrays(GL_POINTS, 0, points);
-  glBindVertexArray(0);
+  glDrawArrays(GL_POINTS, 0, tiles);
   glDepthFunc(GL_GREATER);
   glStencilFunc(GL_EQUAL, target.stencil, 0xff);
   glStencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
-  auto point_uniforms = [&](Program& program) {
-    glUniform2f(program.uniform("u_size"), float(target.width), float(target.height));
-    glUniform1f(program.uniform("u_point_size"), float(2 * k));
-  };
+  Eigen::Matrix4d lattice_projection = s.projection;
+  if (corners) {
+    lattice_projection.row(0) *= double(width) / double(lw);
+    lattice_projection.row(1) *= double(height) / double(lh);
+  }
   SurfacePass meshes = shading;
   meshes.volumes = false;
   Program& program =
       Context::get().program("mesh.vert", "mesh.frag", s.lights->defines() + "#define SHADE 1\n");
   program.use();
-  draw_surfaces(s, program, s.camera_pose, s.projection, kPassRgb, meshes);
+  draw_surfaces(s, program, s.camera_pose, lattice_projection, kPassRgb, meshes);
   glDisable(GL_STENCIL_TEST);
-  // Volumes cast one ray per sample, from the points.
-  SurfacePass volumes = shading;
-  volumes.meshes = false;
-  volumes.points_vao = target.points_vao;
-  volumes.points = volume_points;
-  // Their rays read the depth ranges (see volume.frag) on a unit between the volume's own and
-  // the shadow maps'.
-  constexpr int kDepthRangeUnit = 6;
-  static_assert(kShadowMapUnit > kDepthRangeUnit);
-  volumes.setup = [&](Program& p) {
-    if (shading.setup) shading.setup(p);
-    point_uniforms(p);
-    glActiveTexture(GL_TEXTURE0 + kDepthRangeUnit);
-    glBindTexture(GL_TEXTURE_2D, target.depth_range);
-    glActiveTexture(GL_TEXTURE0);
-    glUniform1i(p.uniform("u_depth_range"), kDepthRangeUnit);
-    glUniform1i(p.uniform("u_supersample_factor"), k);
-  };
-  if (volume_points > 0) draw_surfaces(s, program, s.camera_pose, s.projection, kPassRgb, volumes);
-  glActiveTexture(GL_TEXTURE0 + kDepthRangeUnit);
-  glBindTexture(GL_TEXTURE_2D, 0);
-  glActiveTexture(GL_TEXTURE0);
 
-  // Their means replace the marked pixels' colours.
-  constexpr int kMaskUnit = 7;
+  // The volumes' samples: each packed texel starts as the meshes' sample at its lattice point,
+  // at its depth; the volumes' rays are depth-tested against it.
+  constexpr int kWhereUnit = 6;  // between the volume's own units and the shadow maps'
+  static_assert(kShadowMapUnit > kWhereUnit);
+  if (packed > 0) {
+    glBindFramebuffer(GL_FRAMEBUFFER, target.packed_framebuffer);
+    glViewport(0, 0, side, rows);
+    glDepthFunc(GL_ALWAYS);
+    Program& gather =
+        Context::get().program("supersample_packed.vert", "supersample_gather.frag", "");
+    gather.use();
+    bind_unit(gather, "u_packed_where", 0, target.packed[2]);
+    bind_unit(gather, "u_lattice_color", 1, target.samples[0]);
+    bind_unit(gather, "u_lattice_depth", 2, target.samples[1]);
+    glBindVertexArray(target.points_vao);  // (the triangle's corners come from gl_VertexID)
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glDepthFunc(GL_GREATER);
+    SurfacePass volumes = shading;
+    volumes.meshes = false;
+    volumes.packed = true;
+    volumes.setup = [&](Program& p) {
+      if (shading.setup) shading.setup(p);
+      bind_unit(p, "u_packed_where", kWhereUnit, target.packed[2]);
+      glActiveTexture(GL_TEXTURE0);
+      glUniform2f(p.uniform("u_lattice_origin"), origin, origin);
+      glUniform1f(p.uniform("u_lattice_step"), step);
+      glUniform2f(p.uniform("u_image_size"), float(width), float(height));
+    };
+    draw_surfaces(s, program, s.camera_pose, s.projection, kPassRgb, volumes);
+    for (int unit : {0, 1, 2, kWhereUnit}) {
+      glActiveTexture(GL_TEXTURE0 + unit);
+      glBindTexture(GL_TEXTURE_2D, 0);
+    }
+  }
+
+  // The resolve: each pixel sampled becomes the weighted mean of its samples, blended over its
+  // centre's colour by the constant alpha (the centre's weight is one minus it).
   glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
   const GLenum colour_only[1] = {GL_COLOR_ATTACHMENT0};
   glDrawBuffers(1, colour_only);
-  glViewport(0, 0, target.width, target.height);
+  glViewport(0, 0, width, height);
   glDisable(GL_DEPTH_TEST);
+  glEnable(GL_BLEND);
+  glBlendColor(0.0f, 0.0f, 0.0f, corners ? 0.5f : 1.0f);
+  glBlendFunc(GL_CONSTANT_ALPHA, GL_ONE_MINUS_CONSTANT_ALPHA);
   Program& resolve =
       Context::get().program("supersample_points.vert", "supersample_resolve.frag", "");
   resolve.use();
-  glActiveTexture(GL_TEXTURE0);
-  glBindTexture(GL_TEXTURE_2D, target.samples[0]);
-  glUniform1i(resolve.uniform("u_samples"), 0);
-  glActiveTexture(GL_TEXTURE0 + kMaskUnit);
-  glBindTexture(GL_TEXTURE_2D, target.mask);
-  glUniform1i(resolve.uniform("u_supersample_mask"), kMaskUnit);
+  constexpr int kResolveUnits = 4;
+  bind_unit(resolve, "u_samples", 0, target.samples[0]);
+  bind_unit(resolve, "u_packed_color", 1, target.packed[0]);
+  bind_unit(resolve, "u_lattice_index", 2, target.lattice_index);
+  bind_unit(resolve, "u_supersample_mask", 3, target.mask);
   glUniform1i(resolve.uniform("u_supersample_factor"), k);
-  glUniform2f(resolve.uniform("u_size"), float(target.width), float(target.height));
+  glUniform2f(resolve.uniform("u_size"), float(width), float(height));
   glUniform1f(resolve.uniform("u_point_size"), 2.0f);
   glBindVertexArray(target.points_vao);
-  glDrawArrays(GL_POINTS, 0, points);
+  glDrawArrays(GL_POINTS, tiles, blocks);
   glBindVertexArray(0);
+  glDisable(GL_BLEND);
   glDisable(GL_PROGRAM_POINT_SIZE);
-  glBindTexture(GL_TEXTURE_2D, 0);
+  for (int unit = 0; unit < kResolveUnits; ++unit) {
+    glActiveTexture(GL_TEXTURE0 + unit);
+    glBindTexture(GL_TEXTURE_2D, 0);
+  }
   glActiveTexture(GL_TEXTURE0);
-  glBindTexture(GL_TEXTURE_2D, 0);
   glEnable(GL_DEPTH_TEST);
   check_gl("supersampling the rgb pass");
 }

@@ -67,13 +67,21 @@ struct RenderTarget {
   GLuint textures[kBuffers] = {};
   int width = 0;
   int height = 0;
-  // Supersampling of the rgb pass (made when first asked for, remade for another factor): the
-  // k x k larger colour and depth test, and the mask of the pixels supersampled.
+  // Supersampling of the rgb pass (made when first asked for, remade for another factor). Its
+  // samples lie on a lattice: for k = 2 the pixels' corners (each edge pixel takes its centre,
+  // the main pass's own sample, and its four corners), for k = 3 or 4 a k x k grid per pixel.
+  // The lattice's colour, depth and stencil hold the meshes' samples; the volumes' samples are
+  // rays packed densely, one per fragment of the packed target.
   int factor = 0;
-  GLuint samples_framebuffer = 0, samples[2] = {0, 0};  // colour, depth and stencil
-  GLuint mask = 0;
-  GLuint depth_range = 0;  // per pixel, the depths at which the 3 x 3 around it see a volume
-  GLuint points_vao = 0, points_buffer = 0;  // the pixels to sample, as points
+  int lattice_width = 0, lattice_height = 0;
+  GLuint samples_framebuffer = 0, samples[2] = {0, 0};  // the lattice's colour, depth-stencil
+  GLuint mask = 0;                                      // per pixel, 1 where it is supersampled
+  GLuint lattice_index = 0;  // per lattice point, its packed texel, or -1 (RG16I)
+  // The volumes' samples' colour, depth test and places (RGBA32F, see supersample()), grown to
+  // the largest packing yet.
+  GLuint packed_framebuffer = 0, packed[3] = {0, 0, 0};
+  int packed_width = 0, packed_height = 0;
+  GLuint points_vao = 0, points_buffer = 0;  // the lattice's tiles and the pixel blocks, as points
   int stencil = 0;  // the stencil value marking this capture's samples (1..255)
 };
 
@@ -94,10 +102,9 @@ struct SurfacePass {
   std::function<void(Program&)> setup;  // after the program's own uniforms
   bool orthographic = false;            // volumes: parallel rays along the view's z
   bool meshes = true, volumes = true;   // what is drawn
-  // Volumes drawn as these points (supersampling: one per pixel to sample, k x k sub-pixels
-  // wide) rather than as their boxes; 0 for none.
-  GLuint points_vao = 0;
-  GLsizei points = 0;
+  // Volumes cast supersampling's rays, one per fragment of the packed target in one triangle
+  // over it (supersample_packed.vert), rather than being drawn as their boxes.
+  bool packed = false;
 };
 
 /// What one camera sees at one step: everything a draw needs, copied out of the world while its
@@ -229,9 +236,10 @@ class SceneRenderer : public Renderer {
   std::map<int, ShadowMap> shadow_maps_;        // by light id
   EdgeInputs edge_inputs_;                      // scratch: what picks them
   std::vector<std::uint8_t> supersample_mask_;  // scratch: the pixels to supersample
-  std::vector<float> supersample_points_;       // scratch: their coordinates
-  std::vector<float> supersample_others_;       // scratch: those no volume is sampled at
-  std::vector<float> supersample_depths_;       // scratch: depth_range's values
+  std::vector<std::uint8_t> lattice_needed_;    // scratch: the lattice points to sample
+  std::vector<std::int16_t> lattice_index_;     // scratch: lattice_index's values
+  std::vector<float> packed_where_;             // scratch: the packed samples' places
+  std::vector<float> supersample_points_;       // scratch: lattice tiles, then pixel blocks
   mutable std::mutex volumes_mutex_;  // volumes_ grows during takes, which may overlap draws
   std::map<int, std::unique_ptr<GpuVolume>> volumes_;  // by volume id
   // Ids of objects that left the world, and whether a mesh may have lost its last body;

@@ -560,10 +560,10 @@ void GpuVolume::draw(const Snapshot::Volume& volume, const Eigen::Isometry3d& vi
       ((passes & kPassRgb) ? "#define SHADE 1\n" : "#define SHADE 0\n") +
       ((passes & kPassRgb) && volume.looks ? "#define LOOKS 1\n" : "") +
       (pass.orthographic ? "#define ORTHOGRAPHIC 1\n" : "") +
-      (pass.points_vao != 0 ? "#define FROM_PIXELS 1\n" : "") + pass.defines +
+      (pass.packed ? "#define FROM_PIXELS 1\n" : "") + pass.defines +
       (std::getenv("AMBFPLUS_DEBUG_VOLUME_STEPS") ? "#define DEBUG_STEPS 1\n" : "");
-  Program& program = Context::get().program(
-      pass.points_vao != 0 ? "supersample_points.vert" : "volume.vert", "volume.frag", defines);
+  Program& program = Context::get().program(pass.packed ? "supersample_packed.vert" : "volume.vert",
+                                            "volume.frag", defines);
   program.use();
   const Eigen::Vector3d s = data_->voxel_size();
   Eigen::Matrix4d volume_from_voxel = Eigen::Matrix4d::Identity();
@@ -588,12 +588,9 @@ void GpuVolume::draw(const Snapshot::Volume& volume, const Eigen::Isometry3d& vi
     glUniform1f(program.uniform("u_ray_back"),
                 float(2.0 * Eigen::Vector3d(n[0], n[1], n[2]).norm() + 1.0));
   }
-  if (pass.points_vao != 0) {
+  if (pass.packed) {
     const Eigen::Matrix4f voxel_from_clip = clip_from_voxel.inverse().cast<float>();
     glUniformMatrix4fv(program.uniform("u_voxel_from_clip"), 1, GL_FALSE, voxel_from_clip.data());
-    GLint viewport[4];
-    glGetIntegerv(GL_VIEWPORT, viewport);
-    glUniform2f(program.uniform("u_viewport"), float(viewport[2]), float(viewport[3]));
   }
   const Eigen::Matrix4f clip_f = clip_from_voxel.cast<float>();
   const Eigen::Matrix4f camera_f = camera_from_voxel.cast<float>();
@@ -630,9 +627,9 @@ void GpuVolume::draw(const Snapshot::Volume& volume, const Eigen::Isometry3d& vi
   }
   glActiveTexture(GL_TEXTURE0);
   if (pass.setup) pass.setup(program);
-  if (pass.points_vao != 0) {
-    glBindVertexArray(pass.points_vao);
-    glDrawArrays(GL_POINTS, 0, pass.points);
+  if (pass.packed) {
+    glBindVertexArray(vao_);  // (the triangle's corners come from gl_VertexID)
+    glDrawArrays(GL_TRIANGLES, 0, 3);
     glBindVertexArray(0);
     check_gl("ray casting a volume's samples");
     return;

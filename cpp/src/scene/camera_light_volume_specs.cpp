@@ -53,8 +53,7 @@ void CameraSpec::validate() const {
   check_rgb(background, "camera '" + name + "'", "background");
   if (antialiasing < 1 || antialiasing > kMaxAntialiasing) {
     throw ArgumentError(who + "antialiasing must be 1 (off) to " +
-                        std::to_string(kMaxAntialiasing) + " samples per axis, got " +
-                        std::to_string(antialiasing));
+                        std::to_string(kMaxAntialiasing) + ", got " + std::to_string(antialiasing));
   }
   if (publish.image_interval < 1 || publish.depth_interval < 1) {
     throw ArgumentError(who + "publish intervals must be >= 1");
@@ -80,7 +79,7 @@ const OptionTable<CameraSpec>& camera_options() {
             [](S& s, V v, K k) { s.background = rgb(v, k); }},
           O{"shadows", "bool", "lights with a shadow_quality cast shadows in rgb",
             [](S& s, V v, K k) { s.shadows = v.boolean(k); }},
-          O{"antialiasing", "int", "rgb supersampling per axis, 1 (off) to 4",
+          O{"antialiasing", "int", "rgb antialiasing, 1 (off) to 4",
             [](S& s, V v, K k) { s.antialiasing = v.integer(k); }},
           O{"looks", "bool",
             "volumes in rgb get ambient occlusion, a bone texture and wet highlights",

@@ -24,7 +24,7 @@ struct AMBFPLUS_API CameraPublish {
   double noise_mean = 0.1, noise_std = 0.001, noise_bias = 0.0;  ///< its mean, std_dev, bias
 };
 
-/// The largest rgb supersampling factor per axis (Camera::set_antialiasing).
+/// The largest rgb antialiasing level (Camera::set_antialiasing).
 constexpr int kMaxAntialiasing = 4;
 
 /// Everything needed to create a camera. Defaults are AMBF's (fva 0.7 rad, near 0.1, far 10).
@@ -39,7 +39,7 @@ struct AMBFPLUS_API CameraSpec {
   std::array<float, 3> background{0.0f, 0.0f, 0.0f};  ///< RGB, 0..1, where nothing is hit
   CameraPublish publish;
   bool shadows = false;  ///< lights cast shadows in the rgb pass (see Camera::shadows)
-  int antialiasing = 1;  ///< rgb supersampling factor per axis, 1 (off) to 4
+  int antialiasing = 1;  ///< rgb antialiasing, 1 (off) to 4 (Camera::antialiasing)
   bool looks = false;    ///< volume surface looks in the rgb pass (see Camera::looks)
 
   /// Throws ArgumentError naming the camera and the value unless every value can be used (size
@@ -96,9 +96,10 @@ class AMBFPLUS_API Camera : public Object {
   /// (directional and spot lights). Ground-truth passes never change.
   bool shadows() const { return shadows_; }
   void set_shadows(bool on) { shadows_ = on; }
-  /// The rgb pass's supersampling factor per axis: 1 is off, k (2..4) shades k x k samples in
-  /// each pixel where edges or contrast need them and averages them. Ground-truth passes stay
-  /// one exact sample at each pixel centre. ArgumentError outside 1..4.
+  /// The rgb pass's antialiasing: 1 is off; 2 to 4 supersample each pixel where edges or
+  /// contrast need it: 2 blends its centre (1/2) with its four corners (1/8 each; corners are
+  /// shared with the neighbouring pixels), 3 and 4 take the mean of a k x k grid of samples.
+  /// Ground-truth passes stay one exact sample at each pixel centre. ArgumentError outside 1..4.
   int antialiasing() const { return antialiasing_; }
   void set_antialiasing(int k);
   /// Whether the rgb pass gives volumes their surface looks: ambient occlusion from the

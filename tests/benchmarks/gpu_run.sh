@@ -7,8 +7,9 @@
 #               stereo benchmark), and optionally h5site/ (hdf5plugin, where pip cannot fetch it)
 #   .gl/        optionally the glvnd dispatch packages (libegl1, libopengl0, ...) as .deb files,
 #               where the machine has the NVIDIA driver but not the dispatch libraries
-# Installs the wheel, prints the GPU and what `ambfplus doctor` finds, then the capture, stereo
-# and datasets benchmarks (each under a time limit). Files land in $OUT when it is set.
+# Installs the wheel, prints the GPU and what `ambfplus doctor` finds, then the capture, stereo,
+# antialiasing and datasets benchmarks (each under a time limit, about 8 minutes in all). Files
+# land in $OUT when it is set.
 set -u -o pipefail
 REPO=$(pwd)
 OUT=${OUT:-$REPO/gpu-results}
@@ -27,7 +28,7 @@ export PYTHONPATH=$REPO/.benchdev/h5site AMBFPLUS_BENCH_DIR=$REPO/.benchdev \
   AMBFPLUS_FIXTURES=$REPO/.benchdev/fixtures PYTHONUNBUFFERED=1
 cd /tmp
 timeout 60 python3 -m ambfplus doctor 2>&1 | tee "$OUT/doctor.txt"
-for spec in "capture 150" "stereo 120" "datasets 330"; do
+for spec in "capture 60" "stereo 90" "antialiasing 45" "datasets 270"; do
   set -- $spec
   echo "== $1"
   timeout "$2" python3 "$REPO/tests/benchmarks/run.py" --only "$1" | tee "$OUT/$1.jsonl"

@@ -402,7 +402,7 @@ def stereo(args) -> Iterator[dict]:
             "ratio": round(cost / rgb, 3),
             "what": f"the {name} pass alone, relative to rgb alone",
         }
-    # Shadows (the fixture's lights and their shadow quality), 2 x 2 supersampling and the
+    # Shadows (the fixture's lights and their shadow quality), supersampling at level 2 and the
     # volume looks (ambient occlusion, bone texture, wet highlights), against everything off,
     # rounds alternating so that machine noise hits all alike. The shadow maps are kept while
     # nothing that casts moves; "redrawn" nudges the drill in view before each pair, so each

@@ -76,12 +76,15 @@ void Camera::set_fov_y(double fov_y) {
   fov_y_ = fov_y;
 }
 
-void Camera::set_antialiasing(int k) {
+void check_antialiasing(const std::string& camera, int k) {
   if (k < 1 || k > kMaxAntialiasing) {
-    throw ArgumentError("camera '" + name() + "': antialiasing must be 1 (off) to " +
-                        std::to_string(kMaxAntialiasing) + " samples per axis, got " +
-                        std::to_string(k));
+    throw ArgumentError("camera '" + camera + "': antialiasing must be 1 (off) to " +
+                        std::to_string(kMaxAntialiasing) + ", got " + std::to_string(k));
   }
+}
+
+void Camera::set_antialiasing(int k) {
+  check_antialiasing(name(), k);
   antialiasing_ = k;
 }
 

@@ -51,10 +51,7 @@ void CameraSpec::validate() const {
                         std::to_string(near) + ", far " + std::to_string(far));
   }
   check_rgb(background, "camera '" + name + "'", "background");
-  if (antialiasing < 1 || antialiasing > kMaxAntialiasing) {
-    throw ArgumentError(who + "antialiasing must be 1 (off) to " +
-                        std::to_string(kMaxAntialiasing) + ", got " + std::to_string(antialiasing));
-  }
+  check_antialiasing(name, antialiasing);
   if (publish.image_interval < 1 || publish.depth_interval < 1) {
     throw ArgumentError(who + "publish intervals must be >= 1");
   }

@@ -27,6 +27,9 @@ struct AMBFPLUS_API CameraPublish {
 /// The largest rgb antialiasing level (Camera::set_antialiasing).
 constexpr int kMaxAntialiasing = 4;
 
+/// Throws ArgumentError naming the camera unless k is an antialiasing level (1..4).
+void check_antialiasing(const std::string& camera, int k);
+
 /// Everything needed to create a camera. Defaults are AMBF's (fva 0.7 rad, near 0.1, far 10).
 struct AMBFPLUS_API CameraSpec {
   std::string name;

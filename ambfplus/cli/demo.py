@@ -29,12 +29,15 @@ def add_parser(commands) -> None:
                       help="phantom voxels per side")  # fmt: skip
     demo.add_argument("--every", type=within(1, 1000), default=50,
                       help="steps (ms) between stereo frames")  # fmt: skip
+    demo.add_argument("--plain", action="store_true",
+                      help="no shadows, antialiasing or volume looks (the library's defaults); "
+                      "without it the cameras draw all three, as the launcher does")  # fmt: skip
     demo.set_defaults(func=run)
 
 
 def run(args) -> int:
     """Runs the demo with the command line's options."""
-    return run_demo(args.out, args.width, args.height, args.resolution, args.every)
+    return run_demo(args.out, args.width, args.height, args.resolution, args.every, args.plain)
 
 
 # The demo fails when the anatomy covers less than this share of the view (at the paper's
@@ -129,9 +132,12 @@ def _debrief(path: Path, out: Path, resolution: int) -> str:
     return ", debrief.html, assessment.json"
 
 
-def run_demo(out: Path, width: int, height: int, resolution: int, every: int) -> int:
+def run_demo(
+    out: Path, width: int, height: int, resolution: int, every: int, plain: bool = False
+) -> int:
     """A headless drilling session on the built-in phantom: scripted plunges at three sites
-    while the stereo rig circles, recorded, validated, and previewed as PNG files."""
+    while the stereo rig circles, recorded, validated, and previewed as PNG files. The cameras
+    draw shadows, antialiasing (level 2) and the volume looks unless `plain`."""
     from ..recording import open_recording, validate
     from ..scenes import drilling_phantom, orbit_view, record_session
 
@@ -140,7 +146,10 @@ def run_demo(out: Path, width: int, height: int, resolution: int, every: int) ->
     for old in out.glob("session.h5*"):
         old.unlink()
     print(f"ambfplus {__version__}: {gl_info()['renderer']}", flush=True)
-    scene = drilling_phantom(resolution=resolution, width=width, height=height)
+    scene = drilling_phantom(
+        resolution=resolution, width=width, height=height, shadows=not plain,
+        antialiasing=1 if plain else 2, looks=not plain,
+    )  # fmt: skip
     device = ScriptedDevice()
     sites = [(0.0, 0.0), (-0.006, 0.004), (-0.003, -0.006)]
     start = scene.drill.goal[:3, 3]

@@ -138,11 +138,16 @@ def drilling_phantom(
     height: int = 480,
     baseline: float = 0.065,
     working_distance: float | None = 0.25,
+    shadows: bool = False,
+    antialiasing: int = 1,
+    looks: bool = False,
 ) -> Scene:
     """The built-in temporal-bone phantom (48 mm across) under the paper's stereo rig (65 mm
     baseline, f = 1135 px at 640x480, off-axis with zero disparity at 250 mm), with the 6 mm burr
     of a drill 10 mm above its lateral face (z = 14 mm) and drill meshes riding on it. A device
-    named "hand" drives the drill in world axes at scale 1: button 0 spins the burr."""
+    named "hand" drives the drill in world axes at scale 1: button 0 spins the burr. ``shadows``,
+    ``antialiasing`` and ``looks`` are the rig's cameras' (``StereoRig``); the scene's spec
+    keeps them, so a replay renders what was recorded."""
     world = World()
     for light in DEFAULT_LIGHTS:
         world.add_light(**light)
@@ -150,7 +155,8 @@ def drilling_phantom(
     drill, bodies = _drill_over(world, volume, tip=(0.0, 0.0, 0.024))
     rig = StereoRig(
         world, "rig", baseline=baseline, width=width, height=height, fov_y=paper_fov(height),
-        near=0.01, far=2.0, working_distance=working_distance,
+        near=0.01, far=2.0, working_distance=working_distance, shadows=shadows,
+        antialiasing=antialiasing, looks=looks,
     )  # fmt: skip
     rig.aim(*orbit_view(0.0))
     spec = {
@@ -158,6 +164,7 @@ def drilling_phantom(
         "params": {
             "resolution": resolution, "seed": seed, "width": width, "height": height,
             "baseline": baseline, "working_distance": working_distance,
+            "shadows": shadows, "antialiasing": antialiasing, "looks": looks,
         },
     }  # fmt: skip
     # The drill's bodies are logged too: exports give every body a pose at every step.

@@ -93,6 +93,9 @@ def test_demo_records_a_checked_drilling_session(tmp_path):
     with open_recording(out / "session.h5") as rec:
         assert len(rec.removed["step"]) == recording["voxels_removed"]
         assert len(rec.rigs["rig"]) == recording["frames"]
+        # What a new user sees is drawn as the launcher draws it, and the recording says so.
+        params = rec.metadata["scene"]["params"]
+        assert (params["shadows"], params["antialiasing"], params["looks"]) == (True, 2, True)
 
 
 def test_demo_runs_as_a_module(tmp_path):

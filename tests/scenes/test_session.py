@@ -55,6 +55,26 @@ def test_replay_gives_the_same_removal_forces_and_images(session):
     assert report.voxels_removed == summary["voxels_removed"]
 
 
+def test_a_session_recorded_with_shadows_antialiasing_and_looks_replays_to_its_images(tmp_path):
+    """The rig's rendering options are part of the scene's spec: the replay draws them too."""
+    path = tmp_path / "looks.h5"
+    options = {"shadows": True, "antialiasing": 2, "looks": True}
+    scene = drilling_phantom(resolution=64, width=160, height=120, **options)
+    summary = record_session(
+        scene, path, plunge_and_cut(scene), seconds=0.3, capture_every=100,
+        camera_motion=orbit_view,
+    )  # fmt: skip
+    with open_recording(path) as rec:
+        params = rec.metadata["scene"]["params"]
+        assert {key: params[key] for key in options} == options
+        recorded = rec.rigs["rig"][0].left.rgb
+    plain = drilling_phantom(resolution=64, width=160, height=120)
+    plain.rig.aim(*orbit_view(0.0))
+    assert (plain.rig.left.capture(passes=["rgb"]).rgb != recorded).any(axis=-1).sum() > 100
+    report = replay(path)
+    assert report.images_identical == report.frames == summary["frames"] == 3
+
+
 def test_replay_with_another_baseline_renders_that_baseline(session, tmp_path):
     path, _ = session
     out = tmp_path / "wide.h5"

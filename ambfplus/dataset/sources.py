@@ -136,8 +136,10 @@ def place_rig(world: World, scene: dict, params: dict, where: str = "scene") -> 
     """The dataset's rig (cameras rig_left and rig_right) with the episode's drawn `params`
     (width, height, baseline, working_distance, fov_y and its scale, principal point offset,
     background): where the scene's stereo pair is, riding on the pair's body, with the pair's
-    values for what the spec leaves out; or at the spec's view."""
+    values for what the spec leaves out and the pair's shadows, antialiasing and looks; or at
+    the spec's view, with those off."""
     pair = stereo_pair(world, scene, where)
+    rendering = {}
     if pair is None:
         left = None
         defaults = {**FREE_RIG, "fov_y": paper_fov(int(params["height"] or FREE_RIG["height"]))}
@@ -151,6 +153,9 @@ def place_rig(world: World, scene: dict, params: dict, where: str = "scene") -> 
             "fov_y": left.fov_y,
         }
         near, far = left.near, left.far
+        rendering = {
+            "shadows": left.shadows, "antialiasing": left.antialiasing, "looks": left.looks
+        }  # fmt: skip
     value = {k: (params[k] if params.get(k) is not None else v) for k, v in defaults.items()}
     rig = StereoRig(
         world,
@@ -164,6 +169,7 @@ def place_rig(world: World, scene: dict, params: dict, where: str = "scene") -> 
         working_distance=params["working_distance"],
         background=params["background"],
         principal_point_offset=params["principal_point_offset"],
+        **rendering,
     )
     if left is None:
         rig.aim(scene["view"]["eye"], scene["view"]["target"])

@@ -174,6 +174,30 @@ def test_the_rig_takes_the_scene_pairs_place_or_stands_at_the_view(multi_arm_spe
     np.testing.assert_allclose(rig.left.pose[:3, 2], axis / np.linalg.norm(axis), atol=1e-9)
 
 
+def test_the_rig_draws_as_the_scene_pair_draws(multi_arm_spec, tmp_path):
+    """Shadows, antialiasing and looks that the scene's files give its stereo pair are the
+    dataset rig's too; a free rig draws without them."""
+    folder = tmp_path / "multi_arm"
+    shutil.copytree(multi_arm_spec.parent / "scene", folder / "scene")
+    world_file = folder / "scene" / "world.yaml"
+    world_file.write_text(
+        world_file.read_text().replace(
+            "  name: main\n", "  name: main\n  shadows: true\n  antialiasing: 3\n  looks: true\n"
+        )
+    )
+    spec = load_spec(scene_spec(folder))
+    scene, _ = build_episode_scene(spec.data, sample_episode(spec, 0))
+    pair = scene.world.get("main_left")
+    assert (pair.shadows, pair.antialiasing, pair.looks) == (True, 3, True)
+    for camera in (scene.rig.left, scene.rig.right):
+        assert (camera.shadows, camera.antialiasing, camera.looks) == (True, 3, True)
+    view = {"eye": [0.4, -0.3, 1.2], "target": [0.4, 0.0, 0.5]}
+    spec = load_spec(scene_spec(folder, scene={**scene_spec(folder)["scene"], "view": view}))
+    scene, _ = build_episode_scene(spec.data, sample_episode(spec, 0))
+    left = scene.rig.left
+    assert (left.shadows, left.antialiasing, left.looks) == (False, 1, False)
+
+
 # Generating --------------------------------------------------------------------------------
 
 

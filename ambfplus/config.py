@@ -178,6 +178,12 @@ def number(value, where: Where, minimum=None, maximum=None, integer=False, stric
     return value if integer else float(value)
 
 
+def boolean(value, where: Where) -> bool:
+    if not isinstance(value, bool):
+        raise where.error(None, f"expected true or false, got {describe(value)}")
+    return value
+
+
 def integer(value, where: Where, minimum=None, maximum=None, limit: str = "") -> int:
     return number(value, where, minimum, maximum, integer=True, limit=limit)
 

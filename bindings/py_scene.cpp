@@ -1640,6 +1640,7 @@ void define_scene(py::module_& m) {
   define_object(object);
   auto camera = bound<Camera, Object, std::shared_ptr<Camera>>(m, "Camera");
   define_camera(camera);
+  m.attr("MAX_ANTIALIASING") = kMaxAntialiasing;
   auto light = bound<Light, Object, std::shared_ptr<Light>>(m, "Light");
   define_light(light);
   auto volume = bound<Volume, Object, std::shared_ptr<Volume>>(m, "Volume");

@@ -152,6 +152,7 @@ def sample_episode(spec: DatasetSpec | dict, index: int) -> EpisodePlan:
         "background": draw(appearance.get("background", [0.0, 0.0, 0.0]), rng["background"]),
         "lights": _lights(appearance.get("lights"), rng["lights"]),
         **_materials(appearance, rng["materials"]),
+        **appearance.get("rendering", {}),
     }
     return EpisodePlan(
         index=index,
@@ -226,6 +227,8 @@ def _sample_scene_episode(data: dict, index: int, seed: int, rng: dict) -> Episo
         "background": draw(appearance.get("background", [0.0, 0.0, 0.0]), rng["background"]),
         "lights": lights,
     }
+    if "rendering" in appearance:
+        plan_scene["rendering"] = dict(appearance["rendering"])
     episode = data["episode"]
     kind = "script" if "script" in episode else "waypoints" if "waypoints" in episode else "still"
     if kind == "waypoints":

@@ -137,7 +137,7 @@ def place_rig(world: World, scene: dict, params: dict, where: str = "scene") -> 
     (width, height, baseline, working_distance, fov_y and its scale, principal point offset,
     background): where the scene's stereo pair is, riding on the pair's body, with the pair's
     values for what the spec leaves out and the pair's shadows, antialiasing and looks; or at
-    the spec's view, with those off."""
+    the spec's view, with those off. The spec's ``appearance.rendering`` overrides them."""
     pair = stereo_pair(world, scene, where)
     rendering = {}
     if pair is None:
@@ -156,6 +156,7 @@ def place_rig(world: World, scene: dict, params: dict, where: str = "scene") -> 
         rendering = {
             "shadows": left.shadows, "antialiasing": left.antialiasing, "looks": left.looks
         }  # fmt: skip
+    rendering.update(params.get("rendering") or {})
     value = {k: (params[k] if params.get(k) is not None else v) for k, v in defaults.items()}
     rig = StereoRig(
         world,

@@ -21,11 +21,12 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from .._core import ConfigError
+from .._core import MAX_ANTIALIASING, ConfigError
 from ..config import (
     MAX_SEED,
     Where,
     anatomy,
+    boolean,
     describe,
     existing,
     fixed,
@@ -92,6 +93,8 @@ appearance:                     # optional; every entry may vary
   background: [0, 0, 0]         # RGB 0..1 where nothing is hit
   intrinsics: {fov_y_jitter: 0.02, principal_point_jitter: 2.0}  # relative; pixels
   noise: {rgb_sigma: 0}         # Gaussian sensor noise on RGB, 8-bit levels (ground truth exact)
+  rendering: {shadows: true, antialiasing: 2, looks: true}   # the rig's rgb (fixed values;
+                                # default all off; with a scene, the scene pair's)
 """
 
 SCENE_SCHEMA_TEXT = """\
@@ -382,8 +385,11 @@ def _appearance(value, where: Where, with_scene: bool = False) -> dict:
     keys(
         value,
         where,
-        optional=("lights", "labels", "material", "drill", "background", "intrinsics", "noise"),
-    )
+        optional=(
+            "lights", "labels", "material", "drill", "background", "intrinsics", "noise",
+            "rendering",
+        ),
+    )  # fmt: skip
     if with_scene:
         for key, what in BUILT_IN_LOOKS.items():
             if key in value:
@@ -412,7 +418,21 @@ def _appearance(value, where: Where, with_scene: bool = False) -> dict:
     for key, (what, fields) in sections.items():
         if key in value:
             out[key] = _section(value[key], where.at(key), what, fields)
+    if "rendering" in value:
+        out["rendering"] = _rendering(value["rendering"], where.at("rendering"))
     return out
+
+
+def _rendering(value, where: Where) -> dict:
+    """The rig cameras' shadows, antialiasing and looks (Camera's), as given: fixed values."""
+    mapping(value, where, "rendering")
+    keys(value, where, optional=("shadows", "antialiasing", "looks"))
+    checks = {
+        "shadows": boolean,
+        "antialiasing": lambda v, w: integer(v, w, minimum=1, maximum=MAX_ANTIALIASING),
+        "looks": boolean,
+    }
+    return {key: check(value[key], where.at(key)) for key, check in checks.items() if key in value}
 
 
 def _section(value, where: Where, what: str, fields: dict) -> dict:

@@ -186,6 +186,9 @@ def drilling_scene(
     volume_material: dict | None = None,
     drill_metal: dict | None = None,
     drill_handle: dict | None = None,
+    shadows: bool = False,
+    antialiasing: int = 1,
+    looks: bool = False,
 ) -> Scene:
     """Any anatomy under a stereo rig with a drill over it, every look of it a parameter (the
     scene of a dataset episode; ``drilling_phantom`` is the paper's fixed version).
@@ -198,7 +201,7 @@ def drilling_scene(
     0..1). Appearance: `lights` (dicts of ``World.add_light``'s arguments, without a name;
     default the paper scene's key and fill), `label_colors` ({label id: RGB 0..255}),
     `volume_material` and the drill's `drill_metal` and `drill_handle` (color, specular,
-    shininess). Geometry objects come first and lights last, so that object ids do not depend
+    shininess); the rig's `shadows`, `antialiasing` and `looks`. Geometry objects come first and lights last, so that object ids do not depend
     on the number of lights."""
     anatomy = anatomy or {"phantom": {"resolution": 128, "seed": 0}}
     world = World()
@@ -212,7 +215,8 @@ def drilling_scene(
         world, "rig", baseline=baseline, width=width, height=height,
         fov_y=paper_fov(height) if fov_y is None else fov_y, near=0.01, far=2.0,
         working_distance=working_distance, background=background,
-        principal_point_offset=principal_point_offset,
+        principal_point_offset=principal_point_offset, shadows=shadows,
+        antialiasing=antialiasing, looks=looks,
     )  # fmt: skip
     target = (0.0, 0.0, surface - 0.006)
     rig.aim(*CameraPath(target=target)(0.0))
@@ -226,7 +230,8 @@ def drilling_scene(
             "principal_point_offset": list(principal_point_offset),
             "background": list(background), "lights": lights, "label_colors": label_colors,
             "volume_material": volume_material, "drill_metal": drill_metal,
-            "drill_handle": drill_handle,
+            "drill_handle": drill_handle, "shadows": shadows, "antialiasing": antialiasing,
+            "looks": looks,
         },
     }  # fmt: skip
     # The drill's bodies are logged too: exports give every body a pose at every step.

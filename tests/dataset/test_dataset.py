@@ -121,6 +121,18 @@ def run_cli(*args) -> subprocess.CompletedProcess:
             {"appearance": {"noise": {"rgb_sigma": True}}},
             "appearance.noise.rgb_sigma: expected a number, got bool",
         ),
+        (
+            {"appearance": {"rendering": {"antialiasing": 5}}},
+            "appearance.rendering.antialiasing: expected a value <= 4, got 5",
+        ),
+        (
+            {"appearance": {"rendering": {"looks": "yes"}}},
+            "appearance.rendering.looks: expected true or false, got str 'yes'",
+        ),
+        (
+            {"appearance": {"rendering": {"shading": True}}},
+            "appearance.rendering.shading: unknown key; expected one of antialiasing, looks",
+        ),
     ],
 )
 def test_bad_specs_name_the_key(change, where, tmp_path):
@@ -684,6 +696,7 @@ def test_other_looks_leave_the_ground_truth_exact(dataset_spec, tmp_path):
         "material": {"specular": 0.9, "shininess": 4.0},
         "background": [0.9, 0.1, 0.5],
         "noise": {"rgb_sigma": 6.0},
+        "rendering": {"shadows": True, "antialiasing": 2, "looks": True},
     }
     index = next(
         i for i in range(spec.episodes) if sample_episode(spec, i).scenario["kind"] != "camera"
@@ -694,6 +707,8 @@ def test_other_looks_leave_the_ground_truth_exact(dataset_spec, tmp_path):
         record_episode(data, index, paths[-1])
     with open_recording(paths[0]) as a, open_recording(paths[1]) as b:
         assert a.metadata["sampled"]["scene"]["lights"] != b.metadata["sampled"]["scene"]["lights"]
+        drawn = {k: b.metadata["scene"]["params"][k] for k in ("shadows", "antialiasing", "looks")}
+        assert drawn == {"shadows": True, "antialiasing": 2, "looks": True}  # the rig's cameras
         assert len(a.removed["step"]) > 0
         for key in ("step", "voxel", "label"):
             assert np.array_equal(a.removed[key], b.removed[key])

@@ -176,7 +176,8 @@ def test_the_rig_takes_the_scene_pairs_place_or_stands_at_the_view(multi_arm_spe
 
 def test_the_rig_draws_as_the_scene_pair_draws(multi_arm_spec, tmp_path):
     """Shadows, antialiasing and looks that the scene's files give its stereo pair are the
-    dataset rig's too; a free rig draws without them."""
+    dataset rig's too, but for what the spec's appearance.rendering gives; a free rig draws
+    without them."""
     folder = tmp_path / "multi_arm"
     shutil.copytree(multi_arm_spec.parent / "scene", folder / "scene")
     world_file = folder / "scene" / "world.yaml"
@@ -191,6 +192,11 @@ def test_the_rig_draws_as_the_scene_pair_draws(multi_arm_spec, tmp_path):
     assert (pair.shadows, pair.antialiasing, pair.looks) == (True, 3, True)
     for camera in (scene.rig.left, scene.rig.right):
         assert (camera.shadows, camera.antialiasing, camera.looks) == (True, 3, True)
+    # The spec's appearance.rendering overrides what it gives.
+    spec = load_spec(scene_spec(folder, appearance={"rendering": {"antialiasing": 2}}))
+    scene, _ = build_episode_scene(spec.data, sample_episode(spec, 0))
+    for camera in (scene.rig.left, scene.rig.right):
+        assert (camera.shadows, camera.antialiasing, camera.looks) == (True, 2, True)
     view = {"eye": [0.4, -0.3, 1.2], "target": [0.4, 0.0, 0.5]}
     spec = load_spec(scene_spec(folder, scene={**scene_spec(folder)["scene"], "view": view}))
     scene, _ = build_episode_scene(spec.data, sample_episode(spec, 0))

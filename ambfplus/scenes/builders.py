@@ -201,8 +201,8 @@ def drilling_scene(
     0..1). Appearance: `lights` (dicts of ``World.add_light``'s arguments, without a name;
     default the paper scene's key and fill), `label_colors` ({label id: RGB 0..255}),
     `volume_material` and the drill's `drill_metal` and `drill_handle` (color, specular,
-    shininess); the rig's `shadows`, `antialiasing` and `looks`. Geometry objects come first and lights last, so that object ids do not depend
-    on the number of lights."""
+    shininess); the rig's `shadows`, `antialiasing` and `looks`. Geometry objects come first
+    and lights last, so that object ids do not depend on the number of lights."""
     anatomy = anatomy or {"phantom": {"resolution": 128, "seed": 0}}
     world = World()
     data = anatomy_data(anatomy, label_colors)

@@ -444,6 +444,29 @@ GpuMesh& SceneRenderer::soft_mesh_for(const Snapshot::Soft& soft) {
   return it->second;
 }
 
+namespace {
+
+/// A 2D texture of one level, filtered nearest.
+GLuint nearest_texture(GLenum format, int width, int height) {
+  GLuint texture = 0;
+  glGenTextures(1, &texture);
+  glBindTexture(GL_TEXTURE_2D, texture);
+  glTexStorage2D(GL_TEXTURE_2D, 1, format, width, height);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glBindTexture(GL_TEXTURE_2D, 0);
+  return texture;
+}
+
+/// Binds a 2D texture to a unit and names the unit in a sampler uniform.
+void bind_unit(Program& program, const char* name, int unit, GLuint texture) {
+  glActiveTexture(GL_TEXTURE0 + unit);
+  glBindTexture(GL_TEXTURE_2D, texture);
+  glUniform1i(program.uniform(name), unit);
+}
+
+}  // namespace
+
 RenderTarget& SceneRenderer::target_for(const Snapshot& snapshot) {
   auto it = targets_.find(snapshot.camera_id);
   if (it != targets_.end()) return it->second;
@@ -451,16 +474,12 @@ RenderTarget& SceneRenderer::target_for(const Snapshot& snapshot) {
   t.width = snapshot.width;
   t.height = snapshot.height;
   glGenFramebuffers(1, &t.framebuffer);
-  glGenTextures(RenderTarget::kBuffers, t.textures);
   const GLenum formats[RenderTarget::kBuffers] = {
       GL_RGBA8, GL_R32F, GL_R16UI, GL_R32I, GL_R32I, GL_RGBA8, GL_DEPTH_COMPONENT32F};
   glBindFramebuffer(GL_FRAMEBUFFER, t.framebuffer);
   // Textures, so that supersampling can read the passes that find edges.
   for (int i = 0; i < RenderTarget::kBuffers; ++i) {
-    glBindTexture(GL_TEXTURE_2D, t.textures[i]);
-    glTexStorage2D(GL_TEXTURE_2D, 1, formats[i], t.width, t.height);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    t.textures[i] = nearest_texture(formats[i], t.width, t.height);
     const GLenum attachment = i + 1 < RenderTarget::kBuffers
                                   ? static_cast<GLenum>(GL_COLOR_ATTACHMENT0 + i)
                                   : static_cast<GLenum>(GL_DEPTH_ATTACHMENT);
@@ -824,29 +843,6 @@ void supersample_edges(const EdgeInputs& in, int width, int height, std::uint8_t
   }
 }
 
-namespace {
-
-/// A 2D texture of one level, filtered nearest.
-GLuint nearest_texture(GLenum format, int width, int height) {
-  GLuint texture = 0;
-  glGenTextures(1, &texture);
-  glBindTexture(GL_TEXTURE_2D, texture);
-  glTexStorage2D(GL_TEXTURE_2D, 1, format, width, height);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-  glBindTexture(GL_TEXTURE_2D, 0);
-  return texture;
-}
-
-/// Binds a 2D texture to a unit and names the unit in a sampler uniform.
-void bind_unit(Program& program, const char* name, int unit, GLuint texture) {
-  glActiveTexture(GL_TEXTURE0 + unit);
-  glBindTexture(GL_TEXTURE_2D, texture);
-  glUniform1i(program.uniform(name), unit);
-}
-
-}  // namespace
-
 void SceneRenderer::supersample(const Snapshot& s, RenderTarget& target,
                                 const SurfacePass& shading) {
   const int k = s.antialiasing;
@@ -862,8 +858,6 @@ void SceneRenderer::supersample(const Snapshot& s, RenderTarget& target,
   if (target.factor != k) {
     release_supersampling(target);
     target.factor = k;
-    target.lattice_width = lw;
-    target.lattice_height = lh;
     target.samples[0] = nearest_texture(GL_RGBA8, lw, lh);
     target.samples[1] = nearest_texture(GL_DEPTH32F_STENCIL8, lw, lh);
     target.mask = nearest_texture(GL_R8UI, width, height);

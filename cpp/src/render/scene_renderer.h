@@ -73,7 +73,6 @@ struct RenderTarget {
   // The lattice's colour, depth and stencil hold the meshes' samples; the volumes' samples are
   // rays packed densely, one per fragment of the packed target.
   int factor = 0;
-  int lattice_width = 0, lattice_height = 0;
   GLuint samples_framebuffer = 0, samples[2] = {0, 0};  // the lattice's colour, depth-stencil
   GLuint mask = 0;                                      // per pixel, 1 where it is supersampled
   GLuint lattice_index = 0;  // per lattice point, its packed texel, or -1 (RG16I)

@@ -36,7 +36,7 @@ from ambfplus.dataset import (
 )
 from ambfplus.dataset.sampling import HANDLE_COLOR, METAL_COLOR
 from ambfplus.recording import open_recording
-from ambfplus.scenes import anatomy_data
+from ambfplus.scenes import anatomy_data, drilling_scene
 
 BASE_SPEC = {
     "version": 1,
@@ -684,6 +684,22 @@ def test_randomisation_is_real_recorded_and_within_the_ranges(reference_dataset)
     # every label's colour differs between episodes
     assert set(seen["label_colors"]) == {str(i) for i in table}
     assert all(len(colors) > 1 for colors in seen["label_colors"].values()), seen["label_colors"]
+
+
+def test_appearance_rendering_sets_the_rig_cameras():
+    spec = load_spec(
+        {
+            **BASE_SPEC,
+            "appearance": {"rendering": {"shadows": True, "antialiasing": 3, "looks": True}},
+        }
+    )
+    scene = drilling_scene(**sample_episode(spec, 0).scene)
+    for camera in (scene.rig.left, scene.rig.right):
+        assert (camera.shadows, camera.antialiasing, camera.looks) == (True, 3, True)
+    plain = drilling_scene(**sample_episode(load_spec(BASE_SPEC), 0).scene)
+    assert (plain.rig.left.shadows, plain.rig.left.antialiasing, plain.rig.left.looks) == (
+        False, 1, False,
+    )  # fmt: skip
 
 
 def test_other_looks_leave_the_ground_truth_exact(dataset_spec, tmp_path):

@@ -102,7 +102,7 @@ def test_ray_workers_killed_on_both_nodes_are_retried(
     def killer():
         rng = random.Random(20)
         while not stop.is_set() and sum(killed.values()) < 4:
-            time.sleep(rng.uniform(0.2, 0.8))
+            time.sleep(rng.uniform(0.1, 0.4))  # often enough to reach both nodes in the run
             running = cluster.workers_running(TASK)
             # the second node's workers first, until one of each node is gone
             ips = [ip for ip in sorted(running, reverse=True) if running[ip]]
